@@ -1,0 +1,19 @@
+"""rigidlcp's pure mathematics: LCP/MLCP problems, solvers, residuals. Knows nothing of disks."""
+
+from .api import MethodInfo, get_method, methods, register, solve
+from .problem import LCP, MLCP, InvalidProblem, NotApplicable, load
+from .solution import STATUSES, Solution, complementarity_residual
+
+__all__ = [
+    "LCP", "MLCP", "InvalidProblem", "NotApplicable", "load", "Solution", "STATUSES",
+    "complementarity_residual", "solve", "methods", "get_method", "register", "MethodInfo",
+    "enumerate_solutions",
+]
+
+
+def __getattr__(name: str):
+    if name == "enumerate_solutions":
+        from .enumeration import enumerate_solutions
+
+        return enumerate_solutions
+    raise AttributeError(f"module 'lcp' has no attribute {name!r}")

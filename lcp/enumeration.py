@@ -1,0 +1,1 @@
+"""Placeholder: method module 'enumeration' (to be written)."""

@@ -1,0 +1,1 @@
+"""Placeholder: method module 'lemke' (to be written)."""

@@ -1,0 +1,1 @@
+"""Placeholder: method module 'pgs' (to be written)."""

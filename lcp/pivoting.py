@@ -1,0 +1,1 @@
+"""Placeholder: method module 'pivoting' (to be written)."""

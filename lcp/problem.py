@@ -1,0 +1,235 @@
+"""Problem types: the LCP and the MLCP in Siconos's layout, with validation and .npz storage.
+
+LCP(M, q):              w = M z + q,          0 <= z  perp  w >= 0.
+MLCP(A, C, D, B, a, b): A u + C v + a = 0,    w = D u + B v + b,    0 <= v  perp  w >= 0,
+                        with u free (the generalized accelerations of an event).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+class InvalidProblem(ValueError):
+    """Bad input: the message names the offending argument and what was expected."""
+
+
+class NotApplicable(ValueError):
+    """A method (or a reduction) refuses a well-formed problem, and says why."""
+
+
+def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
+    """Validate and convert a 2-D real finite array; None in `shape` means any size >= 1."""
+    arr = _as_float(name, value)
+    if arr.ndim != 2:
+        raise InvalidProblem(f"{name} must be a 2-D matrix, got an array with {arr.ndim} dims")
+    for axis, (got, want) in enumerate(zip(arr.shape, shape)):
+        if want is not None and got != want:
+            raise InvalidProblem(
+                f"{name} must have shape {_fmt(shape)}, got {arr.shape} (axis {axis} differs)"
+            )
+    return arr
+
+
+def as_vector(name: str, value: Any, size: int | None) -> np.ndarray:
+    """Validate and convert a 1-D real finite array (a column or row matrix is flattened)."""
+    arr = _as_float(name, value)
+    if arr.ndim == 2 and 1 in arr.shape:
+        arr = arr.reshape(-1)
+    if arr.ndim != 1:
+        raise InvalidProblem(f"{name} must be a vector, got an array of shape {arr.shape}")
+    if size is not None and arr.size != size:
+        raise InvalidProblem(f"{name} must have length {size}, got {arr.size}")
+    return arr
+
+
+def _as_float(name: str, value: Any) -> np.ndarray:
+    if value is None:
+        raise InvalidProblem(f"{name} is missing (got None)")
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"{name} must be numeric, got {type(value).__name__}: {exc}") from None
+    if np.iscomplexobj(np.asarray(value)):
+        raise InvalidProblem(f"{name} must be real, got complex values")
+    if arr.size == 0:
+        raise InvalidProblem(f"{name} is empty: a problem needs at least one unknown")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        where = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise InvalidProblem(f"{name} contains NaN or Inf (first at index {where})")
+    return arr
+
+
+def _fmt(shape: tuple[int | None, ...]) -> str:
+    return "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
+
+
+@dataclass(frozen=True, eq=False)
+class LCP:
+    """w = M z + q, 0 <= z perp w >= 0. M is n x n, q has length n (n >= 1)."""
+
+    M: np.ndarray
+    q: np.ndarray
+    name: str = ""
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        M = as_matrix("M", self.M, (None, None))
+        if M.shape[0] != M.shape[1]:
+            raise InvalidProblem(f"M must be square, got shape {M.shape}")
+        q = as_vector("q", self.q, M.shape[0])
+        object.__setattr__(self, "M", M)
+        object.__setattr__(self, "q", q)
+
+    @property
+    def n(self) -> int:
+        return self.q.size
+
+    def w(self, z: np.ndarray) -> np.ndarray:
+        return self.M @ z + self.q
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the problem to a .npz file (atomically)."""
+        return _save_npz(path, "LCP", {"M": self.M, "q": self.q}, self.name, self.meta)
+
+    def __repr__(self) -> str:
+        label = f" {self.name!r}" if self.name else ""
+        return f"<LCP{label} n={self.n}>"
+
+
+@dataclass(frozen=True, eq=False)
+class MLCP:
+    """A u + C v + a = 0, w = D u + B v + b, 0 <= v perp w >= 0 (Siconos's layout).
+
+    u has length nu (free), v and w length m. A: nu x nu, C: nu x m, D: m x nu, B: m x m.
+    """
+
+    A: np.ndarray
+    C: np.ndarray
+    D: np.ndarray
+    B: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    name: str = ""
+    meta: dict = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        A = as_matrix("A", self.A, (None, None))
+        if A.shape[0] != A.shape[1]:
+            raise InvalidProblem(f"A must be square, got shape {A.shape}")
+        nu = A.shape[0]
+        B = as_matrix("B", self.B, (None, None))
+        if B.shape[0] != B.shape[1]:
+            raise InvalidProblem(f"B must be square, got shape {B.shape}")
+        m = B.shape[0]
+        C = as_matrix("C", self.C, (nu, m))
+        D = as_matrix("D", self.D, (m, nu))
+        a = as_vector("a", self.a, nu)
+        b = as_vector("b", self.b, m)
+        for key, val in dict(A=A, B=B, C=C, D=D, a=a, b=b).items():
+            object.__setattr__(self, key, val)
+
+    @property
+    def nu(self) -> int:
+        return self.a.size
+
+    @property
+    def n(self) -> int:
+        """Number of complementarity pairs."""
+        return self.b.size
+
+    def to_lcp(self, rcond: float = 1e-12) -> LCP:
+        """Schur-complement reduction: u = -A^{-1}(C v + a), so w = (B - D A^{-1} C) v + b - D A^{-1} a.
+
+        Raises NotApplicable when A is singular (to the relative tolerance `rcond` on its
+        condition number), naming why.
+        """
+        Ainv_C, Ainv_a = self._solve_A(np.column_stack([self.C, self.a]), rcond)
+        M = self.B - self.D @ Ainv_C
+        q = self.b - self.D @ Ainv_a
+        return LCP(M, q, name=self.name, meta={**self.meta, "reduced_from": "MLCP"})
+
+    def recover_u(self, v: np.ndarray) -> np.ndarray:
+        """The free unknowns of a complementarity solution v: u = -A^{-1}(C v + a)."""
+        cols, _ = self._solve_A(np.column_stack([self.C @ v + self.a]), np.inf)
+        return -cols[:, 0]
+
+    def residuals(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, float]:
+        """(w, equality residual max|A u + C v + a|)."""
+        w = self.D @ u + self.B @ v + self.b
+        eq = float(np.max(np.abs(self.A @ u + self.C @ v + self.a))) if self.nu else 0.0
+        return w, eq
+
+    def _solve_A(self, rhs: np.ndarray, rcond: float) -> tuple[np.ndarray, np.ndarray]:
+        A = self.A
+        if np.count_nonzero(A - np.diag(np.diagonal(A))) == 0:  # diagonal: the mass matrix
+            d = np.diagonal(A)
+            if np.any(np.abs(d) <= rcond * max(np.abs(d).max(), 1e-300)):
+                raise NotApplicable("A is singular (a zero on its diagonal): no Schur reduction")
+            sol = rhs / d[:, None]
+        else:
+            cond = np.linalg.cond(A)
+            if not np.isfinite(cond) or cond * rcond > 1:
+                raise NotApplicable(
+                    f"A is singular or ill-conditioned (cond = {cond:.3g}): the MLCP cannot be "
+                    "reduced to an LCP by the Schur complement"
+                )
+            sol = np.linalg.solve(A, rhs)
+        return sol[:, :-1], sol[:, -1]
+
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write the problem to a .npz file (atomically)."""
+        arrays = {k: getattr(self, k) for k in ("A", "C", "D", "B", "a", "b")}
+        return _save_npz(path, "MLCP", arrays, self.name, self.meta)
+
+    def __repr__(self) -> str:
+        label = f" {self.name!r}" if self.name else ""
+        return f"<MLCP{label} nu={self.nu} m={self.n}>"
+
+
+Problem = LCP | MLCP
+
+
+def _save_npz(path, kind: str, arrays: dict, name: str, meta: dict) -> Path:
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_suffix(path.suffix + ".npz") if path.suffix else path.with_suffix(".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    header = json.dumps({"kind": kind, "name": name, "meta": meta}, default=str)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp.npz")
+    os.close(fd)
+    try:
+        np.savez_compressed(tmp, __header__=np.array(header), **arrays)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
+
+
+def load(path: str | os.PathLike) -> LCP | MLCP:
+    """Read an LCP or MLCP written by `.save` (or any .npz with M, q or A, C, D, B, a, b)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"no problem file at {path}")
+    with np.load(path, allow_pickle=False) as data:
+        keys = set(data.files)
+        header = json.loads(str(data["__header__"])) if "__header__" in keys else {}
+        name, meta = header.get("name", path.stem), header.get("meta", {})
+        if {"M", "q"} <= keys:
+            return LCP(data["M"], data["q"], name=name, meta=meta)
+        mlcp_keys = {"A", "C", "D", "B", "a", "b"}
+        if mlcp_keys <= keys:
+            return MLCP(*(data[k] for k in ("A", "C", "D", "B", "a", "b")), name=name, meta=meta)
+    raise InvalidProblem(
+        f"{path} holds neither an LCP (arrays M, q) nor an MLCP (arrays A, C, D, B, a, b); "
+        f"found {sorted(keys - {'__header__'})}"
+    )

@@ -1,0 +1,1 @@
+"""Placeholder: method module 'qp' (to be written)."""

@@ -1,0 +1,96 @@
+"""The one result type of every method (in the spirit of scipy's OptimizeResult)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+#: Statuses a method may return. Only "solved" carries a solution; the others carry evidence.
+STATUSES = {
+    "solved": "a complementary solution was found",
+    "ray": "Lemke ended on a secondary ray (no conclusion unless M is copositive-plus)",
+    "infeasible": "the LCP has no solution (proved: ray with copositive-plus M)",
+    "max_iter": "the iteration / pivot limit was reached",
+    "not_converged": "an iterative method stopped above its tolerance",
+    "failed": "the method failed (numerical breakdown); see message",
+}
+
+
+def complementarity_residual(z: np.ndarray, w: np.ndarray) -> float:
+    """max |min(z, w)|: zero iff z >= 0, w >= 0 and z_i w_i = 0 for every i."""
+    if z.size == 0:
+        return 0.0
+    return float(np.max(np.abs(np.minimum(z, w))))
+
+
+@dataclass
+class Solution:
+    """Result of `lcp.solve`.
+
+    z, w: the complementary pair (for an MLCP, z is v and u holds the free unknowns);
+    status: one of STATUSES; iterations: pivots (pivoting methods) or sweeps (iterative);
+    residual: max|min(z, w)| with w recomputed as M z + q (or D u + B v + b);
+    eq_residual: max|A u + C v + a| for an MLCP (0 for an LCP);
+    basis: indices i with z_i basic (the active set), when the method defines one;
+    info: evidence (the ray of Lemke, a cycle, ...), method-specific.
+    """
+
+    z: np.ndarray
+    w: np.ndarray
+    status: str
+    method: str
+    iterations: int = 0
+    residual: float = np.inf
+    eq_residual: float = 0.0
+    basis: np.ndarray | None = None
+    u: np.ndarray | None = None
+    message: str = ""
+    info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def success(self) -> bool:
+        return self.status == "solved"
+
+    @property
+    def v(self) -> np.ndarray:
+        """The complementarity unknowns of an MLCP (an alias of z)."""
+        return self.z
+
+    def __repr__(self) -> str:
+        n = self.z.size
+        lines = [
+            f"Solution(method={self.method!r}, status={self.status!r}, n={n})",
+            f"  iterations : {self.iterations}",
+            f"  residual   : {self.residual:.3e}  (max|min(z, w)|)",
+        ]
+        if self.u is not None:
+            lines.append(f"  eq_residual: {self.eq_residual:.3e}  (max|A u + C v + a|)")
+        if self.basis is not None:
+            lines.append(f"  active set : {int(np.size(self.basis))} of {n} z basic")
+        if self.message:
+            lines.append(f"  message    : {self.message}")
+        if n <= 8:
+            lines.append(f"  z = {np.array2string(self.z, precision=6)}")
+            lines.append(f"  w = {np.array2string(self.w, precision=6)}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-friendly view (arrays as lists)."""
+        def conv(x):
+            if isinstance(x, np.ndarray):
+                return x.tolist()
+            if isinstance(x, (np.floating, np.integer)):
+                return x.item()
+            if isinstance(x, dict):
+                return {k: conv(v) for k, v in x.items()}
+            return x
+
+        out = {
+            "method": self.method, "status": self.status, "iterations": self.iterations,
+            "residual": self.residual, "eq_residual": self.eq_residual,
+            "message": self.message, "z": self.z, "w": self.w,
+            "basis": self.basis, "u": self.u, "info": self.info,
+        }
+        return {k: conv(v) for k, v in out.items()}
