@@ -112,4 +112,12 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
 
 def _load_builtin_methods() -> None:
     # Importing the method modules registers them (done lazily to keep import cheap).
-    from . import methods as _methods  # noqa: F401
+    # `from . import methods` would find the *function* lcp.methods and import nothing, and
+    # importing the submodule rebinds the package attribute `methods` to it: undo that.
+    import importlib
+    import sys
+
+    importlib.import_module(f"{__package__}.methods")
+    package = sys.modules[__package__]
+    if getattr(package, "methods", None) is not methods:
+        package.methods = methods
