@@ -1,1 +1,344 @@
-"""Placeholder: method module 'lemke' (to be written)."""
+"""Lemke's complementary pivot algorithm with the lexicographic ratio test (method ``lemke``).
+
+The LCP  w = M z + q,  0 <= z perp w >= 0  is embedded in the augmented system
+
+    w = M z + d z0 + q,        z, w, z0 >= 0,   z_i w_i = 0,                         (1)
+
+with a covering vector d > 0 (ones by default). Lemke's method (Lemke 1965; Cottle, Pang &
+Stone, *The Linear Complementarity Problem*, 1992, Algorithm 4.4.5) starts from the basis
+{w_1..w_n}, lets z0 enter until every w_i >= 0 (the row of min q_i / d_i leaves), and then
+alternates: the complement of the variable that just left enters, the minimum ratio test picks
+the row that leaves. It stops when z0 leaves (a solution) or when no row blocks the entering
+variable (a secondary ray).
+
+Implementation: a dense *dictionary* (compact tableau) x_B = beta + T x_N, stored as one
+Fortran-ordered n x (n + 2) array whose columns are the n + 1 nonbasic variables and beta. A
+pivot is one in-place rank-one update of that array (BLAS ``dger``), O(n^2) with no Python
+loop over rows. The ratio test needs only the entering column and beta; the lexicographic
+tie-break (Cottle-Pang-Stone Sec. 4.9) needs the rows of B^-1 of the tied rows only, and those
+are read from the w columns of the dictionary when (rarely) needed. Details and equations:
+docs/lemke.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.linalg.blas import dger
+
+from .api import register
+from .problem import InvalidProblem, as_matrix, as_vector
+from .solution import Solution
+
+#: Zero tolerance, relative to data normalized to max|M| = max|q| = max d = 1.
+DEFAULT_TOL = 1e-10
+#: Elements per ``dger`` call. OpenBLAS multithreads ?ger above 2304 * 4 = 9216 elements; on a
+#: busy machine one threaded call can take milliseconds instead of microseconds, so the update
+#: is issued in column chunks that stay single-threaded (see docs/lemke.md, "Speed").
+_GER_CHUNK = 8192
+
+_EPS = np.finfo(float).eps
+
+
+@register(
+    "lemke",
+    accepts="any",
+    description="Lemke's complementary pivot method (covering vector d, lexicographic ratio test)",
+)
+def lemke(
+    M: np.ndarray,
+    q: np.ndarray,
+    *,
+    d: np.ndarray | None = None,
+    max_iter: int | None = None,
+    tol: float | None = None,
+) -> Solution:
+    """Solve w = M z + q, 0 <= z perp w >= 0 by Lemke's method (Cottle-Pang-Stone Alg. 4.4.5).
+
+    Parameters
+    ----------
+    M, q : the LCP (n x n, n).
+    d : covering vector, all entries > 0 (default ones).
+    max_iter : pivot limit (default 1000 + 100 n); status ``max_iter`` when reached.
+    tol : zero tolerance on the data normalized to max|M| = max|q| = max(d) = 1 (default
+        1e-10): pivot entries, ratio ties and lexicographic ties below it count as zero.
+
+    Returns
+    -------
+    Solution with status ``solved`` (z, w, basis = indices of the basic z's, iterations =
+    pivots including the first one, where z0 enters), ``ray`` (secondary ray; evidence in
+    ``info``: "ray" = direction in (z, z0) space, "entering", "point", "z0"), ``infeasible``
+    (a ray whose z-part is a verified Farkas certificate y >= 0, M^T y <= 0, q^T y < 0: always
+    the case, by Lemke's theorem, when M is copositive-plus, tested as M + M^T PSD) or
+    ``max_iter``.
+    """
+    M = as_matrix("M", M, (None, None))
+    if M.shape[0] != M.shape[1]:
+        raise InvalidProblem(f"M must be square, got shape {M.shape}")
+    n = M.shape[0]
+    q = as_vector("q", q, n)
+    d = _covering_vector(d, n)
+    max_iter = _check_max_iter(max_iter, n)
+    tol = _check_tol(tol)
+    if np.all(q >= 0):
+        return Solution(
+            z=np.zeros(n), w=q.copy(), status="solved", method="lemke", iterations=0,
+            basis=np.zeros(0, dtype=int), message="q >= 0: z = 0 solves the LCP",
+        )
+    return _Lemke(M, q, d, tol).run(max_iter)
+
+
+def _covering_vector(d, n: int) -> np.ndarray:
+    if d is None:
+        return np.ones(n)
+    d = as_vector("d", d, n)
+    if np.any(d <= 0):
+        i = int(np.flatnonzero(d <= 0)[0])
+        raise InvalidProblem(f"d (covering vector) must be > 0 everywhere, got d[{i}] = {d[i]}")
+    return d
+
+
+def _check_max_iter(max_iter, n: int) -> int:
+    if max_iter is None:
+        return 1000 + 100 * n
+    if isinstance(max_iter, bool) or not isinstance(max_iter, (int, np.integer)) or max_iter < 1:
+        raise InvalidProblem(f"max_iter must be a positive integer, got {max_iter!r}")
+    return int(max_iter)
+
+
+def _check_tol(tol) -> float:
+    if tol is None:
+        return DEFAULT_TOL
+    try:
+        tol = float(tol)
+    except (TypeError, ValueError):
+        raise InvalidProblem(f"tol must be a number, got {tol!r}") from None
+    if not (0 < tol < 1):
+        raise InvalidProblem(f"tol must be in (0, 1), got {tol}")
+    return tol
+
+
+class _Lemke:
+    """One run of the method on normalized data.
+
+    Variables are numbered w_i = i, z_i = n + i, z0 = 2n. The dictionary is
+    x_B = beta + T x_N with T[:, :n+1] the nonbasic columns (slot s holds variable nonbasic[s])
+    and T[:, n+1] = beta. Data are scaled so that max|M| = max|q| = max(d) = 1:
+    M~ = M / mu, q~ = q / nu, d~ = d / delta, hence z~ = z mu / nu, z0~ = z0 delta / nu,
+    w~ = w / nu, and every tolerance is absolute in these units.
+    """
+
+    def __init__(self, M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float):
+        n = q.size
+        self.n, self.M, self.q, self.d, self.tol = n, M, q, d, tol
+        self.mu = float(np.abs(M).max()) or 1.0
+        self.nu = float(np.abs(q).max())
+        self.delta = float(d.max())
+        T = np.empty((n, n + 2), order="F")
+        np.divide(M, self.mu, out=T[:, :n])
+        np.divide(d, self.delta, out=T[:, n])
+        np.divide(q, self.nu, out=T[:, n + 1])
+        self.T = T
+        self.row = np.empty(n + 2)  # the pivot row buffer
+        step = max(1, _GER_CHUNK // n)
+        assert T.flags.f_contiguous  # dger updates the column chunks in place
+        self.chunks = [(self.row[j:j + step], T[:, j:j + step]) for j in range(0, n + 2, step)]
+        # Bookkeeping as Python lists (scalar access is several times faster than numpy's).
+        self.basic = list(range(n))  # row -> variable
+        self.nonbasic = list(range(n, 2 * n + 1))  # slot -> variable
+        self.row_of = list(range(n)) + [-1] * (n + 1)  # variable -> row, or -1
+        self.slot_of = [-1] * n + list(range(n + 1))  # variable -> slot, or -1
+
+    # -- the pivot -------------------------------------------------------------------------
+    def pivot(self, r: int, s: int) -> int:
+        """Exchange basic row r with nonbasic slot s; return the variable that left.
+
+        With p = T[r, s]: the new row r is -T[r, :] / p except 1/p in slot s, and every other
+        row i gets T[i, c] + T[i, s] * newrow[c] (c != s) and T[i, s] / p in slot s: one
+        rank-one update after zeroing row r and column s (with the column's entry at r = 1).
+        """
+        T = self.T
+        colview = T[:, s]
+        col = colview.copy()
+        p = col[r]
+        row = self.row
+        np.multiply(T[r, :], -1.0 / p, out=row)
+        row[s] = 1.0 / p
+        T[r, :] = 0.0
+        colview.fill(0.0)
+        col[r] = 1.0
+        for rv, tv in self.chunks:
+            dger(1.0, col, rv, 1, 1, tv, 1, 1, 1)  # tv += col rv^T, in place
+        entering = self.nonbasic[s]
+        leaving = self.basic[r]
+        self.basic[r] = entering
+        self.nonbasic[s] = leaving
+        self.row_of[entering], self.slot_of[entering] = r, -1
+        self.row_of[leaving], self.slot_of[leaving] = -1, s
+        return leaving
+
+    # -- the ratio test ------------------------------------------------------------------
+    def choose(self, rows: np.ndarray, alpha: np.ndarray, theta: np.ndarray, amax: float) -> int:
+        """Minimum ratio row among `rows` (ratios theta, pivots alpha > 0, amax = max alpha),
+        ties broken lexicographically.
+
+        Rows whose ratio is within tol / amax of the minimum are tied (the step then leaves
+        every basic variable >= -tol). Among tied rows, z0 leaves if it can (the run ends
+        with a solution); otherwise the lexicographic minimum of B^-1[i, :] / alpha_i.
+        """
+        k = theta.argmin()
+        tied = theta <= theta[k] + self.tol / amax
+        if np.count_nonzero(tied) == 1:
+            return int(rows[k])
+        rows, alpha = rows[tied], alpha[tied]
+        z0_row = self.row_of[2 * self.n]
+        if z0_row >= 0 and np.any(rows == z0_row):
+            return z0_row
+        return self.lexico_min(rows, alpha)
+
+    def lexico_min(self, rows: np.ndarray, alpha: np.ndarray) -> int:
+        """Row i in `rows` with the lexicographically smallest B^-1[i, :] / alpha_i.
+
+        Column j of B^-1 is e_r when w_j is basic in row r, and -T[:, slot(w_j)] when w_j is
+        nonbasic (T = -B^-1 N and w_j's column in [I, -M, -d] is e_j). B^-1 is nonsingular,
+        so two rows are never equal in exact arithmetic; entries closer than tol (relative
+        to the compared rows) are treated as equal, since their difference is rounding.
+        """
+        n, T = self.n, self.T
+        basic, nonbasic = np.array(self.basic), np.array(self.nonbasic)
+        U = np.zeros((rows.size, n))
+        wslots = np.flatnonzero(nonbasic < n)
+        U[:, nonbasic[wslots]] = -T[np.ix_(rows, wslots)]
+        bvars = basic[rows]
+        isw = bvars < n
+        U[np.flatnonzero(isw), bvars[isw]] = 1.0
+        U /= alpha[:, None]
+        cand = np.arange(rows.size)
+        while cand.size > 1:
+            sub = U[cand]
+            eps = self.tol * float(np.abs(sub).max())
+            differ = np.flatnonzero(sub.max(axis=0) - sub.min(axis=0) > eps)
+            if differ.size == 0:  # numerically equal rows: B nearly singular
+                break
+            col = sub[:, differ[0]]
+            cand = cand[col <= col.min() + eps]
+        return int(rows[cand[np.argmax(alpha[cand])]])
+
+    # -- the run --------------------------------------------------------------------------
+    def run(self, max_iter: int) -> Solution:
+        n, tol, T, slot_of = self.n, self.tol, self.T, self.slot_of
+        beta = T[:, n + 1]
+        z0 = 2 * n
+        # Step 0: z0 enters; every row is "blocking" with pivot d_i and ratio q_i / d_i.
+        alpha = T[:, n].copy()
+        r = self.choose(np.arange(n), alpha, beta / alpha, float(alpha.max()))
+        s = n
+        pivots = 0
+        pivot, choose = self.pivot, self.choose
+        while True:
+            leaving = pivot(r, s)
+            pivots += 1
+            if leaving == z0:
+                return self.solution(pivots)
+            if pivots >= max_iter:
+                return self.stopped(pivots)
+            entering = leaving + n if leaving < n else leaving - n
+            s = slot_of[entering]
+            a = T[:, s]
+            amax = -float(a.min())
+            thr = tol * amax if amax > 1.0 else tol
+            if amax <= thr:
+                return self.ray(pivots, s, entering)
+            rows = (a < -thr).nonzero()[0]
+            alpha = a[rows]
+            np.negative(alpha, out=alpha)
+            theta = beta[rows]
+            np.maximum(theta, 0.0, out=theta)
+            theta /= alpha
+            r = choose(rows, alpha, theta, amax)
+
+    # -- outcomes -------------------------------------------------------------------------
+    def point(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """Current (z, w, z0) in the original units."""
+        n, beta, basic = self.n, self.T[:, self.n + 1], np.array(self.basic)
+        z, w = np.zeros(n), np.zeros(n)
+        zr = np.flatnonzero((basic >= n) & (basic < 2 * n))
+        wr = np.flatnonzero(basic < n)
+        z[basic[zr] - n] = beta[zr] * (self.nu / self.mu)
+        w[basic[wr]] = beta[wr] * self.nu
+        z0_row = self.row_of[2 * n]
+        z0 = float(beta[z0_row]) * self.nu / self.delta if z0_row >= 0 else 0.0
+        return z, w, z0
+
+    def basis(self) -> np.ndarray:
+        b = np.array(self.basic)
+        return np.sort(b[(b >= self.n) & (b < 2 * self.n)] - self.n)
+
+    def solution(self, pivots: int, message: str = "") -> Solution:
+        z, w, _ = self.point()
+        return Solution(z=z, w=w, status="solved", method="lemke", iterations=pivots,
+                        basis=self.basis(), message=message)
+
+    def stopped(self, pivots: int) -> Solution:
+        z, w, z0 = self.point()
+        return Solution(
+            z=z, w=w, status="max_iter", method="lemke", iterations=pivots, basis=self.basis(),
+            message=f"pivot limit {pivots} reached with z0 = {z0:.3g} (not a solution)",
+            info={"z0": z0},
+        )
+
+    def ray(self, pivots: int, s: int, entering: int) -> Solution:
+        """Secondary ray: x_B = beta + a t, x_entering = t, t -> infinity (Alg. 4.4.5, step 3)."""
+        n, basic, a = self.n, np.array(self.basic), self.T[:, s]
+        z, w, z0 = self.point()
+        if z0 <= self.tol * self.nu / self.delta:
+            # z0 is basic at 0 (a degenerate step): the current point is complementary.
+            return self.solution(pivots, "z0 = 0 on a degenerate basis")
+        dz = np.zeros(n)
+        zr = np.flatnonzero((basic >= n) & (basic < 2 * n))
+        dz[basic[zr] - n] = a[zr]
+        if entering >= n:
+            dz[entering - n] = 1.0
+        dz *= self.nu / self.mu
+        dz0 = float(a[self.row_of[2 * n]]) * self.nu / self.delta
+        ray = np.append(dz, dz0)
+        ray /= np.abs(ray).max()
+        name = f"w[{entering}]" if entering < n else f"z[{entering - n}]"
+        info = {"ray": ray, "entering": name, "point": z, "z0": z0}
+        proved, why = self._infeasibility(ray[:n], info)
+        status = "infeasible" if proved else "ray"
+        message = f"secondary ray after {pivots} pivots ({name} entering unblocked); {why}"
+        return Solution(z=z, w=w, status=status, method="lemke", iterations=pivots,
+                        basis=self.basis(), message=message, info=info)
+
+    def _infeasibility(self, dz: np.ndarray, info: dict) -> tuple[bool, str]:
+        """Does the ray prove the LCP infeasible?
+
+        Lemke's theorem (Cottle-Pang-Stone Thm 4.4.13): if M is copositive-plus, a secondary
+        ray has dz >= 0, dz != 0, M^T dz = -M dz <= 0 and q^T dz = -z0 d^T dz < 0, so y = dz is
+        a Farkas certificate that {z >= 0 : M z + q >= 0} is empty. M + M^T positive
+        semidefinite is a sufficient test for copositive-plus. The certificate itself is
+        checked, to rounding, whatever M is.
+        """
+        M, q, n = self.M, self.q, self.n
+        S = M + M.T
+        lam = np.linalg.eigvalsh(S)
+        psd = bool(lam[0] >= -100 * n * _EPS * max(np.abs(lam).max(), 1e-300))
+        info["copositive_plus"] = psd
+        y = np.maximum(dz, 0.0)
+        if y.sum() <= 0:
+            return False, "the ray has dz = 0 (no certificate)"
+        y /= y.sum()
+        MTy, qTy = M.T @ y, float(q @ y)
+        slack = float(max(MTy.max(), 0.0))
+        info["farkas"] = y
+        info["farkas_check"] = {"max_MTy": slack, "qTy": qTy}
+        ok = (qTy < -100 * n * _EPS * self.nu and slack <= 100 * n * _EPS * self.mu)
+        if ok:
+            return True, ("the LCP is infeasible: y = info['farkas'] >= 0 has M^T y <= 0 and "
+                          f"q^T y = {qTy:.3g} < 0"
+                          + (" (M + M^T is PSD, so M is copositive-plus)" if psd else ""))
+        if psd:
+            return False, ("M + M^T is PSD (copositive-plus), so in exact arithmetic this ray "
+                           "proves infeasibility, but its certificate fails numerically "
+                           f"(max M^T y = {slack:.3g}, q^T y = {qTy:.3g}): numerical trouble")
+        return False, "M is not known to be copositive-plus: the ray proves nothing"
