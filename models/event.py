@@ -1,0 +1,215 @@
+"""The complementarity problem of an event (Sec. II B-C) and the paper's contact matrix (Eq. 2.15).
+
+At an event every contact is closed (no displacement) and carries (R, S). With lambda = [R; S]
+and a = W lambda + q (models.dynamics):
+
+* Signorini at acceleration level, Eq. (2.5), on every contact:   0 <= R  perp  a_n >= 0;
+* a sliding contact (v_t != 0), Eq. (2.10): S = -sgn(v_t) mu R is substituted, each contact with
+  its own mu (the coefficient of the contact whose force it is multiplies that column of W);
+* a frictionless contact (mu = 0): S = 0;
+* a non-sliding candidate (v_t = 0, mu > 0), the three alternatives of Eq. (2.7), written with
+  tau = mu R + S in [0, 2 mu R] and a_t = a_plus - a_minus:
+      0 <= tau       perp  a_plus = a_t + a_minus >= 0,
+      0 <= a_minus   perp  2 mu R - tau >= 0.
+  (a_t > 0 forces tau = 0, i.e. S = -mu R; a_t < 0 forces a_minus > 0, i.e. S = +mu R;
+  a_t = 0 leaves S anywhere in [-mu R, mu R]: exactly Eq. (2.7).)
+
+The LCP unknowns are z = [R (c), tau (k), a_minus (k)] for k candidates, so n = c + 2k.
+The MLCP keeps the free generalized accelerations u = nu' (Siconos's layout):
+    M u - H^T G z - f = 0,      w = D u + B v + b,
+whose Schur complement is the LCP.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lcp import LCP, MLCP
+
+from .dynamics import Dynamics
+from .system import System
+
+
+@dataclass
+class State:
+    """The kinematic state at time t: angular velocities omega, the box's velocity V relative to
+    the plane, and the tangential state s of every contact: +1 / -1 sliding with sgn(v_t) = s,
+    0 when v_t = 0 (a non-sliding candidate; frictionless contacts carry 0 too, unused).
+
+    s is kept explicitly rather than read off sgn(v_t): at an event v_t is zero only up to
+    rounding, and the sign a contact slides with is decided by the LCP (Eq. 2.7), not by noise.
+    """
+
+    t: float
+    omega: np.ndarray
+    V: float
+    s: np.ndarray
+
+    def copy(self) -> State:
+        return State(self.t, self.omega.copy(), self.V, self.s.copy())
+
+
+def initial_state(
+    system: System,
+    omega: np.ndarray | None = None,
+    seed: int | None = None,
+    omega_scale: float = 1.0,
+    zero_tol: float = 0.0,
+) -> State:
+    """State at t = 0: the given angular velocities, or uniform in [-omega_scale, omega_scale]
+    drawn from `seed` (zeros when neither is given). Contacts with |v_t| <= zero_tol start as
+    non-sliding candidates."""
+    p = system.p
+    if omega is None:
+        omega = (
+            np.zeros(p) if seed is None
+            else np.random.default_rng(seed).uniform(-omega_scale, omega_scale, p)
+        )
+    omega = np.array(omega, dtype=float).reshape(-1)
+    if omega.size != p:
+        raise ValueError(f"omega must have one angular velocity per disk ({p}), got {omega.size}")
+    if not np.all(np.isfinite(omega)):
+        raise ValueError("omega contains NaN or Inf")
+    vt = Dynamics(system).velocities(omega, system.V0)[system.c:]
+    s = np.where(np.abs(vt) <= zero_tol, 0, np.sign(vt)).astype(int)
+    s[system.mu == 0] = 0
+    return State(0.0, omega, float(system.V0), s)
+
+
+@dataclass
+class EventProblem:
+    """The LCP / MLCP of one event, with what is needed to turn its solution into mechanics."""
+
+    system: System
+    dyn: Dynamics
+    s: np.ndarray  # sgn(v_t) for sliding contacts, 0 for candidates and frictionless contacts
+    candidates: np.ndarray  # indices of the non-sliding candidates (v_t = 0, mu > 0)
+    G: np.ndarray  # lambda = G z
+    lcp: LCP
+    mlcp: MLCP = field(repr=False)
+
+    @property
+    def k(self) -> int:
+        return self.candidates.size
+
+    def forces(self, z: np.ndarray) -> np.ndarray:
+        """lambda = [R; S] of a solution z."""
+        return self.G @ z
+
+    def unpack(self, z: np.ndarray, tol: float | None = None) -> EventSolution:
+        """Forces, accelerations and contact states of an LCP solution z."""
+        c, p = self.system.c, self.system.p
+        lam = self.forces(z)
+        nu_dot = self.dyn.accelerations(lam)
+        a = self.dyn.H @ nu_dot + self.dyn.u_obs_dot
+        tol_a = acceleration_tol(self.system) if tol is None else tol
+        new_s = self.s.copy()
+        at = a[c:][self.candidates]
+        new_s[self.candidates] = np.where(at > tol_a, 1, np.where(at < -tol_a, -1, 0))
+        return EventSolution(
+            R=lam[:c], S=lam[c:], omega_dot=nu_dot[2 * p:], trans_acc=nu_dot[: 2 * p],
+            a_n=a[:c], a_t=a[c:], s=new_s, z=z,
+        )
+
+
+@dataclass
+class EventSolution:
+    """Forces and accelerations of an event. s: the tangential state after the event
+    (+1/-1 sliding, 0 non-sliding, i.e. v_t = a_t = 0, or frictionless)."""
+
+    R: np.ndarray
+    S: np.ndarray
+    omega_dot: np.ndarray
+    trans_acc: np.ndarray
+    a_n: np.ndarray
+    a_t: np.ndarray
+    s: np.ndarray
+    z: np.ndarray
+
+
+def acceleration_tol(system: System) -> float:
+    """Zero test for accelerations: 1e-9 of the driving scale (g, |gamma|)."""
+    return 1e-9 * max(system.g, abs(system.gamma), 1e-12)
+
+
+def event_problem(system: System, state: State, dyn: Dynamics | None = None) -> EventProblem:
+    """The LCP of the event at `state` (and its MLCP, of which the LCP is the Schur complement)."""
+    dyn = dyn or Dynamics(system)
+    c = system.c
+    mu = system.mu
+    s = np.asarray(state.s, dtype=int).reshape(-1)
+    if s.size != c or not np.all(np.isin(s, (-1, 0, 1))):
+        raise ValueError(f"state.s must hold one of -1, 0, +1 per contact ({c})")
+    frictionless = mu == 0
+    cand_mask = (s == 0) & ~frictionless
+    s = np.where(frictionless, 0, s)
+    cand = np.flatnonzero(cand_mask)
+    k = cand.size
+    n = c + 2 * k
+    # lambda = G z: R = z[:c]; S = -s mu R (sliding), tau - mu R (candidates), 0 (frictionless).
+    G = np.zeros((2 * c, n))
+    G[np.arange(c), np.arange(c)] = 1.0
+    slope = np.where(cand_mask, -mu, -s * mu)
+    G[c + np.arange(c), np.arange(c)] = slope
+    G[c + cand, c + np.arange(k)] = 1.0
+    # Complementarity rows: w = D u + B z + b.
+    H = dyn.H.toarray()
+    P = np.zeros((k, c))
+    P[np.arange(k), cand] = 1.0
+    D = np.vstack([H[:c], P @ H[c:], np.zeros((k, 3 * system.p))])
+    B = np.zeros((n, n))
+    B[c : c + k, c + k :] = np.eye(k)  # a_plus = a_t + a_minus
+    B[c + k :, :c] = 2.0 * mu[cand, None] * P  # 2 mu R - tau
+    B[c + k :, c : c + k] = -np.eye(k)
+    b = np.concatenate([dyn.u_obs_dot[:c], dyn.u_obs_dot[c:][cand], np.zeros(k)])
+    mass = 1.0 / dyn.Minv
+    mlcp = MLCP(np.diag(mass), -(H.T @ G), D, B, -dyn.f, b, name="event", meta={"t": state.t})
+    # The Schur complement, assembled from W directly (cheaper than through the MLCP).
+    WG = dyn.W @ G
+    M = B.copy()
+    M[:c] += WG[:c]
+    M[c : c + k] += WG[c:][cand]
+    q = np.concatenate([dyn.q[:c], dyn.q[c:][cand], np.zeros(k)])
+    lcp = LCP(M, q, name="event", meta={"t": state.t, "c": c, "k": k})
+    return EventProblem(system, dyn, s, cand, G, lcp, mlcp)
+
+
+def contact_matrix(
+    system: System,
+    normal: np.ndarray,
+    tangential: np.ndarray,
+    dyn: Dynamics | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The paper's linear system M x = b (Eq. 2.15) for given contact states.
+
+    x = [R (c); S (c)]. normal[alpha]: True (T: a_n = 0, Eq. 2.9) or False (NT: R = 0, Eq. 2.8).
+    tangential[alpha]: 0 (NS: a_t = 0, Eq. 2.12) or +1 / -1 (sliding with sgn(v_t) = +-1:
+    S + sgn mu R = 0, Eq. 2.10). Rows 0..c-1 are the normal equations, c..2c-1 the tangential.
+    """
+    dyn = dyn or Dynamics(system)
+    c = system.c
+    normal = np.asarray(normal, dtype=bool).reshape(-1)
+    tangential = np.asarray(tangential).reshape(-1)
+    if normal.size != c or tangential.size != c:
+        raise ValueError(
+            f"one state per contact expected ({c}): got {normal.size} normal and "
+            f"{tangential.size} tangential states"
+        )
+    if not np.all(np.isin(tangential, (-1, 0, 1))):
+        raise ValueError("tangential states must be 0 (NS), +1 or -1 (sliding)")
+    W, q = dyn.W, dyn.q
+    Mc = np.zeros((2 * c, 2 * c))
+    rhs = np.zeros(2 * c)
+    idx = np.arange(c)
+    Mc[idx[normal]] = W[idx[normal]]
+    rhs[idx[normal]] = -q[idx[normal]]
+    Mc[idx[~normal], idx[~normal]] = 1.0
+    ns = tangential == 0
+    Mc[c + idx[ns]] = W[c + idx[ns]]
+    rhs[c + idx[ns]] = -q[c + idx[ns]]
+    sl = idx[~ns]
+    Mc[c + sl, c + sl] = 1.0
+    Mc[c + sl, sl] = tangential[sl] * system.mu[sl]
+    return Mc, rhs

@@ -1,0 +1,266 @@
+"""Exact event-driven evolution (Sec. II C, Sec. IV).
+
+Between two events the contact states, hence the forces and accelerations, are constant and every
+angular velocity is linear in time (the geometry does not change: no particle displacement).
+The next event is the earliest time at which a sliding contact's tangential velocity reaches
+zero, t_k = t + |v_t| / |a_t| for the contacts with sgn(a_t) = -sgn(v_t): computed exactly, with
+no time step. At the event that contact becomes a non-sliding candidate and the LCP of
+models.event decides every contact's state anew. The run stops:
+
+* "steady": no future event (every a_t has the sign of its v_t, or both are zero, Sec. IV A);
+* "time_limit" / "event_limit": the limits given;
+* "detachment": a contact would open (a_n > 0): the no-displacement regime of the paper ends;
+* "no_solution": the solver ends without a solution (e.g. a Lemke ray), contacts named;
+* "zeno": events accumulate (more than `zeno_events` within `zeno_time`);
+* "solver_failed": a solution whose residual exceeds `check_tol`.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import lcp
+
+from .dynamics import Dynamics
+from .event import (
+    EventProblem,
+    EventSolution,
+    State,
+    acceleration_tol,
+    event_problem,
+    initial_state,
+)
+from .system import System
+
+STOP_REASONS = ("steady", "time_limit", "event_limit", "detachment", "no_solution", "zeno",
+                "solver_failed")
+
+
+@dataclass
+class EventRecord:
+    """What is recorded at each event (values right after the event's LCP is solved)."""
+
+    t: float
+    V: float
+    omega: np.ndarray
+    omega_dot: np.ndarray
+    R: np.ndarray
+    S: np.ndarray
+    s: np.ndarray  # tangential states after the event: +1/-1 sliding, 0 non-sliding
+    vt: np.ndarray
+    at: np.ndarray
+    mu_g: float
+    dissipation: float
+    iterations: int
+    residual: float
+    n_lcp: int
+    method: str
+
+
+@dataclass
+class Run:
+    """A simulation: the system, one record per event, and why it stopped."""
+
+    system: System
+    records: list[EventRecord] = field(default_factory=list)
+    status: str = "running"
+    message: str = ""
+    contacts: list[int] = field(default_factory=list)  # contacts named by the stop report
+    wall_time: float = 0.0
+    method: str = "lemke"
+    final: State | None = None
+
+    @property
+    def steady(self) -> bool:
+        return self.status == "steady"
+
+    @property
+    def n_events(self) -> int:
+        return len(self.records)
+
+    def array(self, name: str) -> np.ndarray:
+        """Stack a record field over events, e.g. run.array('mu_g') or run.array('omega')."""
+        return np.array([getattr(r, name) for r in self.records])
+
+    @property
+    def last(self) -> EventRecord:
+        if not self.records:
+            raise ValueError("the run has no event")
+        return self.records[-1]
+
+    def summary(self) -> dict:
+        from .observables import state_counts
+
+        out = {"status": self.status, "message": self.message, "events": self.n_events,
+               "wall_time_s": round(self.wall_time, 4), "method": self.method}
+        if self.records:
+            last = self.last
+            out.update(t=last.t, mu_g=last.mu_g, F_g=last.mu_g * self.system.total_mass
+                       * self.system.g, dissipation=last.dissipation,
+                       **state_counts(self.system, last))
+        return out
+
+
+def simulate(
+    system: System,
+    state: State | None = None,
+    *,
+    method: str = "lemke",
+    omega: np.ndarray | None = None,
+    seed: int | None = None,
+    t_max: float = np.inf,
+    max_events: int = 100_000,
+    check_tol: float = 1e-8,
+    warm_start: bool = True,
+    zeno_events: int = 1000,
+    zeno_time: float = 1e-9,
+    progress: Callable[[Run], None] | None = None,
+    dump_dir: str | None = None,
+) -> Run:
+    """Evolve `system` from `state` (or from omega / a seed) event by event.
+
+    method: any `lcp` method; "pivoting" is warm-started from the previous event's contact states
+    when warm_start is true. Every solution's residual max|min(z, w)| must be <= check_tol (in
+    units of the problem's scale), or the run stops with "solver_failed".
+    """
+    if method not in {m.name for m in lcp.methods()}:
+        raise lcp.InvalidProblem(
+            f"unknown method {method!r}; available: {', '.join(m.name for m in lcp.methods())}"
+        )
+    dyn = Dynamics(system)
+    if state is None:
+        state = initial_state(system, omega=omega, seed=seed)
+    state = state.copy()
+    run = Run(system, method=method)
+    c = system.c
+    tol_a = acceleration_tol(system)
+    scale_v = max(np.abs(dyn.velocities(state.omega, state.V)).max(initial=0.0), 1e-300)
+    recent: list[float] = []
+    prev: EventSolution | None = None
+    start = _time.perf_counter()
+    while True:
+        ep = event_problem(system, state, dyn)
+        options = {}
+        if method == "pivoting" and warm_start and prev is not None:
+            options["active"] = warm_active_set(ep, prev, state)
+        sol = lcp.solve(ep.lcp, method=method, **options)
+        if dump_dir is not None:
+            ep.lcp.save(f"{dump_dir}/event_{run.n_events:06d}.npz")
+        scale = max(np.abs(ep.lcp.q).max(initial=0.0), system.mass * system.g, 1e-300)
+        if sol.status != "solved":
+            run.status = "no_solution" if sol.status in ("ray", "infeasible") else "solver_failed"
+            run.contacts = contacts_of_ray(ep, sol)
+            run.message = (
+                f"t = {state.t:.6g}: {method} ended with status {sol.status!r} "
+                f"({sol.message or 'no message'}); contacts involved: {run.contacts}"
+            )
+            break
+        if sol.residual > check_tol * scale:
+            run.status = "solver_failed"
+            run.message = (
+                f"t = {state.t:.6g}: {method} returned residual {sol.residual:.3g} > "
+                f"{check_tol:g} x scale {scale:.3g}"
+            )
+            break
+        es = ep.unpack(sol.z)
+        vt = dyn.velocities(state.omega, state.V)[c:]
+        run.records.append(_record(system, state, es, vt, sol))
+        opening = np.flatnonzero(es.a_n > max(tol_a, 10 * sol.residual))
+        if opening.size:
+            run.status = "detachment"
+            run.contacts = opening.tolist()
+            names = "; ".join(f"{system.lattice.label(a)} (a_n = {es.a_n[a]:.3g})"
+                              for a in opening[:5])
+            run.message = (
+                f"t = {state.t:.6g}: contact(s) would open, the no-displacement regime ends: "
+                f"{names}"
+            )
+            break
+        prev = es
+        # The next event: a sliding contact whose v_t is driven to zero.
+        s = es.s
+        vt_signed = np.where(s != 0, np.abs(vt), np.inf)
+        closing = (s != 0) & (s * es.a_t < -tol_a)
+        dt_all = np.full(c, np.inf)
+        dt_all[closing] = vt_signed[closing] / np.abs(es.a_t[closing])
+        dt = dt_all.min(initial=np.inf)
+        if not np.isfinite(dt):
+            run.status, run.message = "steady", f"steady state at t = {state.t:.6g}"
+            break
+        if state.t + dt > t_max:
+            state = _advance(state, es, t_max - state.t, system)
+            run.status, run.message = "time_limit", f"t_max = {t_max:g} reached"
+            break
+        if run.n_events >= max_events:
+            run.status, run.message = "event_limit", f"{max_events} events"
+            break
+        new_state = _advance(state, es, dt, system)
+        # Every contact whose v_t reaches zero now (within rounding) becomes a candidate.
+        vt_new = dyn.velocities(new_state.omega, new_state.V)[c:]
+        stuck = closing & ((dt_all <= dt * (1 + 1e-9)) | (np.abs(vt_new) <= 1e-12 * scale_v))
+        new_state.s = np.where(stuck, 0, s)
+        recent = [t for t in recent if new_state.t - t <= zeno_time] + [new_state.t]
+        if len(recent) > zeno_events:
+            run.status = "zeno"
+            run.message = (f"{len(recent)} events within {zeno_time:g} time units before t = "
+                           f"{new_state.t:.6g}: events accumulate")
+            break
+        state = new_state
+        if progress is not None:
+            progress(run)
+    run.final = state
+    run.wall_time = _time.perf_counter() - start
+    return run
+
+
+def _advance(state: State, es: EventSolution, dt: float, system: System) -> State:
+    """Angular velocities are linear in time between events; so is V."""
+    return State(state.t + dt, state.omega + es.omega_dot * dt, state.V + system.gamma * dt,
+                 es.s.copy())
+
+
+def _record(system: System, state: State, es: EventSolution, vt: np.ndarray, sol) -> EventRecord:
+    from .observables import dissipation_rate, global_friction
+
+    return EventRecord(
+        t=state.t, V=state.V, omega=state.omega.copy(), omega_dot=es.omega_dot.copy(),
+        R=es.R.copy(), S=es.S.copy(), s=es.s.copy(), vt=vt.copy(), at=es.a_t.copy(),
+        mu_g=global_friction(system, es.S) / (system.total_mass * system.g or 1.0),
+        dissipation=dissipation_rate(es.S, vt), iterations=int(sol.iterations),
+        residual=float(sol.residual), n_lcp=int(sol.z.size), method=sol.method,
+    )
+
+
+def warm_active_set(ep: EventProblem, prev: EventSolution, state: State) -> np.ndarray:
+    """Warm start for `pivoting` from the previous event's contact states.
+
+    In z = [R, tau, a_minus]: R is basic on transmitting contacts; for a candidate tau is basic
+    unless it slides with a_t > 0 (tau = 0), and a_minus is basic when it slides with a_t < 0.
+    A contact that has just stopped is guessed non-sliding (tau basic).
+    """
+    c, k = ep.system.c, ep.k
+    active = list(np.flatnonzero(prev.R > 0))
+    for pos, alpha in enumerate(ep.candidates):
+        was = prev.s[alpha] if state.s[alpha] == 0 else 0
+        if was <= 0:
+            active.append(c + pos)
+        if was < 0:
+            active.append(c + k + pos)
+    return np.array(sorted(active), dtype=int)
+
+
+def contacts_of_ray(ep: EventProblem, sol: lcp.Solution) -> list[int]:
+    """Contacts whose variables carry the ray (or the last iterate) of a failed solve."""
+    vec = sol.info.get("ray")
+    vec = np.asarray(vec if vec is not None else sol.z, dtype=float).reshape(-1)[: ep.lcp.n]
+    if vec.size < ep.lcp.n:
+        return []
+    c, k = ep.system.c, ep.k
+    support = np.abs(vec) > 1e-12 * max(np.abs(vec).max(initial=0.0), 1e-300)
+    alphas = set(np.flatnonzero(support[:c]).tolist())
+    alphas |= set(ep.candidates[np.flatnonzero(support[c:c + k] | support[c + k:])].tolist())
+    return sorted(int(a) for a in alphas)

@@ -1,0 +1,182 @@
+"""Regular arrays of equal rigid disks in a box: two vertical walls and a basal plane.
+
+Geometry of the paper (Sec. II A, Fig. 1). Units: radius r (default 1). The box spans
+0 <= x <= 2 r Lx; the plane is y = 0.
+
+* rectangular(Lx, Ly): Ly rows of Lx disks, each row touching both walls; columns stacked.
+* triangular(Lx, Ly): rows alternate between Lx disks (touching both walls) and Lx - 1 disks
+  sitting in the hollows (touching neither wall); the bottom row is a full row on the plane.
+  Lx is the paper's: the number of disks in the rows that touch both walls (Eq. 3.3).
+
+Contact alpha joins body i (always a disk) and body j (a disk or an obstacle). Its unit normal n
+points from i to j and its tangent is t = n rotated by +90 degrees (DESIGN.md). For two disks,
+i is the lower (or, in a row, the left) one, so n points up or to the right.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Codes of the obstacles in `Lattice.j` (disks have indices >= 0).
+LEFT_WALL, RIGHT_WALL, PLANE = -1, -2, -3
+OBSTACLE_NAMES = {LEFT_WALL: "left wall", RIGHT_WALL: "right wall", PLANE: "plane"}
+#: Contact kinds, as in the paper's three coefficients of friction.
+KINDS = ("pp", "plane", "wall")
+
+
+class InvalidSystem(ValueError):
+    """A lattice or system that cannot be built; the message names the parameter."""
+
+
+@dataclass(frozen=True, eq=False)
+class Lattice:
+    """Positions of the disks and every contact (all contacts are closed: interstice zero).
+
+    Arrays: x (p, 2) centres; row, col (p,) indices; for each contact alpha: i[alpha] (disk),
+    j[alpha] (disk index or LEFT_WALL / RIGHT_WALL / PLANE), n[alpha], t[alpha] unit vectors,
+    kind[alpha] in KINDS.
+    """
+
+    name: str
+    lx: int
+    ly: int
+    radius: float
+    x: np.ndarray
+    row: np.ndarray
+    col: np.ndarray
+    i: np.ndarray
+    j: np.ndarray
+    n: np.ndarray
+    t: np.ndarray
+    kind: np.ndarray
+
+    @property
+    def p(self) -> int:
+        """Number of disks."""
+        return self.x.shape[0]
+
+    @property
+    def c(self) -> int:
+        """Number of contacts."""
+        return self.i.size
+
+    @property
+    def width(self) -> float:
+        return 2.0 * self.radius * self.lx
+
+    def label(self, alpha: int) -> str:
+        """Human-readable name of contact alpha, e.g. 'disk 3 (row 0, col 3) - plane'."""
+        i, j = int(self.i[alpha]), int(self.j[alpha])
+        other = OBSTACLE_NAMES[j] if j < 0 else self.disk_label(j)
+        return f"#{alpha} {self.disk_label(i)} - {other}"
+
+    def disk_label(self, k: int) -> str:
+        return f"disk {k} (row {int(self.row[k])}, col {int(self.col[k])})"
+
+    def contacts_of_kind(self, kind: str) -> np.ndarray:
+        if kind not in KINDS:
+            raise InvalidSystem(f"contact kind must be one of {KINDS}, got {kind!r}")
+        return np.flatnonzero(self.kind == kind)
+
+    def __repr__(self) -> str:
+        return f"<Lattice {self.name} {self.lx}x{self.ly}: {self.p} disks, {self.c} contacts>"
+
+
+def _check_size(name: str, value, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        else:
+            raise InvalidSystem(f"{name} must be an integer, got {value!r}")
+    if value < minimum:
+        raise InvalidSystem(f"{name} must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def _check_radius(radius) -> float:
+    r = float(radius)
+    if not np.isfinite(r) or r <= 0:
+        raise InvalidSystem(f"radius must be a positive finite number, got {radius!r}")
+    return r
+
+
+def rectangular(lx: int, ly: int, radius: float = 1.0) -> Lattice:
+    """Ly rows of Lx disks in columns; every row touches both walls, the bottom row the plane."""
+    lx, ly, r = _check_size("lx", lx, 1), _check_size("ly", ly, 1), _check_radius(radius)
+    rows = [[(r + 2 * r * k, r + 2 * r * m) for k in range(lx)] for m in range(ly)]
+    return _build("rect", lx, ly, r, rows, full=[True] * ly)
+
+
+def triangular(lx: int, ly: int, radius: float = 1.0) -> Lattice:
+    """Rows alternate Lx disks (touching both walls) and Lx - 1 disks in the hollows.
+
+    The bottom row is a full row resting on the plane. Needs lx >= 2 when ly >= 2 (a row of
+    lx - 1 >= 1 disks must exist above the bottom row).
+    """
+    lx, ly, r = _check_size("lx", lx, 1), _check_size("ly", ly, 1), _check_radius(radius)
+    if ly >= 2 and lx < 2:
+        raise InvalidSystem(
+            f"a triangular array with ly = {ly} rows needs lx >= 2 (the rows in the hollows "
+            f"hold lx - 1 disks), got lx = {lx}"
+        )
+    h = np.sqrt(3.0) * r
+    rows = []
+    for m in range(ly):
+        if m % 2 == 0:
+            rows.append([(r + 2 * r * k, r + h * m) for k in range(lx)])
+        else:
+            rows.append([(2 * r + 2 * r * k, r + h * m) for k in range(lx - 1)])
+    return _build("tri", lx, ly, r, rows, full=[m % 2 == 0 for m in range(ly)])
+
+
+def _build(name: str, lx: int, ly: int, r: float, rows: list, full: list[bool]) -> Lattice:
+    x, row, col, index = [], [], [], []
+    for m, disks in enumerate(rows):
+        index.append([])
+        for k, pos in enumerate(disks):
+            index[m].append(len(x))
+            x.append(pos)
+            row.append(m)
+            col.append(k)
+    x = np.array(x, dtype=float)
+    ci, cj, normals, kinds = [], [], [], []
+
+    def add(i: int, j: int, n, kind: str) -> None:
+        ci.append(i)
+        cj.append(j)
+        normals.append(n)
+        kinds.append(kind)
+
+    for k in index[0]:  # the plane, below the bottom row
+        add(k, PLANE, (0.0, -1.0), "plane")
+    for m, ids in enumerate(index):
+        if full[m]:
+            add(ids[0], LEFT_WALL, (-1.0, 0.0), "wall")
+        for a, b in zip(ids[:-1], ids[1:]):
+            add(a, b, (1.0, 0.0), "pp")
+        if full[m]:
+            add(ids[-1], RIGHT_WALL, (1.0, 0.0), "wall")
+        if m + 1 < len(index):  # contacts with the row above: every pair at distance 2r
+            for a in ids:
+                for b in index[m + 1]:
+                    d = x[b] - x[a]
+                    if abs(np.hypot(*d) - 2 * r) <= 1e-9 * r:
+                        add(a, b, tuple(d / (2 * r)), "pp")
+    n = np.array(normals, dtype=float)
+    t = np.column_stack([-n[:, 1], n[:, 0]])  # n rotated by +90 degrees
+    return Lattice(
+        name=name, lx=lx, ly=ly, radius=r, x=x, row=np.array(row), col=np.array(col),
+        i=np.array(ci), j=np.array(cj), n=n, t=t, kind=np.array(kinds),
+    )
+
+
+def make_lattice(kind: str, lx: int, ly: int, radius: float = 1.0) -> Lattice:
+    """`rectangular` or `triangular` by name ('rect'/'rectangular', 'tri'/'triangular')."""
+    key = str(kind).lower()
+    if key in ("rect", "rectangular"):
+        return rectangular(lx, ly, radius)
+    if key in ("tri", "triangular"):
+        return triangular(lx, ly, radius)
+    raise InvalidSystem(f"lattice must be 'rect' or 'tri', got {kind!r}")

@@ -1,0 +1,117 @@
+"""A system: a lattice, the three coefficients of friction, the disks' inertia and the driving.
+
+Frame (DESIGN.md): the box's frame, x to the right, y up. The box moves relative to the plane
+with velocity V(t) = V0 + gamma t, so in the box frame every disk feels gravity (0, -m g) and
+the inertial force (-m gamma, 0); the walls are fixed and the plane moves with velocity -V(t).
+Constant velocity is gamma = 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .lattice import KINDS, PLANE, InvalidSystem, Lattice
+
+
+def _nonneg(name: str, value) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v) or v < 0:
+        raise InvalidSystem(f"{name} must be a finite number >= 0, got {value!r}")
+    return v
+
+
+def _positive(name: str, value) -> float:
+    v = _nonneg(name, value)
+    if v == 0:
+        raise InvalidSystem(f"{name} must be > 0, got {value!r}")
+    return v
+
+
+def _finite(name: str, value) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise InvalidSystem(f"{name} must be finite, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class System:
+    """Lattice + friction (mu_pp particle-particle, mu_plane, mu_wall) + m, I, g + driving.
+
+    gamma: constant acceleration of the box relative to the plane (either sign; 0 = constant
+    velocity); V0: the relative velocity at t = 0. I defaults to m r^2 / 2 (uniform disks).
+    """
+
+    lattice: Lattice
+    mu_pp: float = 0.0
+    mu_plane: float = 0.0
+    mu_wall: float = 0.0
+    gamma: float = 0.0
+    V0: float = 0.0
+    mass: float = 1.0
+    inertia: float | None = None
+    g: float = 1.0
+    mu: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.lattice, Lattice):
+            raise InvalidSystem(f"lattice must be a models.Lattice, got {type(self.lattice).__name__}")
+        for name in ("mu_pp", "mu_plane", "mu_wall"):
+            object.__setattr__(self, name, _nonneg(name, getattr(self, name)))
+        object.__setattr__(self, "gamma", _finite("gamma", self.gamma))
+        object.__setattr__(self, "V0", _finite("V0", self.V0))
+        object.__setattr__(self, "mass", _positive("mass", self.mass))
+        object.__setattr__(self, "g", _nonneg("g", self.g))
+        r = self.lattice.radius
+        inertia = 0.5 * self.mass * r**2 if self.inertia is None else self.inertia
+        object.__setattr__(self, "inertia", _positive("inertia", inertia))
+        coef = {"pp": self.mu_pp, "plane": self.mu_plane, "wall": self.mu_wall}
+        mu = np.array([coef[k] for k in self.lattice.kind], dtype=float)
+        mu.setflags(write=False)
+        object.__setattr__(self, "mu", mu)
+
+    @property
+    def p(self) -> int:
+        return self.lattice.p
+
+    @property
+    def c(self) -> int:
+        return self.lattice.c
+
+    @property
+    def total_mass(self) -> float:
+        """m_g of Eq. (2.1)."""
+        return self.mass * self.p
+
+    @property
+    def plane_contacts(self) -> np.ndarray:
+        return np.flatnonzero(self.lattice.j == PLANE)
+
+    def describe(self) -> dict:
+        """Parameters as a JSON-friendly dict (for run metadata)."""
+        lat = self.lattice
+        return {
+            "lattice": lat.name, "lx": lat.lx, "ly": lat.ly, "radius": lat.radius,
+            "mu_pp": self.mu_pp, "mu_plane": self.mu_plane, "mu_wall": self.mu_wall,
+            "gamma": self.gamma, "V0": self.V0, "mass": self.mass, "inertia": self.inertia,
+            "g": self.g,
+        }
+
+
+def make_system(lattice: str, lx: int, ly: int, **params) -> System:
+    """System from a lattice name and size plus System's keyword parameters."""
+    from .lattice import make_lattice
+
+    radius = params.pop("radius", 1.0)
+    return System(make_lattice(lattice, lx, ly, radius), **params)
+
+
+__all__ = ["System", "make_system", "KINDS"]
