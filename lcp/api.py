@@ -37,7 +37,8 @@ class MethodInfo:
     def __str__(self) -> str:
         limit = f", n <= {self.max_n}" if self.max_n else ""
         opts = ", ".join(self.options) or "-"
-        return f"{self.name:<12} {ACCEPTS[self.accepts]}{limit}. {self.description} [options: {opts}]"
+        accepts = ACCEPTS[self.accepts]
+        return f"{self.name:<12} {accepts}{limit}. {self.description} [options: {opts}]"
 
 
 _REGISTRY: dict[str, MethodInfo] = {}
@@ -92,7 +93,9 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
         )
     lcp = problem.to_lcp() if isinstance(problem, MLCP) else problem
     if info.max_n is not None and lcp.n > info.max_n:
-        raise NotApplicable(f"method {method!r} is limited to n <= {info.max_n}; this LCP has n = {lcp.n}")
+        raise NotApplicable(
+            f"method {method!r} is limited to n <= {info.max_n}; this LCP has n = {lcp.n}"
+        )
     sol = info.func(lcp.M, lcp.q, **options)
     sol.method = method
     z = np.asarray(sol.z, dtype=float)

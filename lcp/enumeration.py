@@ -54,6 +54,8 @@ MAX_N = 20
 RCOND = 1e-10
 #: A singular basis's solution set wider than WIDTH_FACTOR * tol * z_scale is a continuum.
 WIDTH_FACTOR = 1e3
+#: HiGHS tolerances for the LPs of singular bases (its defaults are 1e-7).
+_HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 #: Work per batch (elements of the stacked arrays), to bound memory at n = 20.
 _BATCH_ELEMENTS = 2_000_000
 
@@ -155,27 +157,33 @@ def _singular_basis(
     if np.any(np.abs(out_of_range) > tw[alpha]):
         return None
     tz = sc.tol * float(sc.z_scale(zp[None, :])[0])
-    # Feasible set in y: z_p + N y >= -tz/2, M_ba (z_p + N y) + q_b >= -tw_b/2 (half the
-    # tolerance, so that the LP's point passes the final check with the full one).
+    # Feasible set in y: z_p + N y >= 0, M_ba (z_p + N y) + q_b >= 0; if rounding makes it
+    # empty, relax by half the tolerance (so that the LP's point passes the final check).
     Mba = M[np.ix_(beta, alpha)]
     A_ub = np.vstack([-N, -(Mba @ N)])
-    b_ub = np.concatenate([zp + tz / 2, Mba @ zp + q[beta] + tw[beta] / 2])
+    b_exact = np.concatenate([zp, Mba @ zp + q[beta]])
+    b_ub = b_exact + np.concatenate([np.full(alpha.size, tz), tw[beta]]) / 2
     # Rows that do not depend on y (e.g. duplicated columns) decide at once.
     free_rows = np.max(np.abs(A_ub), axis=1) <= RCOND * (1.0 + float(np.max(np.abs(A_ub))))
     if np.any(b_ub[free_rows] < 0):
         return None
     d = N.shape[1]
     bounds = [(None, None)] * d
-    res = linprog(N.sum(axis=0), A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs")
+    res = linprog(N.sum(axis=0), A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs",
+                  options=_HIGHS)
     if res.status != 0:  # infeasible (2), or numerical trouble: no solution on this basis
         return None
+    exact = linprog(N.sum(axis=0), A_ub=A_ub, b_ub=b_exact, bounds=bounds, method="highs",
+                    options=_HIGHS)
+    if exact.status == 0:  # the same set without the relaxation: a cleaner point
+        res = exact
     y = res.x
     z = zp + N @ y
     # Extent of the basis's solution set along a random direction of z-space.
     c = N.T @ rng.standard_normal(alpha.size)
     c /= max(np.linalg.norm(c), 1e-300)
-    lo = linprog(c, A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs")
-    hi = linprog(-c, A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs")
+    lo = linprog(c, A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs", options=_HIGHS)
+    hi = linprog(-c, A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs", options=_HIGHS)
     if lo.status == 3 or hi.status == 3:  # unbounded
         continuum = True
     elif lo.status == 0 and hi.status == 0:

@@ -228,12 +228,14 @@ class _Lemke:
         n, tol, T, slot_of = self.n, self.tol, self.T, self.slot_of
         beta = T[:, n + 1]
         z0 = 2 * n
+        amin_of, count = np.minimum.reduce, np.count_nonzero
+        negative, maximum = np.negative, np.maximum
         # Step 0: z0 enters; every row is "blocking" with pivot d_i and ratio q_i / d_i.
         alpha = T[:, n].copy()
         r = self.choose(np.arange(n), alpha, beta / alpha, float(alpha.max()))
         s = n
         pivots = 0
-        pivot, choose = self.pivot, self.choose
+        pivot = self.pivot
         while True:
             leaving = pivot(r, s)
             pivots += 1
@@ -244,17 +246,25 @@ class _Lemke:
             entering = leaving + n if leaving < n else leaving - n
             s = slot_of[entering]
             a = T[:, s]
-            amax = -float(a.min())
+            amax = -float(amin_of(a))  # the largest pivot candidate alpha_i = -a_i
             thr = tol * amax if amax > 1.0 else tol
             if amax <= thr:
                 return self.ray(pivots, s, entering)
             rows = (a < -thr).nonzero()[0]
+            if rows.size == 1:
+                r = int(rows[0])
+                continue
             alpha = a[rows]
-            np.negative(alpha, out=alpha)
+            negative(alpha, out=alpha)
             theta = beta[rows]
-            np.maximum(theta, 0.0, out=theta)
+            maximum(theta, 0.0, out=theta)
             theta /= alpha
-            r = choose(rows, alpha, theta, amax)
+            k = theta.argmin()
+            tied = theta <= theta[k] + tol / amax
+            if count(tied) == 1:
+                r = int(rows[k])
+            else:
+                r = self.choose(rows, alpha, theta, amax)
 
     # -- outcomes -------------------------------------------------------------------------
     def point(self) -> tuple[np.ndarray, np.ndarray, float]:

@@ -51,6 +51,8 @@ from .solution import Solution
 RCOND = 1e-13
 #: |Mbar_rr| below PIVOT_TOL times the size of its row counts as a zero pivot.
 PIVOT_TOL = 1e-10
+#: Sign tests use at least FLOOR times the largest row scale of w (rounding level).
+FLOOR = 1e-6
 
 
 class _Basis:
@@ -139,6 +141,9 @@ def _infeasible(z: np.ndarray, w: np.ndarray, alpha: np.ndarray, M: np.ndarray,
     mscale = float(np.max(np.abs(M))) or 1.0
     zscale = max(float(np.max(np.abs(z))), float(np.max(np.abs(q))) / mscale)
     wscale = np.abs(q) + np.abs(M) @ np.abs(z)
+    # Row scale (invariant under scaling a row of M and q), with a floor at rounding level of
+    # the whole problem, so that a row whose every entry is ~1e-190 does not decide anything.
+    wscale = np.maximum(wscale, FLOOR * float(np.max(wscale)))
     bad = np.where(alpha, z < -tol * zscale, w < -tol * wscale)
     return np.flatnonzero(bad)
 
@@ -247,11 +252,22 @@ def solve_pivoting(
                 if abs(row_c[r]) > PIVOT_TOL * (float(np.max(np.abs(row_c))) or 1.0):
                     s = int(c)
                     break
-            if s < 0:
-                return result("failed", z, f"zero pivot on index {r} and no usable exchange "
-                              "pivot: M is not sufficient, the criss-cross rule does not apply")
-            flip.append(s)
-            info["exchange_pivots"] += 1
+            if s >= 0:
+                flip.append(s)
+                info["exchange_pivots"] += 1
+            else:
+                # No usable exchange pivot (M is not sufficient, or the 2 x 2 block is singular
+                # in floating point): pivot on the least other failing index with a nonzero
+                # diagonal. The finiteness guarantee is lost; max_iter and the cycle test stay.
+                for c in H[1:]:
+                    row_c = basis.row(int(c))
+                    if abs(row_c[c]) > PIVOT_TOL * (float(np.max(np.abs(row_c))) or 1.0):
+                        flip = [int(c)]
+                        break
+                else:
+                    return result("failed", z, f"zero pivot on index {r} and no usable "
+                                  "exchange or diagonal pivot: M is not sufficient")
+                info["fallback_pivots"] = info.get("fallback_pivots", 0) + 1
         new = basis.alpha.copy()
         new[flip] = ~new[flip]
         trial = _Basis(M, new)

@@ -147,7 +147,8 @@ class MLCP:
         return self.b.size
 
     def to_lcp(self, rcond: float = 1e-12) -> LCP:
-        """Schur-complement reduction: u = -A^{-1}(C v + a), so w = (B - D A^{-1} C) v + b - D A^{-1} a.
+        """Schur-complement reduction: u = -A^{-1}(C v + a), hence
+        w = (B - D A^{-1} C) v + b - D A^{-1} a.
 
         Raises NotApplicable when A is singular (to the relative tolerance `rcond` on its
         condition number), naming why.

@@ -67,36 +67,38 @@ def active_set_polish(
 ) -> tuple[np.ndarray, int]:
     """Active-set least-squares polish of an approximate solution (see module doc).
 
-    Round 1 takes alpha = {i : z_i > w_i} and moves z_a to the nearest solution of
-    M_aa z_a = -q_a (minimum-norm least-squares correction), z_b = 0. Entries that come out
-    negative leave alpha and the next round re-solves (on a degenerate or singular problem the
-    nearest point of the affine set may lie slightly outside z >= 0). For symmetric PSD M any
-    z_a >= 0 solving those equations, with alpha inside {w* = 0} and containing the support of
-    a solution z*, is itself a solution: M (z - z*) = 0 follows from (z - z*)' M (z - z*) = 0.
+    Each round takes alpha = {i : z_i > w_i} at the current point and moves z_a to the
+    nearest solution of M_aa z_a = -q_a (minimum-norm least-squares correction), z_b = 0.
+    Entries that come out negative are clipped and kept out of alpha afterwards (on a
+    degenerate or singular problem the nearest point of the affine set may lie slightly outside
+    z >= 0); rounds stop when alpha repeats. For symmetric PSD M any z_a >= 0 solving those
+    equations, with alpha inside {w* = 0} and containing the support of a solution z*, is
+    itself a solution: M (z - z*) = 0 follows from (z - z*)' M (z - z*) = 0.
     Returns the best point met (never worse than max(z, 0)) and the number of rounds run.
     """
     z = np.maximum(z, 0.0)
     w = M @ z + q
     best_z, best = z, complementarity_residual(z, w)
-    a = np.flatnonzero(z > w)
+    dropped = np.zeros(z.size, dtype=bool)
+    seen: set[bytes] = set()
     done = 0
     for _ in range(rounds):
-        if best == 0.0:
+        a = np.flatnonzero((z > w) & ~dropped)
+        if best == 0.0 or a.tobytes() in seen:
             break
+        seen.add(a.tobytes())
         done += 1
         trial = np.zeros_like(z)
         if a.size:
             Maa = M[np.ix_(a, a)]
             r = Maa @ z[a] + q[a]
             za = z[a] + lstsq(Maa, -r, cond=1e-13, check_finite=False)[0]
-            trial[a] = za
-            keep = za >= 0
-        res = complementarity_residual(np.maximum(trial, 0.0), M @ np.maximum(trial, 0.0) + q)
+            dropped[a[za < 0]] = True
+            trial[a] = np.maximum(za, 0.0)
+        z, w = trial, M @ trial + q
+        res = complementarity_residual(z, w)
         if res < best:
-            best_z, best = np.maximum(trial, 0.0), res
-        if not a.size or keep.all():
-            break
-        z, a = np.maximum(trial, 0.0), a[keep]
+            best_z, best = z, res
     return best_z, done
 
 
@@ -238,7 +240,7 @@ def solve_qp_osqp(
         polishing=bool(polish),
     )
     with _quiet_stdout():
-        out = prob.solve()
+        out = prob.solve(raise_error=False)
     status = str(out.info.status)
     iters = int(out.info.iter)
     if status.startswith("dual infeasible"):

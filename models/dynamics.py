@@ -48,7 +48,8 @@ class Dynamics:
         cols += [2 * p + lat.i, 2 * p + lat.j[disk_j]]
         vals += [np.full(c, -r), np.full(int(disk_j.sum()), -r)]
         self.H = sp.csr_matrix(
-            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(2 * c, 3 * p)
+            (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+            shape=(2 * c, 3 * p),
         )
         m, inertia = system.mass, system.inertia
         self.Minv = np.concatenate([np.full(2 * p, 1.0 / m), np.full(p, 1.0 / inertia)])
@@ -72,7 +73,7 @@ class Dynamics:
         return self.system.c
 
     def u_obs(self, V: float) -> np.ndarray:
-        """Obstacle part of the relative velocities when the box moves at V relative to the plane."""
+        """Obstacle part of the relative velocities when the box moves at V past the plane."""
         return self._obs_per_V * V
 
     @cached_property

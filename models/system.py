@@ -63,7 +63,8 @@ class System:
 
     def __post_init__(self) -> None:
         if not isinstance(self.lattice, Lattice):
-            raise InvalidSystem(f"lattice must be a models.Lattice, got {type(self.lattice).__name__}")
+            got = type(self.lattice).__name__
+            raise InvalidSystem(f"lattice must be a models.Lattice, got {got}")
         for name in ("mu_pp", "mu_plane", "mu_wall"):
             object.__setattr__(self, name, _nonneg(name, getattr(self, name)))
         object.__setattr__(self, "gamma", _finite("gamma", self.gamma))
