@@ -1,0 +1,54 @@
+"""Helper of benchmarks/lcp_dense.py, run by the system interpreter (/usr/bin/python3) that has
+Debian's python3-siconos: Siconos's lexicographic Lemke (``lcp_lexicolemke``, SICONOS_LCP_LEMKE)
+on LCPs passed as .npy files.
+
+Protocol (one JSON object per line): the helper first prints {"ready": true, "numpy": ...} or
+{"ready": false, "error": ...}; then for every request {"M": path, "q": path, "max_iter": k} it
+solves once and prints {"time": seconds of the solve call only, "iterations": Siconos's pivot
+count, "info": return code, "residual": max|min(z, M z + q)|}. End of input ends it.
+
+Siconos counts the pivots of its main loop, i.e. every pivot except the first (z0 entering).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+
+def main() -> int:
+    try:
+        import numpy as np
+        import siconos.numerics as sn
+    except Exception as exc:  # noqa: BLE001 - any import failure means "skip"
+        print(json.dumps({"ready": False, "error": f"{type(exc).__name__}: {exc}"}), flush=True)
+        return 0
+    print(json.dumps({"ready": True, "numpy": np.__version__}), flush=True)
+    for line in sys.stdin:
+        if not line.strip():
+            continue
+        req = json.loads(line)
+        M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
+        q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
+        n = q.size
+        problem = sn.LCP(M, q)
+        options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+        options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(req.get("max_iter", 10000))
+        z, w = np.zeros(n), np.zeros(n)
+        t0 = time.perf_counter()
+        info = sn.lcp_lexicolemke(problem, z, w, options)
+        elapsed = time.perf_counter() - t0
+        residual = float(np.max(np.abs(np.minimum(z, M @ z + q))))
+        out = {
+            "time": elapsed,
+            "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),
+            "info": int(info) if info is not None else None,
+            "residual": residual,
+        }
+        print(json.dumps(out), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
