@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import lcp
+from lcp.face import face_minimum_norm
 
 from .dynamics import Dynamics
 from .event import (
@@ -59,6 +60,7 @@ class EventRecord:
     residual: float
     n_lcp: int
     method: str
+    fallback: bool = False
 
 
 @dataclass
@@ -120,17 +122,47 @@ def simulate(
     zeno_time: float = 1e-9,
     progress: Callable[[Run], None] | None = None,
     dump_dir: str | None = None,
+    select: str = "face-min-norm",
+    fallback: str | None = "lemke",
+    blas_threads: int | None = 1,
 ) -> Run:
     """Evolve `system` from `state` (or from omega / a seed) event by event.
 
     method: any `lcp` method; "pivoting" is warm-started from the previous event's contact states
     when warm_start is true. Every solution's residual max|min(z, w)| must be <= check_tol (in
     units of the problem's scale), or the run stops with "solver_failed".
+
+    select: "face-min-norm" (default) replaces the solver's solution by the minimum-norm contact
+    forces on its face (`lcp.face.face_minimum_norm`): when the event's solution is not unique
+    (hyperstatic rows, loops of non-sliding contacts, Sec. III) this makes the result independent
+    of which vertex a method happened to return. "none" keeps the solver's solution.
+
+    fallback: when `method` fails at an event (no solution, cycling, iteration limit), that
+    event is solved again by this method (None: stop); each use is counted in the record.
+    blas_threads: BLAS threads during the run (the event problems are small dense matrices, for
+    which one thread is fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
-    if method not in {m.name for m in lcp.methods()}:
-        raise lcp.InvalidProblem(
-            f"unknown method {method!r}; available: {', '.join(m.name for m in lcp.methods())}"
-        )
+    if blas_threads is None:
+        return _simulate(system, state, method=method, omega=omega, seed=seed, t_max=t_max,
+                         max_events=max_events, check_tol=check_tol, warm_start=warm_start,
+                         zeno_events=zeno_events, zeno_time=zeno_time, progress=progress,
+                         dump_dir=dump_dir, select=select, fallback=fallback)
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(blas_threads):
+        return _simulate(system, state, method=method, omega=omega, seed=seed, t_max=t_max,
+                         max_events=max_events, check_tol=check_tol, warm_start=warm_start,
+                         zeno_events=zeno_events, zeno_time=zeno_time, progress=progress,
+                         dump_dir=dump_dir, select=select, fallback=fallback)
+
+
+def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_tol, warm_start,
+              zeno_events, zeno_time, progress, dump_dir, select, fallback) -> Run:
+    if select not in ("face-min-norm", "none"):
+        raise ValueError(f"select must be 'face-min-norm' or 'none', got {select!r}")
+    for name in (method, fallback):
+        if name is not None:
+            lcp.get_method(name)  # raises InvalidProblem naming the available methods
     dyn = Dynamics(system)
     if state is None:
         state = initial_state(system, omega=omega, seed=seed)
@@ -148,6 +180,13 @@ def simulate(
         if method == "pivoting" and warm_start and prev is not None:
             options["active"] = warm_active_set(ep, prev, state)
         sol = lcp.solve(ep.lcp, method=method, **options)
+        fell_back = False
+        if sol.status != "solved" and fallback is not None and fallback != method:
+            first = sol
+            sol = lcp.solve(ep.lcp, method=fallback)
+            fell_back = True
+            if sol.status != "solved":
+                sol.message = f"{method}: {first.status}; {fallback}: {sol.message}"
         if dump_dir is not None:
             ep.lcp.save(f"{dump_dir}/event_{run.n_events:06d}.npz")
         scale = max(np.abs(ep.lcp.q).max(initial=0.0), system.mass * system.g, 1e-300)
@@ -166,9 +205,20 @@ def simulate(
                 f"{check_tol:g} x scale {scale:.3g}"
             )
             break
-        es = ep.unpack(sol.z)
+        z = sol.z
+        if select == "face-min-norm":
+            face = face_minimum_norm(ep.lcp, z, ep.G)
+            if face.status == "selected":
+                z = face.z
+                sol.residual = lcp.complementarity_residual(z, ep.lcp.M @ z + ep.lcp.q)
+                if sol.residual > check_tol * scale:
+                    run.status = "solver_failed"
+                    run.message = (f"t = {state.t:.6g}: the face selection left residual "
+                                   f"{sol.residual:.3g}")
+                    break
+        es = ep.unpack(z)
         vt = dyn.velocities(state.omega, state.V)[c:]
-        run.records.append(_record(system, state, es, vt, sol))
+        run.records.append(_record(system, state, es, vt, sol, fell_back))
         opening = np.flatnonzero(es.a_n > max(tol_a, 10 * sol.residual))
         if opening.size:
             run.status = "detachment"
@@ -223,7 +273,9 @@ def _advance(state: State, es: EventSolution, dt: float, system: System) -> Stat
                  es.s.copy())
 
 
-def _record(system: System, state: State, es: EventSolution, vt: np.ndarray, sol) -> EventRecord:
+def _record(
+    system: System, state: State, es: EventSolution, vt: np.ndarray, sol, fell_back: bool
+) -> EventRecord:
     from .observables import dissipation_rate, global_friction
 
     return EventRecord(
@@ -232,6 +284,7 @@ def _record(system: System, state: State, es: EventSolution, vt: np.ndarray, sol
         mu_g=global_friction(system, es.S) / (system.total_mass * system.g or 1.0),
         dissipation=dissipation_rate(es.S, vt), iterations=int(sol.iterations),
         residual=float(sol.residual), n_lcp=int(sol.z.size), method=sol.method,
+        fallback=fell_back,
     )
 
 

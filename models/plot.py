@@ -1,0 +1,159 @@
+"""Figures of a run, in the manner of the paper's Figs. 7-10 and 13 (matplotlib, Agg backend)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .evolution import Run
+from .lattice import LEFT_WALL, PLANE, RIGHT_WALL
+from .system import System
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: str = "",
+                 cmap: str = "coolwarm") -> None:
+    """Disks (coloured by `values`, symmetric colour scale), walls and plane."""
+    from matplotlib.collections import PatchCollection
+    from matplotlib.patches import Circle
+
+    lat = system.lattice
+    r = lat.radius
+    patches = [Circle(tuple(x), r) for x in lat.x]
+    coll = PatchCollection(patches, edgecolor="k", linewidth=0.6)
+    if values is not None:
+        vmax = max(np.abs(values).max(initial=0.0), 1e-12)
+        coll.set_array(np.asarray(values))
+        coll.set_cmap(cmap)
+        coll.set_clim(-vmax, vmax)
+    else:
+        coll.set_facecolor("whitesmoke")
+    ax.add_collection(coll)
+    if values is not None:
+        ax.figure.colorbar(coll, ax=ax, label=label, shrink=0.8)
+    top = lat.x[:, 1].max() + r
+    ax.plot([0, 0], [0, top], "k-", lw=2)
+    ax.plot([lat.width, lat.width], [0, top], "k-", lw=2)
+    ax.plot([-0.3 * r, lat.width + 0.3 * r], [0, 0], "k-", lw=2)
+    ax.set_xlim(-0.5 * r, lat.width + 0.5 * r)
+    ax.set_ylim(-0.5 * r, top + 0.5 * r)
+    ax.set_aspect("equal")
+    ax.axis("off")
+
+
+def contact_points(system: System) -> tuple[np.ndarray, np.ndarray]:
+    """Segment ends of every contact: disk centre to disk centre, or to the obstacle's surface."""
+    lat = system.lattice
+    a = lat.x[lat.i]
+    b = np.where((lat.j >= 0)[:, None], lat.x[np.maximum(lat.j, 0)], a + lat.radius * lat.n)
+    return a, b
+
+
+def draw_forces(ax, system: System, F: np.ndarray, signed: bool = False,
+                max_width: float = 6.0) -> None:
+    """Contact forces as segments whose width is proportional to |F| (Fig. 8b-c, Fig. 4).
+    signed: colour by sign (red +, blue -), for friction forces."""
+    from matplotlib.collections import LineCollection
+
+    a, b = contact_points(system)
+    fmax = max(np.abs(F).max(initial=0.0), 1e-12)
+    widths = max_width * np.abs(F) / fmax
+    colors = ["tab:red" if f > 0 else "tab:blue" for f in F] if signed else "k"
+    segs = np.stack([a, b], axis=1)
+    keep = widths > 1e-3
+    if np.any(keep):
+        ax.add_collection(LineCollection(segs[keep], linewidths=widths[keep],
+                                         colors=np.array(colors)[keep] if signed else colors))
+
+
+def step_series(run: Run, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """A per-event quantity as a piecewise-constant curve up to the end of the run."""
+    t = run.array("t")
+    v = run.array(name)
+    t_end = run.final.t if run.final is not None else t[-1]
+    t_end = max(t_end, t[-1] + 0.1 * max(t[-1], 1.0)) if run.steady else t_end
+    return np.append(t, t_end), np.append(v, v[-1])
+
+
+def dissipation_curve(run: Run, samples: int = 20) -> tuple[np.ndarray, np.ndarray]:
+    """D(t) = -sum S (v_t + a_t (t - t_k)): linear within each inter-event interval."""
+    ts, ds = [], []
+    times, t_end = step_series(run, "t")
+    for k, rec in enumerate(run.records):
+        t1 = times[k + 1] if k + 1 < len(run.records) else t_end[-1]
+        tt = np.linspace(rec.t, t1, samples)
+        ts.append(tt)
+        ds.append(-(rec.S @ (rec.vt[:, None] + rec.at[:, None] * (tt - rec.t))))
+    return np.concatenate(ts), np.concatenate(ds)
+
+
+def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
+    """Write the figures of a run to `outdir`; returns the files written."""
+    plt = _plt()
+    out = Path(outdir)
+    out.mkdir(parents=True, exist_ok=True)
+    system = run.system
+    rec = run.records[event]
+    files = []
+
+    def save(fig, name: str) -> None:
+        path = out / name
+        fig.savefig(path, dpi=130, bbox_inches="tight")
+        plt.close(fig)
+        files.append(path)
+
+    lat = system.lattice
+    size = (max(6.0, 0.6 * lat.lx + 2), max(3.0, 0.6 * lat.ly * (0.87 if lat.name == "tri" else 1)
+                                            + 1.5))
+    for name, values, label in (("angular_acceleration", rec.omega_dot, r"$\dot\omega$"),
+                                ("angular_velocity", rec.omega, r"$\omega$")):
+        fig, ax = plt.subplots(figsize=size)
+        draw_lattice(ax, system, values, label=label)
+        ax.set_title(f"{label} at t = {rec.t:.4g} ({run.status}, event {event % run.n_events})")
+        save(fig, f"{name}.png")
+    # Fig. 9: angular accelerations against the position in each row.
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for row in range(lat.ly):
+        sel = lat.row == row
+        ax.plot(lat.x[sel, 0], rec.omega_dot[sel], "o-", label=f"row {row + 1}")
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set_xlabel("x / r")
+    ax.set_ylabel(r"$\dot\omega$ (g / r)")
+    ax.legend(fontsize="small")
+    save(fig, "angular_acceleration_rows.png")
+    for name, F, signed, title in (("normal_forces", rec.R, False, "normal forces R"),
+                                   ("friction_forces", rec.S, True, "friction forces S")):
+        fig, ax = plt.subplots(figsize=size)
+        draw_lattice(ax, system)
+        draw_forces(ax, system, F, signed=signed)
+        ax.set_title(f"{title} at t = {rec.t:.4g} (width ~ |force|)")
+        save(fig, f"{name}.png")
+    # Fig. 10: mu_g(t); Fig. 13: dissipation rate.
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    t, mu = step_series(run, "mu_g")
+    ax.step(t, mu, where="post")
+    ax.set_xlabel("t (sqrt(r/g))")
+    ax.set_ylabel(r"$\mu_g$")
+    ax.set_title("global friction coefficient")
+    save(fig, "mu_g.png")
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    t, D = dissipation_curve(run)
+    ax.plot(t, D)
+    ax.set_xlabel("t (sqrt(r/g))")
+    ax.set_ylabel("dissipation rate D")
+    ax.set_title(r"$D = -\sum S\, v_t$")
+    save(fig, "dissipation.png")
+    return files
+
+
+__all__ = ["plot_run", "draw_lattice", "draw_forces", "dissipation_curve", "step_series",
+           "LEFT_WALL", "RIGHT_WALL", "PLANE"]

@@ -1,0 +1,113 @@
+"""Save and load a run: one .npz with the per-event arrays and a JSON sidecar with the metadata.
+
+Both files are written to temporary names and renamed into place, so an interrupted write never
+leaves a half-written run behind.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
+
+from .event import State
+from .evolution import EventRecord, Run
+from .system import make_system
+
+FORMAT = "rigidlcp-run/1"
+_SCALARS = ("t", "V", "mu_g", "dissipation", "iterations", "residual", "n_lcp", "fallback")
+_ARRAYS = ("omega", "omega_dot", "R", "S", "s", "vt", "at")
+
+
+def _atomic_write(path: Path, write) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def run_paths(path: str | os.PathLike) -> tuple[Path, Path]:
+    """(data .npz, metadata .json) for a run path given with or without the .npz suffix."""
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_name(path.name + ".npz")
+    return path, path.with_suffix(".json")
+
+
+def save_run(run: Run, path: str | os.PathLike) -> Path:
+    """Write `run` to PATH.npz (+ PATH.json); returns the .npz path."""
+    data_path, meta_path = run_paths(path)
+    arrays: dict[str, np.ndarray] = {}
+    for name in _SCALARS + _ARRAYS:
+        arrays[name] = run.array(name) if run.records else np.zeros(0)
+    if run.final is not None:
+        arrays.update(final_omega=run.final.omega, final_s=run.final.s,
+                      final_tV=np.array([run.final.t, run.final.V]))
+    meta = {
+        "format": FORMAT, "system": run.system.describe(), "status": run.status,
+        "message": run.message, "contacts": run.contacts, "method": run.method,
+        "wall_time": run.wall_time, "events": run.n_events,
+        "methods_per_event": [r.method for r in run.records],
+        "summary": run.summary(),
+    }
+    text = json.dumps(meta, indent=2, default=_json_default)
+
+    def write_npz(tmp: str) -> None:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, __meta__=np.array(text), **arrays)
+
+    def write_json(tmp: str) -> None:
+        Path(tmp).write_text(text + "\n")
+
+    _atomic_write(data_path, write_npz)
+    _atomic_write(meta_path, write_json)
+    return data_path
+
+
+def load_run(path: str | os.PathLike) -> Run:
+    """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
+    data_path, _ = run_paths(path)
+    if not data_path.exists():
+        raise FileNotFoundError(f"no run file at {data_path}")
+    with np.load(data_path, allow_pickle=False) as data:
+        meta = json.loads(str(data["__meta__"]))
+        if meta.get("format") != FORMAT:
+            raise ValueError(f"{data_path} is not a rigidlcp run (format {meta.get('format')!r})")
+        cols = {k: data[k] for k in _SCALARS + _ARRAYS}
+        final = None
+        if "final_omega" in data.files:
+            t, V = data["final_tV"]
+            final = State(float(t), data["final_omega"], float(V), data["final_s"].astype(int))
+    params = dict(meta["system"])
+    system = make_system(params.pop("lattice"), params.pop("lx"), params.pop("ly"), **params)
+    methods = meta.get("methods_per_event", [])
+    names = {f.name for f in fields(EventRecord)}
+    records = []
+    for k in range(meta["events"]):
+        rec = {name: cols[name][k] for name in _SCALARS + _ARRAYS}
+        rec.update(method=methods[k] if k < len(methods) else meta["method"])
+        for name in ("t", "V", "mu_g", "dissipation", "residual"):
+            rec[name] = float(rec[name])
+        rec["iterations"], rec["n_lcp"] = int(rec["iterations"]), int(rec["n_lcp"])
+        rec["fallback"], rec["s"] = bool(rec["fallback"]), rec["s"].astype(int)
+        records.append(EventRecord(**{k: v for k, v in rec.items() if k in names}))
+    return Run(system, records, status=meta["status"], message=meta["message"],
+               contacts=list(meta.get("contacts", [])), wall_time=float(meta["wall_time"]),
+               method=meta["method"], final=final)
+
+
+def _json_default(obj):
+    if isinstance(obj, (np.integer, np.floating, np.bool_)):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serializable: {type(obj).__name__}")
