@@ -20,10 +20,12 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--mu-plane", type=float, default=0.2, help="particle-plane friction")
     g.add_argument("--mu-wall", type=float, default=0.0, help="particle-wall friction")
     g.add_argument("--gamma", type=float, default=0.1,
-                   help="acceleration of the box relative to the plane, in g (0: constant velocity)")
+                   help="acceleration of the box relative to the plane, in g "
+                   "(0: constant velocity)")
     g.add_argument("--v0", type=float, default=0.0,
                    help="initial velocity of the box relative to the plane (sqrt(g r))")
-    g.add_argument("--inertia", type=float, default=None, help="moment of inertia (default m r^2/2)")
+    g.add_argument("--inertia", type=float, default=None,
+                   help="moment of inertia (default m r^2/2)")
 
 
 def system_from_args(args):
