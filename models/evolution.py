@@ -132,10 +132,11 @@ def simulate(
     when warm_start is true. Every solution's residual max|min(z, w)| must be <= check_tol (in
     units of the problem's scale), or the run stops with "solver_failed".
 
-    select: "face-min-norm" (default) replaces the solver's solution by the minimum-norm contact
-    forces on its face (`lcp.face.face_minimum_norm`): when the event's solution is not unique
-    (hyperstatic rows, loops of non-sliding contacts, Sec. III) this makes the result independent
-    of which vertex a method happened to return. "none" keeps the solver's solution.
+    select: "face-min-norm" (default) replaces the solver's solution by a canonical point of its
+    face (`lcp.face.face_minimum_norm`): the least total normal force sum R, and among those the
+    least |lambda|. When the event's solution is not unique (hyperstatic rows, loops of
+    non-sliding contacts, Sec. III) this makes the result independent of which point a method
+    happened to return (see docs/theory.md, "Non-unique events"). "none" keeps the solver's.
 
     fallback: when `method` fails at an event (no solution, cycling, iteration limit), that
     event is solved again by this method (None: stop); each use is counted in the record.
@@ -172,10 +173,14 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
     tol_a = acceleration_tol(system)
     scale_v = max(np.abs(dyn.velocities(state.omega, state.V)).max(initial=0.0), 1e-300)
     recent: list[float] = []
+    least_force = None
     prev: EventSolution | None = None
     start = _time.perf_counter()
     while True:
         ep = event_problem(system, state, dyn)
+        if least_force is None or least_force.size != ep.lcp.n:
+            least_force = np.zeros(ep.lcp.n)
+            least_force[:c] = 1.0  # sum of R over the contacts: z = [R, tau, a_minus]
         options = {}
         if method == "pivoting" and warm_start and prev is not None:
             options["active"] = warm_active_set(ep, prev, state)
@@ -207,7 +212,7 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
             break
         z = sol.z
         if select == "face-min-norm":
-            face = face_minimum_norm(ep.lcp, z, ep.G)
+            face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force)
             if face.status == "selected":
                 z = face.z
                 sol.residual = lcp.complementarity_residual(z, ep.lcp.M @ z + ep.lcp.q)
