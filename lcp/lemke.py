@@ -147,6 +147,7 @@ class _Lemke:
         self.nonbasic = list(range(n, 2 * n + 1))  # slot -> variable
         self.row_of = list(range(n)) + [-1] * (n + 1)  # variable -> row, or -1
         self.slot_of = [-1] * n + list(range(n + 1))  # variable -> slot, or -1
+        self.basic_np, self.slot_np = np.array(self.basic), np.array(self.slot_of)  # mirrors
 
     # -- the pivot -------------------------------------------------------------------------
     def pivot(self, r: int, s: int) -> int:
@@ -174,6 +175,7 @@ class _Lemke:
         self.nonbasic[s] = leaving
         self.row_of[entering], self.slot_of[entering] = r, -1
         self.row_of[leaving], self.slot_of[leaving] = -1, s
+        self.basic_np[r], self.slot_np[entering], self.slot_np[leaving] = entering, -1, s
         return leaving
 
     # -- the ratio test ------------------------------------------------------------------
@@ -201,26 +203,38 @@ class _Lemke:
         Column j of B^-1 is e_r when w_j is basic in row r, and -T[:, slot(w_j)] when w_j is
         nonbasic (T = -B^-1 N and w_j's column in [I, -M, -d] is e_j). B^-1 is nonsingular,
         so two rows are never equal in exact arithmetic; entries closer than tol (relative
-        to the compared rows) are treated as equal, since their difference is rounding.
+        to the largest compared entry) are treated as equal, since their difference is
+        rounding. If all columns are equal to that tolerance, the largest pivot is taken.
+
+        The sweep over the columns j = 0, 1, ... keeps the rows whose entry is minimal. A
+        column of a basic w_j has one nonzero, 1/alpha_r > 0 in w_j's row r, so it removes row
+        r if r is still a candidate (and not the last one): those columns are handled in bulk
+        between the columns of nonbasic w's, and only the latter where the tied rows differ
+        are compared one by one.
         """
-        n, T = self.n, self.T
-        basic, nonbasic = np.array(self.basic), np.array(self.nonbasic)
-        U = np.zeros((rows.size, n))
-        wslots = np.flatnonzero(nonbasic < n)
-        U[:, nonbasic[wslots]] = -T[np.ix_(rows, wslots)]
-        bvars = basic[rows]
-        isw = bvars < n
-        U[np.flatnonzero(isw), bvars[isw]] = 1.0
-        U /= alpha[:, None]
+        n = self.n
+        slot_w = self.slot_np[:n]
+        wj = np.flatnonzero(slot_w >= 0)  # nonbasic w's, in index order
+        V = -self.T[np.ix_(rows, slot_w[wj])] / alpha[:, None]
+        bvars = self.basic_np[rows]
+        pos = np.where(bvars < n, bvars, n)  # column of each row's unit entry (n: none)
+        eps = self.tol * max(float(np.abs(V).max(initial=0.0)), float((1.0 / alpha).max()))
+        events = np.flatnonzero(V.max(axis=0, initial=-np.inf) - V.min(axis=0, initial=np.inf)
+                                > eps) if wj.size else np.zeros(0, dtype=int)
         cand = np.arange(rows.size)
-        while cand.size > 1:
-            sub = U[cand]
-            eps = self.tol * float(np.abs(sub).max())
-            differ = np.flatnonzero(sub.max(axis=0) - sub.min(axis=0) > eps)
-            if differ.size == 0:  # numerically equal rows: B nearly singular
+        for k in [*events.tolist(), None]:
+            j = n if k is None else int(wj[k])
+            early = pos[cand] < j  # unit entries before column j: their rows go, in order
+            if early.all():
+                cand = cand[[int(np.argmax(pos[cand]))]]
+            elif early.any():
+                cand = cand[~early]
+            if cand.size == 1 or k is None:
                 break
-            col = sub[:, differ[0]]
-            cand = cand[col <= col.min() + eps]
+            v = V[cand, k]
+            cand = cand[v <= v.min() + eps]
+            if cand.size == 1:
+                break
         return int(rows[cand[np.argmax(alpha[cand])]])
 
     # -- the run --------------------------------------------------------------------------
@@ -269,7 +283,7 @@ class _Lemke:
     # -- outcomes -------------------------------------------------------------------------
     def point(self) -> tuple[np.ndarray, np.ndarray, float]:
         """Current (z, w, z0) in the original units."""
-        n, beta, basic = self.n, self.T[:, self.n + 1], np.array(self.basic)
+        n, beta, basic = self.n, self.T[:, self.n + 1], self.basic_np
         z, w = np.zeros(n), np.zeros(n)
         zr = np.flatnonzero((basic >= n) & (basic < 2 * n))
         wr = np.flatnonzero(basic < n)
@@ -280,7 +294,7 @@ class _Lemke:
         return z, w, z0
 
     def basis(self) -> np.ndarray:
-        b = np.array(self.basic)
+        b = self.basic_np
         return np.sort(b[(b >= self.n) & (b < 2 * self.n)] - self.n)
 
     def solution(self, pivots: int, message: str = "") -> Solution:
@@ -298,7 +312,7 @@ class _Lemke:
 
     def ray(self, pivots: int, s: int, entering: int) -> Solution:
         """Secondary ray: x_B = beta + a t, x_entering = t, t -> infinity (Alg. 4.4.5, step 3)."""
-        n, basic, a = self.n, np.array(self.basic), self.T[:, s]
+        n, basic, a = self.n, self.basic_np, self.T[:, s]
         z, w, z0 = self.point()
         if z0 <= self.tol * self.nu / self.delta:
             # z0 is basic at 0 (a degenerate step): the current point is complementary.

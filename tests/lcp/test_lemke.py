@@ -188,20 +188,36 @@ def test_matches_exact_reference_with_covering_vector(problem, d):
     assert_matches_reference(M, q, d=np.array(d[: q.size], float))
 
 
-@settings(max_examples=60, deadline=None)
-@given(st.integers(1, 3), st.integers(0, 2**32 - 1))
-def test_friction_lcp_matches_exact_reference(c, seed):
-    """Friction LCPs with small rational data: the zero block of q ties the ratio test."""
+@settings(max_examples=80, deadline=None)
+@given(st.integers(1, 4), st.integers(0, 2**32 - 1), st.booleans())
+def test_friction_lcp_matches_exact_reference(c, seed, symmetric):
+    """Friction LCPs with small rational data: the zero block of q ties the ratio test, and
+    with `symmetric` (equal q_n, q_t = 0, as in a regular array under gravity) so does q_n."""
     rng = np.random.default_rng(seed)
     J = rng.integers(-2, 3, (2 * c, 2 * c))
     W = J @ J.T + np.eye(2 * c)
     mu = rng.integers(1, 4, c) / 4
     qn, qt = rng.integers(-3, 2, c), rng.integers(-2, 3, c)
+    if symmetric:
+        qn, qt = -np.ones(c), np.zeros(c)
     M, q = friction_lcp(W, mu, qn, qt)
     assert_matches_reference(M, q)
     sol = lcp.solve(lcp.LCP(M, q), method="lemke")
     if sol.status == "solved":
         assert sol.residual <= 1e-9
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_highly_degenerate_friction_lcp_is_solved(seed):
+    """n = 90: equal q_n and q_t = 0 tie dozens of rows at once (the lexicographic rule runs
+    on most pivots); W = H H^T is singular (fewer degrees of freedom than contact forces)."""
+    c = 30
+    rng = np.random.default_rng(seed)
+    H = rng.standard_normal((2 * c, 45))
+    M, q = friction_lcp(H @ H.T, rng.uniform(0.1, 0.6, c), -np.ones(c), np.zeros(c))
+    sol = lcp.solve(lcp.LCP(M, q), method="lemke")
+    assert sol.status == "solved", sol.message
+    assert sol.residual <= 1e-9
 
 
 def test_reference_agrees_on_hand_checked_degenerate_example():
