@@ -4,7 +4,8 @@ on LCPs passed as .npy files.
 
 Protocol (one JSON object per line): the helper first prints {"ready": true, "numpy": ...} or
 {"ready": false, "error": ...}; then for every request {"M": path, "q": path, "max_iter": k} it
-solves once and prints {"time": seconds of the solve call only, "iterations": Siconos's pivot
+solves once and prints {"time": wall seconds of the solve call only, "cpu": its CPU seconds
+(process time), "iterations": Siconos's pivot
 count, "info": return code, "residual": max|min(z, M z + q)|}. End of input ends it.
 
 Siconos counts the pivots of its main loop, i.e. every pivot except the first (z0 entering).
@@ -36,12 +37,13 @@ def main() -> int:
         options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
         options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(req.get("max_iter", 10000))
         z, w = np.zeros(n), np.zeros(n)
-        t0 = time.perf_counter()
+        c0, t0 = time.process_time(), time.perf_counter()
         info = sn.lcp_lexicolemke(problem, z, w, options)
-        elapsed = time.perf_counter() - t0
+        elapsed, cpu = time.perf_counter() - t0, time.process_time() - c0
         residual = float(np.max(np.abs(np.minimum(z, M @ z + q))))
         out = {
             "time": elapsed,
+            "cpu": cpu,
             "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),
             "info": int(info) if info is not None else None,
             "residual": residual,

@@ -92,10 +92,11 @@ def _debian_version(package: str) -> str:
     return out.stdout.strip() or "?"
 
 
-def _time_solve(problem: lcp.LCP, method: str) -> tuple[float, lcp.Solution]:
-    t0 = time.perf_counter()
+def _time_solve(problem: lcp.LCP, method: str) -> tuple[float, float, lcp.Solution]:
+    """Wall and CPU (process) seconds of one lcp.solve call."""
+    c0, t0 = time.process_time(), time.perf_counter()
     sol = lcp.solve(problem, method=method)
-    return time.perf_counter() - t0, sol
+    return time.perf_counter() - t0, time.process_time() - c0, sol
 
 
 def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[str] | None,
@@ -131,7 +132,7 @@ def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[
                     print(f"{n:>5}  {name:<12} {skip}")
                     continue
                 try:
-                    t, sol = _time_solve(problem, name)  # trial run (warms caches, imports)
+                    t, _, sol = _time_solve(problem, name)  # trial run (warms caches, imports)
                 except lcp.NotApplicable as exc:
                     print(f"{n:>5}  {name:<12} skipped: not applicable ({exc})")
                     continue
@@ -141,23 +142,26 @@ def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[
                 except Exception as exc:  # noqa: BLE001 - a benchmark reports, never dies
                     print(f"{n:>5}  {name:<12} skipped: raised {type(exc).__name__}: {exc}")
                     continue
-                times = [t]
+                times, cpus = [t], []
                 sic: list[dict] = []
                 if t > budget:
                     too_slow[name] = n
                 else:
                     times = []
                     for _ in range(repeats):
-                        t, sol = _time_solve(problem, name)
+                        t, c, sol = _time_solve(problem, name)
                         times.append(t)
+                        cpus.append(c)
                         if name == "lemke" and siconos is not None and siconos.available:
                             sic.append(siconos.solve(M_path, q_path, 1000 + 100 * n))
                 note = "  (1 run: over budget)" if len(times) == 1 and repeats > 1 else ""
                 print(f"{n:>5}  {name:<12} {sol.status:<13} {sol.iterations:>7} "
                       f"{1e3 * np.median(times):>12.3f} {sol.residual:>9.1e}{note}")
                 if sic:
-                    pairs.append({"n": n, "ours": times, "pivots": sol.iterations,
+                    pairs.append({"n": n, "ours": times, "ours_cpu": cpus,
+                                  "pivots": sol.iterations,
                                   "siconos": [s["time"] for s in sic],
+                                  "siconos_cpu": [s["cpu"] for s in sic],
                                   "sic_pivots": sic[-1]["iterations"],
                                   "sic_info": sic[-1]["info"],
                                   "sic_residual": sic[-1]["residual"]})
@@ -179,17 +183,19 @@ def _report_siconos(siconos: Siconos | None, pairs: list[dict], use_siconos: boo
           f"{SYSTEM_PYTHON} subprocess, solve call only), runs interleaved, medians")
     print("Siconos counts the pivots after the first one (z0 entering); rigidlcp counts all, "
           "so equal paths show rigidlcp = Siconos + 1.")
-    print("ratio = median/median; best = min/min over the runs (less sensitive to machine load).")
+    print("Wall time: medians and ratio = rigidlcp/Siconos; best = min/min over the runs. CPU: the")
+    print("same with process CPU time (less sensitive to other jobs on the machine).")
     header = (f"{'n':>5} {'rigidlcp [ms]':>14} {'Siconos [ms]':>13} {'ratio':>6} {'best':>6} "
-              f"{'pivots':>7} {'Siconos+1':>9} {'info':>5} {'Siconos res':>11}")
+              f"{'CPU ratio':>9} {'pivots':>7} {'Siconos+1':>9} {'info':>5} {'Siconos res':>11}")
     print(header)
     print("-" * len(header))
     for p in pairs:
         ours, theirs = float(np.median(p["ours"])), float(np.median(p["siconos"]))
         best = min(p["ours"]) / min(p["siconos"])
+        cpu = float(np.median(p["ours_cpu"])) / max(float(np.median(p["siconos_cpu"])), 1e-9)
         print(f"{p['n']:>5} {1e3 * ours:>14.3f} {1e3 * theirs:>13.3f} {ours / theirs:>6.2f} "
-              f"{best:>6.2f} {p['pivots']:>7} {p['sic_pivots'] + 1:>9} {p['sic_info']:>5} "
-              f"{p['sic_residual']:>11.1e}")
+              f"{best:>6.2f} {cpu:>9.2f} {p['pivots']:>7} {p['sic_pivots'] + 1:>9} "
+              f"{p['sic_info']:>5} {p['sic_residual']:>11.1e}")
     print()
 
 
