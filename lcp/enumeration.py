@@ -28,8 +28,9 @@ when some singular basis has a continuum: ``enumerate_solutions`` therefore answ
 uniqueness question completely (to the tolerance), not only "how many vertices".
 
 Tolerances are relative to the data: z_a >= -tol * z_scale with z_scale = max(|z|, |q|/|M|),
-and w_i >= -tol * (|q_i| + sum_j |M_ij| |z_j|) (the size of the terms that make w_i); the same
-bound limits |w_a|, which screens near-singular bases whose solve lost accuracy.
+and w_i >= -tol * (|q_i| + sum_j |M_ij| |z_j|) (the size of the terms that make w_i, floored
+at 1e-4 of the largest such size); the same bound limits |w_a|, which screens near-singular
+bases whose solve lost accuracy.
 
 Cost: 2^n small solves, done in batches with numpy's stacked ``inv`` (one refinement step), so
 n = 12 takes a few tens of milliseconds and n = 20 (10^6 bases) tens of seconds.
@@ -52,6 +53,8 @@ from .solution import Solution, complementarity_residual
 MAX_N = 20
 #: Bases whose estimated 1-norm condition number exceeds 1/RCOND are treated as singular.
 RCOND = 1e-10
+#: Row scales of w are at least FLOOR times the largest one (see _Scales.w_scale).
+FLOOR = 1e-4
 #: A singular basis's solution set wider than WIDTH_FACTOR * tol * z_scale is a continuum.
 WIDTH_FACTOR = 1e3
 #: HiGHS tolerances for the LPs of singular bases (its defaults are 1e-7).
@@ -84,8 +87,14 @@ class _Scales:
         return np.maximum(np.max(np.abs(z), axis=-1, initial=0.0), self.q / self.m) + 1e-300
 
     def w_scale(self, z: np.ndarray) -> np.ndarray:
-        """Per candidate and row: |q_i| + sum_j |M_ij| |z_j|."""
-        return self.absq + np.abs(z) @ self.absM.T + 1e-300
+        """Per candidate and row: |q_i| + sum_j |M_ij| |z_j|, at least FLOOR times its max.
+
+        The row scale makes the test invariant under scaling a row of (M, q); the floor keeps
+        a row whose entries are all tiny (1e-70 next to O(1) rows) from demanding accuracy
+        beyond the rounding level of the whole problem.
+        """
+        ws = self.absq + np.abs(z) @ self.absM.T + 1e-300
+        return np.maximum(ws, FLOOR * np.max(ws, axis=-1, keepdims=True))
 
     def accept(self, z: np.ndarray, w: np.ndarray, alpha_mask: np.ndarray) -> np.ndarray:
         """Rows (candidates) that are complementary solutions to the tolerance."""

@@ -52,7 +52,7 @@ RCOND = 1e-13
 #: |Mbar_rr| below PIVOT_TOL times the size of its row counts as a zero pivot.
 PIVOT_TOL = 1e-10
 #: Sign tests use at least FLOOR times the largest row scale of w (rounding level).
-FLOOR = 1e-6
+FLOOR = 1e-4
 
 
 class _Basis:
@@ -111,6 +111,33 @@ class _Basis:
         if not self.alpha[r]:
             out[b] += M[r, b]
         return out
+
+
+def _usable(row: np.ndarray, i: int) -> bool:
+    """Whether row[i] is a nonzero pivot relative to its row."""
+    return abs(row[i]) > PIVOT_TOL * (float(np.max(np.abs(row))) or 1.0)
+
+
+def _pivot_candidates(basis: _Basis, H: np.ndarray, row: np.ndarray):
+    """Single pivots to try, best first, as (indices to flip, kind).
+
+    1. Murty / criss-cross on r = min H: the diagonal pivot if Mbar_rr != 0, else exchange
+       pivots {r, s} for s with Mbar_rs > 0 and Mbar_sr != 0, least s first;
+    2. fall-backs, tried only when none of those gives a nonsingular basis (M not sufficient,
+       or singular to rounding): diagonal pivots on the other failing indices, least first.
+       They void the finiteness guarantee; max_iter and the cycle test still hold.
+    """
+    r = int(H[0])
+    if _usable(row, r):
+        yield [r], "single_pivots"
+    else:
+        scale = float(np.max(np.abs(row))) or 1.0
+        for s in np.flatnonzero(row > PIVOT_TOL * scale):
+            if _usable(basis.row(int(s)), r):
+                yield [r, int(s)], "exchange_pivots"
+    for c in H[1:]:
+        if _usable(basis.row(int(c)), int(c)):
+            yield [int(c)], "fallback_pivots"
 
 
 def _initial_active(active, q: np.ndarray) -> np.ndarray:
@@ -230,49 +257,26 @@ def solve_pivoting(
         r = int(H[0])  # Murty's least-index rule
         row = basis.row(r)
         scale = float(np.max(np.abs(row))) or 1.0
-        flip = [r]
-        if abs(row[r]) > PIVOT_TOL * scale:
-            info["single_pivots"] += 1
+        if abs(row[r]) <= PIVOT_TOL * scale and not np.any(row > PIVOT_TOL * scale):
+            info["certificate"] = {
+                "row": r, "active": basis.a.tolist(),
+                "qbar_r": float(z[r] if basis.alpha[r] else w[r]),
+                "max_coefficient": float(row.max()),
+            }
+            return result(
+                "infeasible", z,
+                f"row {r} of the pivoted system reads y_{r} = qbar_{r} + sum Mbar_rj x_j "
+                f"with qbar_{r} < 0 and no positive coefficient: no solution exists",
+            )
+        for flip, kind in _pivot_candidates(basis, H, row):
+            new = basis.alpha.copy()
+            new[flip] = ~new[flip]
+            trial = _Basis(M, new)
+            if not trial.singular:
+                info[kind] = info.get(kind, 0) + 1
+                break
         else:
-            cand = np.flatnonzero(row > PIVOT_TOL * scale)
-            if cand.size == 0:
-                info["certificate"] = {
-                    "row": r, "active": basis.a.tolist(),
-                    "qbar_r": float(z[r] if basis.alpha[r] else w[r]),
-                    "max_coefficient": float(row.max()),
-                }
-                return result(
-                    "infeasible", z,
-                    f"row {r} of the pivoted system reads y_{r} = qbar_{r} + sum Mbar_rj x_j "
-                    f"with qbar_{r} < 0 and no positive coefficient: no solution exists",
-                )
-            s = -1
-            for c in cand:
-                row_c = basis.row(int(c))
-                if abs(row_c[r]) > PIVOT_TOL * (float(np.max(np.abs(row_c))) or 1.0):
-                    s = int(c)
-                    break
-            if s >= 0:
-                flip.append(s)
-                info["exchange_pivots"] += 1
-            else:
-                # No usable exchange pivot (M is not sufficient, or the 2 x 2 block is singular
-                # in floating point): pivot on the least other failing index with a nonzero
-                # diagonal. The finiteness guarantee is lost; max_iter and the cycle test stay.
-                for c in H[1:]:
-                    row_c = basis.row(int(c))
-                    if abs(row_c[c]) > PIVOT_TOL * (float(np.max(np.abs(row_c))) or 1.0):
-                        flip = [int(c)]
-                        break
-                else:
-                    return result("failed", z, f"zero pivot on index {r} and no usable "
-                                  "exchange or diagonal pivot: M is not sufficient")
-                info["fallback_pivots"] = info.get("fallback_pivots", 0) + 1
-        new = basis.alpha.copy()
-        new[flip] = ~new[flip]
-        trial = _Basis(M, new)
-        if trial.singular:
-            return result("failed", z, f"pivot on {flip} gave a singular basis "
-                          "(numerical breakdown)")
+            return result("failed", z, f"no pivot on the failing indices {H.tolist()} gives a "
+                          "nonsingular basis: M is not sufficient, or it is numerically singular")
         basis = trial
         info["flips"] += len(flip)

@@ -160,8 +160,8 @@ class MLCP:
 
     def recover_u(self, v: np.ndarray) -> np.ndarray:
         """The free unknowns of a complementarity solution v: u = -A^{-1}(C v + a)."""
-        cols, _ = self._solve_A(np.column_stack([self.C @ v + self.a]), np.inf)
-        return -cols[:, 0]
+        _, Ainv_rhs = self._solve_A(np.column_stack([self.C @ v + self.a]), 0.0)
+        return -Ainv_rhs
 
     def residuals(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, float]:
         """(w, equality residual max|A u + C v + a|)."""

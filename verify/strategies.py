@@ -14,7 +14,8 @@ that have the advertised property *by construction*, with the reason in its docs
 Sizes may be an int or a strategy of ints, and matrix strategies can be passed to ``lcps``:
 ``lcps(p_matrices(st.integers(1, 6)), planted=True)``. Entries are kept O(1) and the
 constructions keep conditioning moderate, so that a method disagreeing with another by more
-than ~1e-8 is a bug, not rounding.
+than ~1e-8 is a bug, not rounding. Entries lie on a grid of step 1/1000 (exact zeros and ties
+included; no 1e-140 next to 1).
 """
 
 from __future__ import annotations
@@ -50,8 +51,18 @@ def _size(draw, n: SizeLike, least: int = 1) -> int:
     return int(value)
 
 
+#: Entries are drawn on a grid of GRID + 1 points of [lo, hi] (see _unit).
+GRID = 1000
+
+
 def _unit(lo: float = -1.0, hi: float = 1.0) -> st.SearchStrategy[float]:
-    return st.floats(lo, hi, allow_nan=False, allow_infinity=False, allow_subnormal=False)
+    """Numbers on a grid of [lo, hi] (step (hi - lo)/GRID; 0 is on it when lo = -hi).
+
+    A grid rather than arbitrary floats: Hypothesis likes values such as 1e-140, whose
+    products underflow next to O(1) entries and turn a PSD construction into rounding noise.
+    Exact zeros and exact ties (degeneracy) remain common, and shrinking goes to round numbers.
+    """
+    return st.integers(0, GRID).map(lambda k: lo + (hi - lo) * k / GRID)
 
 
 def _matrix(draw, rows: int, cols: int, lo: float = -1.0, hi: float = 1.0) -> np.ndarray:
