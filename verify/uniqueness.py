@@ -21,9 +21,13 @@ Every margin below is relative to these scales.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
+import os
+import sys
 import time
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -40,6 +44,28 @@ BOUND_FACTOR = 1e3
 #: other than scipy's own five are passed to HiGHS verbatim (scipy warns; the warning is muted).
 _HIGHS_MILP = {"mip_feasibility_tolerance": 1e-9, "primal_feasibility_tolerance": 1e-9}
 _HIGHS_LP = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
+
+
+@contextlib.contextmanager
+def quiet_highs() -> Iterator[None]:
+    """Silence HiGHS's C++ debug prints (e.g. "HighsMipSolverData::transformNewInteger...") that
+    go to file descriptor 1 whatever log_to_console says, and scipy's warning about passing
+    HiGHS options verbatim."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        try:
+            sys.stdout.flush()
+            saved = os.dup(1)
+        except (OSError, ValueError):  # no real fd 1 (some embedded consoles): just run
+            yield
+            return
+        try:
+            with open(os.devnull, "w") as devnull:
+                os.dup2(devnull.fileno(), 1)
+                yield
+        finally:
+            os.dup2(saved, 1)
+            os.close(saved)
 
 
 # --------------------------------------------------------------------------------------------
@@ -307,8 +333,7 @@ def milp_search(
             res.message = f"time limit {time_limit:g} s reached"
             break
         A = sp.csr_matrix(np.array(rows))
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
+        with quiet_highs():
             out = milp(c, integrality=integrality, bounds=Bounds(0.0, 1.0),
                        constraints=LinearConstraint(A, np.array(lo), np.array(hi)),
                        options={"time_limit": float(left), **_HIGHS_MILP})
