@@ -14,9 +14,10 @@ states are solved from M_aa z_a = -q_a, and the inequalities that fail are
 Flipping all of H at once is *block principal pivoting* (Kostreva 1978; Judice & Pires,
 Comput. Oper. Res. 21, 587, 1994). It may cycle, so the scheme of Judice & Pires is used: keep
 the least |H| seen so far; a step that does not lower it is allowed ``block_tries`` times, after
-which single principal pivots are made on the least index of H (Murty's least-index rule,
-Murty 1974, finite on P-matrices) until |H| drops below its record, when block steps resume.
-The record strictly decreases between block phases, so the method is finite on P-matrices.
+which single principal pivots are made on the least index of H (Murty's least-index rule:
+K. G. Murty, Opsearch 11, 123, 1974; finite on P-matrices) until |H| drops below its record,
+when block steps resume. The record strictly decreases between block phases, so the method
+is finite on P-matrices.
 
 Single pivots use the principal pivot transform ("tableau") of M for the current basis,
 y = Mbar x + qbar, with y the basic and x the nonbasic member of each pair. When the diagonal
@@ -31,7 +32,12 @@ method solves those too.
 
 Every basis visited has a nonsingular M_aa (checked with LAPACK's condition estimate): a block
 step onto a singular basis is refused and replaced by a single pivot, and a singular warm start
-falls back to the empty basis.
+falls back to the empty basis. When no criss-cross pivot gives a nonsingular basis (M is not
+sufficient, or is singular to rounding) a diagonal pivot on another failing index is tried
+(counted in ``info["fallback_pivots"]``); this voids the finiteness argument, so the iteration
+limit and an exact cycle test (a repeated state proves an endless loop) report the failure.
+Sign tests are relative: z_i < -tol max|z| and w_i < -tol (|q_i| + sum_j |M_ij z_j|), the
+latter floored at 1e-4 of its largest value over i (rounding level of the whole problem).
 """
 
 from __future__ import annotations
