@@ -474,3 +474,14 @@ def paper_solution(poly: Polyhedron, method: str = "milp", time_limit: float = 1
     if capped.any():
         msg += f"; R unbounded on {int(capped.sum())} contacts: capped at {cap:.3g}"
     return _particular(poly, x, "paper (MILP: most R = 0 and S = +-mu R)", msg)
+
+
+def event_z(ep: EventProblem, x: np.ndarray) -> np.ndarray:
+    """The event LCP's z = [R, tau, a_minus] of a force vector x = [R; S] (models.event):
+    tau = mu R + S and a_minus = max(-a_t, 0) on the non-sliding candidates."""
+    c = ep.system.c
+    x = np.asarray(x, dtype=float)
+    cand = ep.candidates
+    a_t = (ep.dyn.W @ x + ep.dyn.q)[c:]
+    tau = ep.system.mu[cand] * x[cand] + x[c + cand]
+    return np.concatenate([x[:c], tau, np.maximum(-a_t[cand], 0.0)])
