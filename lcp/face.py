@@ -11,6 +11,12 @@ points of the same face; `face_minimum_norm` returns a point of F(z) that depend
 face, not on the point a method found: lexicographically, first the minimum of a linear
 functional c'y when `c` is given (a linear program), then, among those minimizers, the unique
 minimizer of |G y|^2 + eps |y|^2 (G: a linear map, e.g. from LCP unknowns to contact forces).
+
+`face_minimum_norm` is local: it walks from the given solution over neighbouring faces, so two
+solutions in different parts of the solution set can lead to different points.
+`global_minimum_norm` is not: it minimizes c'y over the whole solution set by a mixed-integer
+linear program (big-M bounds supplied by the caller), then takes the least |G y| on the
+minimizer's face. It is slower and is what makes a result independent of the method.
 """
 
 from __future__ import annotations
@@ -59,7 +65,8 @@ def face_minimum_norm(
     bound = None
     if c is not None:  # stage 1: descend c'y over faces, then keep c'y at its minimum
         c = np.asarray(c, dtype=float)
-        slack = 1e-9 * max(abs(c @ z), scale)
+        slack = 1e-11 * max(abs(c @ z), scale)
+        best_value = c @ z
         for _ in range(max_walk):
             best = None
             for f in (face, _Face(M, q, z, tol, degenerate_in_A=False)):
@@ -73,23 +80,22 @@ def face_minimum_norm(
                     best = z1
             if best is None or c @ best >= c @ z - slack:
                 break
-            z = best
+            z, best_value = best, c @ best
             face = _Face(M, q, z, tol)
             if face.nullity == 0:
                 break
-        bound = c @ z + slack
+        bound = best_value
     if face.nullity == 0:
         return FaceResult(z, 0, float(np.abs(z - z0).max()), "selected")
     GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
     GN = GA @ face.N
     # min 1/2 |G_A (z_A + N x)|^2 + eps/2 |N x|^2  s.t.  the face's inequalities (and c'y bound)
     P = GN.T @ GN + eps * np.eye(face.nullity)
-    Aineq, bineq = face.Aineq, face.bineq
-    if bound is not None:
-        cN = c[face.A] @ face.N
-        Aineq = np.vstack([Aineq, cN[None, :]])
-        bineq = np.append(bineq, max(bound - c @ z, 0.0))
-    x, status = _qp(P, GN.T @ (GA @ z[face.A]), Aineq, bineq)
+    Aeq = beq = None
+    if bound is not None:  # stay on the linear program's optimal set: c'y = its minimum
+        Aeq = (c[face.A] @ face.N)[None, :]
+        beq = np.array([bound - c @ z])
+    x, status = _qp(P, GN.T @ (GA @ z[face.A]), face.Aineq, face.bineq, Aeq, beq)
     if x is None:
         return FaceResult(z0, face.nullity, 0.0, f"failed: {status}")
     y = face.point(x)
@@ -105,13 +111,13 @@ class _Face:
     """
 
     def __init__(self, M: np.ndarray, q: np.ndarray, z: np.ndarray, tol: float,
-                 degenerate_in_A: bool = True):
+                 degenerate_in_A: bool = True, A: np.ndarray | None = None):
         w = M @ z + q
         self.z = z
         in_A = w <= tol
         if not degenerate_in_A:
             in_A &= z > tol
-        self.A = np.flatnonzero(in_A)
+        self.A = np.flatnonzero(in_A) if A is None else np.asarray(A)
         Ac = np.setdiff1d(np.arange(q.size), self.A)
         if self.A.size == 0:
             self.nullity = 0
@@ -132,6 +138,86 @@ class _Face:
         return y
 
 
+def global_minimum_norm(
+    problem: LCP,
+    G: np.ndarray,
+    c: np.ndarray,
+    z_upper: np.ndarray,
+    w_upper: np.ndarray,
+    *,
+    w_zero: np.ndarray | None = None,
+    time_limit: float = 30.0,
+    eps: float = 1e-10,
+) -> FaceResult:
+    """The solution minimizing c'y over every solution of the LCP, then |G y| on its face.
+
+    Mixed-integer program (scipy.optimize.milp, HiGHS): 0 <= y_i <= z_upper_i b_i,
+    0 <= w_i <= w_upper_i (1 - b_i), b_i binary; indices in `w_zero` have w_i = 0 imposed and
+    no binary. The bounds must hold for the minimizer (the caller derives them, e.g. from a
+    known solution with a larger c'y); a minimizer at a bound is reported as "failed". The
+    pattern found is then solved exactly: a linear program on its face for c'y, and the
+    quadratic program for |G y| as in `face_minimum_norm`.
+    """
+    from scipy.optimize import Bounds, LinearConstraint, milp
+
+    M, q = problem.M, problem.q
+    n = q.size
+    zero = np.zeros(n, bool)
+    if w_zero is not None:
+        zero[np.asarray(w_zero, int)] = True
+    free = np.flatnonzero(~zero)
+    m = free.size
+    # variables [y (n), b (m)]
+    rows, lo, hi = [], [], []
+    rows.append(np.hstack([M, np.zeros((n, m))]))  # w = M y + q in [0, inf) or {0}
+    lo.append(-q)
+    hi.append(np.where(zero, -q, np.inf))
+    Bz = np.zeros((m, n + m))  # y_i - U b_i <= 0
+    Bz[np.arange(m), free] = 1.0
+    Bz[np.arange(m), n + np.arange(m)] = -z_upper[free]
+    rows.append(Bz)
+    lo.append(np.full(m, -np.inf))
+    hi.append(np.zeros(m))
+    Bw = np.hstack([M[free], np.zeros((m, m))])  # w_i + V b_i <= V - q_i
+    Bw[np.arange(m), n + np.arange(m)] = w_upper[free]
+    rows.append(Bw)
+    lo.append(np.full(m, -np.inf))
+    hi.append(w_upper[free] - q[free])
+    cons = LinearConstraint(np.vstack(rows), np.concatenate(lo), np.concatenate(hi))
+    cost = np.concatenate([c, np.zeros(m)])
+    integrality = np.concatenate([np.zeros(n), np.ones(m)])
+    bounds = Bounds(np.zeros(n + m), np.concatenate([z_upper, np.ones(m)]))
+    res = milp(cost, constraints=cons, integrality=integrality, bounds=bounds,
+               options={"time_limit": time_limit, "disp": False})
+    if res.status != 0 or res.x is None:
+        return FaceResult(np.zeros(n), 0, 0.0, f"failed: milp {res.message}")
+    y, b = res.x[:n], res.x[n:] > 0.5
+    if np.any(y >= 0.999 * z_upper) or np.any((M @ y + q)[free][~b] >= 0.999 * w_upper[free][~b]):
+        return FaceResult(y, 0, 0.0, "failed: a big-M bound is active (bounds too small)")
+    A = np.sort(np.concatenate([np.flatnonzero(zero), free[b]]))
+    Ac = np.setdiff1d(np.arange(n), A)
+    # Exact vertex of the minimizer's face: min c'y, y_A >= 0, (My+q)_A = 0, (My+q)_Ac >= 0.
+    from scipy.optimize import linprog
+
+    lp = linprog(c[A], A_eq=M[np.ix_(A, A)], b_eq=-q[A], A_ub=-M[np.ix_(Ac, A)], b_ub=q[Ac],
+                 bounds=(0, None), method="highs")
+    if lp.status != 0:
+        return FaceResult(y, 0, 0.0, f"failed: face LP {lp.message}")
+    z = np.zeros(n)
+    z[A] = lp.x
+    face = _Face(M, q, z, 0.0, A=A)
+    if face.nullity == 0:
+        return FaceResult(z, 0, 0.0, "selected")
+    GA = G[:, face.A]
+    GN = GA @ face.N
+    P = GN.T @ GN + eps * np.eye(face.nullity)
+    Aeq, beq = (c[face.A] @ face.N)[None, :], np.zeros(1)
+    x, status = _qp(P, GN.T @ (GA @ z[face.A]), face.Aineq, face.bineq, Aeq, beq)
+    if x is None:
+        return FaceResult(z, face.nullity, 0.0, f"selected (LP vertex; QP {status})")
+    return FaceResult(face.point(x), face.nullity, 0.0, "selected")
+
+
 def _lp(c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):
     """min c'x s.t. Aineq x <= bineq (x free), by HiGHS."""
     from scipy.optimize import linprog
@@ -142,8 +228,9 @@ def _lp(c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):
     return res.x, "optimal"
 
 
-def _qp(P: np.ndarray, c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):
-    """min 1/2 x'Px + c'x s.t. Aineq x <= bineq, by Clarabel (interior point)."""
+def _qp(P: np.ndarray, c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray,
+        Aeq: np.ndarray | None = None, beq: np.ndarray | None = None):
+    """min 1/2 x'Px + c'x s.t. Aeq x = beq, Aineq x <= bineq, by Clarabel (interior point)."""
     import clarabel
 
     n = c.size
@@ -152,11 +239,37 @@ def _qp(P: np.ndarray, c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):
     settings.tol_gap_abs = settings.tol_gap_rel = 1e-12
     settings.tol_feas = 1e-12
     Pu = sp.triu(sp.csc_matrix((P + P.T) / 2), format="csc")
+    if Aeq is None:
+        Aeq, beq = np.zeros((0, n)), np.zeros(0)
+    cones = [clarabel.NonnegativeConeT(bineq.size)]
+    if beq.size:
+        cones.insert(0, clarabel.ZeroConeT(beq.size))
     solver = clarabel.DefaultSolver(
-        Pu, c, sp.csc_matrix(Aineq), bineq, [clarabel.NonnegativeConeT(bineq.size)], settings
+        Pu, c, sp.csc_matrix(np.vstack([Aeq, Aineq])), np.concatenate([beq, bineq]), cones,
+        settings,
     )
     sol = solver.solve()
     status = str(sol.status)
     if "Solved" not in status:
         return None, status
-    return np.array(sol.x).reshape(n), status
+    return _polish(P, c, Aineq, bineq, Aeq, beq, np.array(sol.x).reshape(n)), status
+
+
+def _polish(P, c, Aineq, bineq, Aeq, beq, x):
+    """Re-solve the KKT system on the interior point's active constraints, exactly (to rounding),
+    and keep the result if it is feasible and not worse: an interior-point answer is accurate
+    to ~1e-9 only, which would show in event times."""
+    scale = max(np.abs(bineq).max(initial=0.0), 1.0)
+    slack = bineq - Aineq @ x
+    act = np.flatnonzero(slack <= 1e-7 * scale)
+    Aact = np.vstack([Aeq, Aineq[act]])
+    n, k = x.size, Aact.shape[0]
+    K = np.block([[P, Aact.T], [Aact, np.zeros((k, k))]])
+    rhs = np.concatenate([-c, beq, bineq[act]])
+    sol = np.linalg.lstsq(K, rhs, rcond=None)[0]
+    y = sol[:n]
+    if np.all(Aineq @ y <= bineq + 1e-12 * scale) and np.allclose(Aeq @ y, beq, atol=1e-12 * scale):
+        f = 0.5 * y @ P @ y + c @ y
+        if f <= 0.5 * x @ P @ x + c @ x + 1e-12 * max(abs(f), 1.0):
+            return y
+    return x

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import lcp
-from lcp.face import face_minimum_norm
+from lcp.face import face_minimum_norm, global_minimum_norm
 
 from .dynamics import Dynamics
 from .event import (
@@ -36,6 +36,9 @@ from .event import (
     initial_state,
 )
 from .system import System
+
+#: How an event's particular solution is chosen when it is not unique (see `simulate`).
+SELECT = ("face-min-norm", "global", "none")
 
 STOP_REASONS = ("steady", "time_limit", "event_limit", "detachment", "no_solution", "zeno",
                 "solver_failed")
@@ -52,6 +55,7 @@ class EventRecord:
     R: np.ndarray
     S: np.ndarray
     s: np.ndarray  # tangential states after the event: +1/-1 sliding, 0 non-sliding
+    s_in: np.ndarray  # the states the event started from (0: candidates), see Run.state_at
     vt: np.ndarray
     at: np.ndarray
     mu_g: float
@@ -87,6 +91,11 @@ class Run:
     def array(self, name: str) -> np.ndarray:
         """Stack a record field over events, e.g. run.array('mu_g') or run.array('omega')."""
         return np.array([getattr(r, name) for r in self.records])
+
+    def state_at(self, k: int) -> State:
+        """The state from which event k was solved (to re-solve it with another method)."""
+        rec = self.records[k]
+        return State(rec.t, rec.omega.copy(), rec.V, rec.s_in.copy())
 
     @property
     def last(self) -> EventRecord:
@@ -136,7 +145,10 @@ def simulate(
     face (`lcp.face.face_minimum_norm`): the least total normal force sum R, and among those the
     least |lambda|. When the event's solution is not unique (hyperstatic rows, loops of
     non-sliding contacts, Sec. III) this makes the result independent of which point a method
-    happened to return (see docs/theory.md, "Non-unique events"). "none" keeps the solver's.
+    happened to return (see docs/theory.md, "Non-unique events"). The face walk is local:
+    "global" minimizes sum R over every solution of the event (a mixed-integer program, slower),
+    which makes the run independent of the method and of the order of the unknowns.
+    "none" keeps the solver's solution.
 
     fallback: when `method` fails at an event (no solution, cycling, iteration limit), that
     event is solved again by this method (None: stop); each use is counted in the record.
@@ -159,8 +171,8 @@ def simulate(
 
 def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_tol, warm_start,
               zeno_events, zeno_time, progress, dump_dir, select, fallback) -> Run:
-    if select not in ("face-min-norm", "none"):
-        raise ValueError(f"select must be 'face-min-norm' or 'none', got {select!r}")
+    if select not in SELECT:
+        raise ValueError(f"select must be one of {SELECT}, got {select!r}")
     for name in (method, fallback):
         if name is not None:
             lcp.get_method(name)  # raises InvalidProblem naming the available methods
@@ -211,9 +223,11 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
             )
             break
         z = sol.z
-        if select == "face-min-norm":
-            face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force)
-            if face.status == "selected":
+        if select != "none":
+            face = (global_selection(ep, z, least_force) if select == "global" else None)
+            if face is None or face.status.startswith("failed"):
+                face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force)
+            if face.status.startswith("selected"):
                 z = face.z
                 sol.residual = lcp.complementarity_residual(z, ep.lcp.M @ z + ep.lcp.q)
                 if sol.residual > check_tol * scale:
@@ -285,7 +299,8 @@ def _record(
 
     return EventRecord(
         t=state.t, V=state.V, omega=state.omega.copy(), omega_dot=es.omega_dot.copy(),
-        R=es.R.copy(), S=es.S.copy(), s=es.s.copy(), vt=vt.copy(), at=es.a_t.copy(),
+        R=es.R.copy(), S=es.S.copy(), s=es.s.copy(), s_in=np.asarray(state.s).copy(),
+        vt=vt.copy(), at=es.a_t.copy(),
         mu_g=global_friction(system, es.S) / (system.total_mass * system.g or 1.0),
         dissipation=dissipation_rate(es.S, vt), iterations=int(sol.iterations),
         residual=float(sol.residual), n_lcp=int(sol.z.size), method=sol.method,
@@ -309,6 +324,32 @@ def warm_active_set(ep: EventProblem, prev: EventSolution, state: State) -> np.n
         if was < 0:
             active.append(c + k + pos)
     return np.array(sorted(active), dtype=int)
+
+
+def global_selection(ep: EventProblem, z: np.ndarray, least_force: np.ndarray):
+    """`lcp.face.global_minimum_norm` with big-M bounds derived from the mechanics.
+
+    With B = sum R of the solver's solution, the minimizer has every R <= B and
+    |S| <= mu_max B, so tau <= 2 mu B, and |a_t| <= |q_t| + max_j |W_tj| (1 + mu_max) B.
+    a_n = 0 is imposed on every contact (a solution with a_n > 0 is a detachment, which stops
+    the run before selection matters); returns None when the solver's solution has a_n > 0.
+    """
+    system, dyn = ep.system, ep.dyn
+    c = system.c
+    w = ep.lcp.M @ z + ep.lcp.q
+    if np.any(w[:c] > acceleration_tol(system)):
+        return None
+    B = max(float(z[:c].sum()), 1e-12)
+    mu = system.mu[ep.candidates]
+    mu_max = float(system.mu.max(initial=0.0))
+    Wt = dyn.W[c:][ep.candidates]
+    amax = np.abs(dyn.q[c:][ep.candidates]) + np.abs(Wt).max(axis=1, initial=0.0) * (
+        1 + mu_max) * B
+    amax = 2.0 * amax + 1e-12
+    z_upper = np.concatenate([np.full(c, 2.0 * B), 4.0 * mu * B + 1e-12, amax])
+    w_upper = np.concatenate([np.ones(c), 2.0 * amax, 4.0 * mu * B + 1e-12])
+    return global_minimum_norm(ep.lcp, ep.G, least_force, z_upper, w_upper,
+                               w_zero=np.arange(c))
 
 
 def contacts_of_ray(ep: EventProblem, sol: lcp.Solution) -> list[int]:

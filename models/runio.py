@@ -20,7 +20,7 @@ from .system import make_system
 
 FORMAT = "rigidlcp-run/1"
 _SCALARS = ("t", "V", "mu_g", "dissipation", "iterations", "residual", "n_lcp", "fallback")
-_ARRAYS = ("omega", "omega_dot", "R", "S", "s", "vt", "at")
+_ARRAYS = ("omega", "omega_dot", "R", "S", "s", "s_in", "vt", "at")
 
 
 def _atomic_write(path: Path, write) -> None:
@@ -99,6 +99,7 @@ def load_run(path: str | os.PathLike) -> Run:
             rec[name] = float(rec[name])
         rec["iterations"], rec["n_lcp"] = int(rec["iterations"]), int(rec["n_lcp"])
         rec["fallback"], rec["s"] = bool(rec["fallback"]), rec["s"].astype(int)
+        rec["s_in"] = rec["s_in"].astype(int)
         records.append(EventRecord(**{k: v for k, v in rec.items() if k in names}))
     return Run(system, records, status=meta["status"], message=meta["message"],
                contacts=list(meta.get("contacts", [])), wall_time=float(meta["wall_time"]),
