@@ -62,7 +62,7 @@ class Certificate:
     other_distance: float = 0.0  # |z' - z|_inf / z_s
     others: list[np.ndarray] = field(default_factory=list)
     degenerate: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
-    delta: float = 1e-6
+    delta: float = 1e-4
     bound: float | None = None  # the MILP's box 0 <= z <= bound (verdicts relative to it)
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
@@ -104,7 +104,7 @@ class Certificate:
 
 def certify(
     problem, solution, tol: float = 1e-8, uniqueness: str = "auto", *,
-    delta: float = 1e-6, bound: float | None = None, time_limit: float = 10.0,
+    delta: float = 1e-4, bound: float | None = None, time_limit: float = 10.0,
     objective: str = "none", observables: dict[str, np.ndarray] | None = None,
 ) -> Certificate:
     """Certify `solution` (an `lcp.Solution` or a vector z) of `problem`.
@@ -113,7 +113,8 @@ def certify(
     questions), or a `models.EventProblem` (its LCP, with the observables "forces" and
     "accelerations"). uniqueness: "auto" (P-matrix test; then enumeration for n <= 10, else the
     MILP), "p-matrix", "enumeration", "milp" or "none". delta: the relative margin by which
-    another solution must differ to count (see verify.uniqueness.milp_search); bound: the
+    another solution must differ to count (see verify.uniqueness.milp_search; the MILP raises
+    it to its rounding floor, 1e-4 with the default box; the margin used is reported); bound: the
     MILP's box (default 1e3 z_s); time_limit: seconds per MILP; objective: "none" (the first
     other solution HiGHS meets) or "min-sum" (the other solution of least sum z, e.g. the
     small-force one; slower: optimality must be proved). observables: extra linear maps
@@ -172,7 +173,9 @@ def certify(
     for name, L in (observables or {}).items():
         obs[name] = np.atleast_2d(np.asarray(L, dtype=float))
     cert.observables = {name: None for name in obs}
-    cert.degenerate = np.flatnonzero(sign_pattern(z, w, zs, ws, delta) == 0)
+    # Degenerate pairs: z_i and w_i both zero to 100 tol (relative), i.e. beyond doubt at
+    # the accuracy the solution was accepted with.
+    cert.degenerate = np.flatnonzero(sign_pattern(z, w, zs, ws, 100 * tol) == 0)
     if cert.degenerate.size:
         cert.pattern_unique = False
     if uniqueness == "none" or lcp_form is None:
@@ -249,6 +252,7 @@ class _Context:
         kw = dict(bound=self.bound, time_limit=self.time_limit, objective=self.objective)
         s = milp_search(self.M, self.q, self.z, target, L, delta=self.delta, **kw)
         self.cert.bound = s.bound
+        self.cert.delta = max(self.cert.delta, s.delta)
         if s.status == "found" and s.deviation < 1e-3 and self.delta < 1e-2:
             s2 = milp_search(self.M, self.q, self.z, target, L, delta=1e-2, **kw)
             if s2.status == "found":

@@ -203,7 +203,7 @@ class Search:
 
 def milp_search(
     M: np.ndarray, q: np.ndarray, z_star: np.ndarray, target: str = "pattern",
-    L: np.ndarray | None = None, *, delta: float = 1e-6, bound: float | None = None,
+    L: np.ndarray | None = None, *, delta: float = 1e-4, bound: float | None = None,
     time_limit: float = 10.0, objective: str = "none", retries: int = 5,
 ) -> Search:
     """Search for an LCP solution other than z_star, as a MILP (HiGHS through scipy.optimize.milp).
@@ -228,6 +228,11 @@ def milp_search(
       (binaries e_j+, e_j-; s_L = max(||L||_inf z_s, |L z*|_inf)). L = M asks for another w,
       L = I another z, L = an acceleration map another set of accelerations.
 
+    Margin: delta is relative (to z_s, w_s, s_L) and is raised, if smaller, to 100 times the
+    MILP's leakage 1e-9 U / z_s (HiGHS treats y within 1e-9 of 0 as 0, which lets z_i reach
+    1e-9 U); with the default box this floor is 1e-4, the default delta. The margin used is
+    reported in `Search.delta`.
+
     A MILP point is never trusted: its basis (y) is fixed and the solution on it recomputed by
     an LP with the target's inequality (tolerance 1e-10), then checked (scaled residual <= 1e-8
     and the difference present). objective "min-sum" asks for the other solution of least sum z
@@ -243,6 +248,10 @@ def milp_search(
     n = q.size
     zs, ws = scales(M, q, z_star)
     U = float(bound) if bound is not None else BOUND_FACTOR * zs
+    # HiGHS accepts y within 1e-9 of an integer, so z_i <= 1e-9 U "vanishes": a margin below
+    # ~100 times this leakage would let rounding pass for a difference. Raise delta to it.
+    floor = 100.0 * _HIGHS_MILP["mip_feasibility_tolerance"] * U / zs
+    delta = max(float(delta), floor)
     w_star = M @ z_star + q
     if target not in ("pattern", "values"):
         raise ValueError(f"target must be 'pattern' or 'values', got {target!r}")
