@@ -46,8 +46,12 @@ def face_minimum_norm(
     tol: float | None = None,
     eps: float = 1e-10,
     max_walk: int = 20,
+    keep: np.ndarray | None = None,
 ) -> FaceResult:
     """The point of the face of z minimizing c'y, then |G y| (see the module docstring).
+
+    keep: indices whose degenerate pairs stay on the z side in the walk (the caller knows w_i
+    must vanish there, e.g. a_n = 0 on every contact of an event without detachment).
 
     With `c`, the linear stage walks from face to face: a minimizer of c'y on the face of z is
     again a solution, whose own face (its degenerate indices, z_i = w_i = 0, may now go either
@@ -59,32 +63,31 @@ def face_minimum_norm(
     scale = max(np.abs(q).max(initial=0.0), np.abs(z0).max(initial=0.0), 1e-300)
     tol = 1e-9 * scale if tol is None else tol
     z = z0
-    face = _Face(M, q, z, tol)
-    if face.nullity == 0:
-        return FaceResult(z0, 0, 0.0, "unique")
     bound = None
     if c is not None:  # stage 1: descend c'y over faces, then keep c'y at its minimum
         c = np.asarray(c, dtype=float)
         slack = 1e-11 * max(abs(c @ z), scale)
         best_value = c @ z
+        seen: set[bytes] = set()
+        kept = np.zeros(q.size, bool)
+        if keep is not None:
+            kept[np.asarray(keep, int)] = True
         for _ in range(max_walk):
             best = None
-            for f in (face, _Face(M, q, z, tol, degenerate_in_A=False)):
-                if f.nullity == 0:
+            w = M @ z + q
+            for in_A in (w <= tol, (w <= tol) & ((z > tol) | kept)):  # degenerate pairs: both
+                key = np.packbits(in_A).tobytes()
+                if key in seen:  # a face already minimized over
                     continue
-                x1, status = _lp(c[f.A] @ f.N, f.Aineq, f.bineq)
-                if x1 is None:
-                    return FaceResult(z0, f.nullity, 0.0, f"failed (linear stage): {status}")
-                z1 = f.point(x1)
-                if best is None or c @ z1 < c @ best:
+                seen.add(key)
+                z1 = _face_lp(M, q, np.flatnonzero(in_A), c)
+                if z1 is not None and (best is None or c @ z1 < c @ best):
                     best = z1
             if best is None or c @ best >= c @ z - slack:
                 break
             z, best_value = best, c @ best
-            face = _Face(M, q, z, tol)
-            if face.nullity == 0:
-                break
         bound = best_value
+    face = _Face(M, q, z, tol)
     if face.nullity == 0:
         return FaceResult(z, 0, float(np.abs(z - z0).max()), "selected")
     GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
@@ -216,6 +219,39 @@ def global_minimum_norm(
     if x is None:
         return FaceResult(z, face.nullity, 0.0, f"selected (LP vertex; QP {status})")
     return FaceResult(face.point(x), face.nullity, 0.0, "selected")
+
+
+def _face_lp(M: np.ndarray, q: np.ndarray, A: np.ndarray, c: np.ndarray) -> np.ndarray | None:
+    """A vertex minimizing c'y over the face with support A: y_A >= 0, (M y + q)_A = 0,
+    (M y + q)_Ac >= 0, by HiGHS's simplex through its own API (scipy's linprog wrapper costs
+    more than the solve on these small sparse LPs), tight tolerances; None if it fails."""
+    import highspy
+
+    if A.size == 0:
+        return None
+    Ac = np.setdiff1d(np.arange(q.size), A)
+    K = sp.csc_matrix(np.vstack([M[np.ix_(A, A)], M[np.ix_(Ac, A)]]))
+    inf = highspy.kHighsInf
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = A.size, K.shape[0]
+    lp.col_cost_ = np.asarray(c[A], dtype=float)
+    lp.col_lower_, lp.col_upper_ = np.zeros(A.size), np.full(A.size, inf)
+    lp.row_lower_ = np.concatenate([-q[A], -q[Ac]])
+    lp.row_upper_ = np.concatenate([-q[A], np.full(Ac.size, inf)])
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = K.indptr, K.indices, K.data
+    h = highspy.Highs()
+    for key, value in (("output_flag", False), ("presolve", "off"),
+                       ("primal_feasibility_tolerance", 1e-10),
+                       ("dual_feasibility_tolerance", 1e-10)):
+        h.setOptionValue(key, value)
+    h.passModel(lp)
+    h.run()
+    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
+        return None
+    y = np.zeros(q.size)
+    y[A] = np.maximum(np.asarray(h.getSolution().col_value), 0.0)
+    return y
 
 
 def _lp(c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):

@@ -226,7 +226,7 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
         if select != "none":
             face = (global_selection(ep, z, least_force) if select == "global" else None)
             if face is None or face.status.startswith("failed"):
-                face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force)
+                face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force, keep=np.arange(c))
             if face.status.startswith("selected"):
                 z = face.z
                 sol.residual = lcp.complementarity_residual(z, ep.lcp.M @ z + ep.lcp.q)
