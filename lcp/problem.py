@@ -54,11 +54,13 @@ def _as_float(name: str, value: Any) -> np.ndarray:
     if value is None:
         raise InvalidProblem(f"{name} is missing (got None)")
     try:
+        if np.iscomplexobj(np.asarray(value)):
+            raise InvalidProblem(f"{name} must be real, got complex values")
         arr = np.array(value, dtype=float)
     except (TypeError, ValueError) as exc:
+        if isinstance(exc, InvalidProblem):
+            raise
         raise InvalidProblem(f"{name} must be numeric, got {type(value).__name__}: {exc}") from None
-    if np.iscomplexobj(np.asarray(value)):
-        raise InvalidProblem(f"{name} must be real, got complex values")
     if arr.size == 0:
         raise InvalidProblem(f"{name} is empty: a problem needs at least one unknown")
     bad = ~np.isfinite(arr)
