@@ -146,11 +146,13 @@ def add_verify_formulas(sub) -> None:
                    "convention); frictionless: S = 0 at the walls (the paper's simulations)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--markdown", action="store_true", help="the table in Markdown")
+    p.add_argument("--grid", action="store_true",
+                   help="Markdown grids (Lx down, Ly across): SVD count [paper's, if different]")
     p.set_defaults(func=cmd_verify_formulas)
 
 
 def cmd_verify_formulas(args: argparse.Namespace) -> int:
-    from .formulas import format_table, formula_table, summary
+    from .formulas import format_grid, format_table, formula_table, summary
 
     for name, (lo, hi) in (("--lx", args.lx), ("--ly", args.ly)):
         if lo > hi or lo < 1:
@@ -163,6 +165,12 @@ def cmd_verify_formulas(args: argparse.Namespace) -> int:
     stats = summary(rows)
     if args.json:
         print(json.dumps({"walls": args.walls, "summary": stats, "rows": rows}, indent=1))
+    elif args.grid:
+        for name in lattices:
+            for kind, eq in (("normal", "3.3"), ("tangential", "3.4")):
+                print(f"{name}, Eq. ({eq}), {kind}:\n")
+                print(format_grid(rows, name, kind))
+                print()
     else:
         print(format_table(rows, markdown=args.markdown))
         print()

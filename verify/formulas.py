@@ -219,6 +219,26 @@ def format_table(rows: list[dict], markdown: bool = False) -> str:
     return "\n".join([fmt.format(*COLUMNS)] + [fmt.format(*t) for t in table])
 
 
+def format_grid(rows: list[dict], lattice: str, kind: str) -> str:
+    """Markdown grid, Lx down and Ly across, of the SVD count for one lattice and kind; where
+    the paper's value differs it follows in brackets, e.g. "8 [10]"."""
+    key = {"normal": "Nn", "tangential": "Nt"}[_kind(kind)]
+    sel = [r for r in rows if r["lattice"] == _lattice_name(lattice)]
+    lys = sorted({r["ly"] for r in sel})
+    cell = {(r["lx"], r["ly"]): r for r in sel}
+    lines = ["| Lx \\ Ly | " + " | ".join(map(str, lys)) + " |", "|---" * (len(lys) + 1) + "|"]
+    for lx in sorted({r["lx"] for r in sel}):
+        out = []
+        for ly in lys:
+            r = cell[lx, ly]
+            v = str(r[f"{key}_svd"])
+            if r[f"{key}_paper"] != r[f"{key}_svd"]:
+                v += f" [{r[f'{key}_paper']}]"
+            out.append(v)
+        lines.append(f"| {lx} | " + " | ".join(out) + " |")
+    return "\n".join(lines)
+
+
 def summary(rows: list[dict]) -> dict:
     """How often each closed form agrees with the SVD count, per lattice."""
     out = {}
