@@ -47,6 +47,17 @@ def test_closed_form_sizes_match_the_lattice(lattice, lx, ly):
     assert vf.full_rows(lattice, ly) == len(set(lat.row[lat.i[lat.kind == "wall"]]))
 
 
+@pytest.mark.parametrize("lattice", ["rect", "tri"])
+@pytest.mark.parametrize("lx,ly", [(2, 1), (2, 5), (4, 4), (7, 3), (9, 6)])
+def test_frameworks_are_rigid(lattice, lx, ly):
+    # The derivations' hypotheses: central forces pin every translation (rank 2p) and, with
+    # every contact rough, no motion leaves all contacts at rest (H has full column rank 3p).
+    sysm = models.System(models.make_lattice(lattice, lx, ly), **vf.DEFAULT_MU)
+    H = models.Dynamics(sysm).H.toarray()
+    assert np.linalg.matrix_rank(H[: sysm.c, : 2 * sysm.p]) == 2 * sysm.p
+    assert np.linalg.matrix_rank(H) == 3 * sysm.p
+
+
 def test_where_the_paper_holds_and_where_it_does_not():
     # Rectangular: both closed forms hold (rough walls for Eq. 3.4).
     for lx, ly in [(2, 1), (4, 3), (7, 5)]:
@@ -88,6 +99,10 @@ def test_cli_verify_formulas_text_and_json(capsys):
     data = json.loads(capsys.readouterr().out)
     (row,) = data["rows"]
     assert (row["Nn_paper"], row["Nn_svd"], row["Nt_paper"], row["Nt_svd"]) == (10, 8, 22, 22)
+    assert main(["verify-formulas", "--lattice", "tri", "--lx", "4", "4", "--ly", "3", "4",
+                 "--grid"]) == 0
+    out = capsys.readouterr().out
+    assert "| 4 | 6 [8] | 8 [10] |" in out and "| 4 | 17 [16] | 22 |" in out
     assert main(["verify-formulas", "--lx", "3", "2"]) == 2
 
 

@@ -188,6 +188,24 @@ def test_fig5b_loops_of_four_contacts_in_a_3x3_rectangular_array():
         assert q3.exact_rank(sub) == 8
 
 
+def test_fig5e_loops_through_the_plane():
+    # Fig. 5(e)/Fig. 6: a row on the plane, alternate disks rolling (NS on the plane), the
+    # others sliding on it, frictionless walls: loops plane - disk - disk - disk - plane.
+    sysm = system("rect", 7, 1, mu_wall=0.0)
+    lat = sysm.lattice
+    tangential = vn.paper_states(sysm, "tangential")[1]
+    plane = np.flatnonzero(lat.kind == "plane")
+    tangential[plane[1::2]] = 1
+    loops = vn.rotation_loops(lat, tangential == 0)
+    assert loops.dim == 3
+    for k, loop in enumerate(loops.loops()):
+        d = 2 * k
+        pp = [int(np.flatnonzero((lat.i == d + m) & (lat.j == d + m + 1))[0]) for m in (0, 1)]
+        assert set(loop) == {int(plane[d]), int(plane[d + 2]), *pp}
+    normal_dim = vn.null_space(sysm, *vn.paper_states(sysm, "normal")).dim
+    assert vn.null_space(sysm, np.ones(lat.c, bool), tangential).dim - normal_dim == 3
+
+
 def test_rectangular_3x3_tangential_basis_all_ns():
     # Eq. (3.4)'s state (every contact NS, rough walls): 15 = 3 + 12 null vectors; the
     # sparsest are the two corner wedges (disk - wall - plane, 2 contacts) and the three rows.
