@@ -239,9 +239,15 @@ def null_space(
     localize: bool = False,
     tol: float | None = None,
 ) -> NullSpace:
-    """The null space of the contact matrix of Eq. (2.15) for the given contact states."""
+    """The null space of the contact matrix of Eq. (2.15) for the given contact states.
+
+    localize: also compute `localized_basis` (one LP per contributing contact; seconds for a
+    few hundred contacts). BLAS runs on one thread: these matrices are small and dense, and
+    threads only cost time (a lot of it on a loaded machine).
+    """
     M, _ = models.contact_matrix(system, normal, tangential)
-    w, V, tol, rank = svd_rank(M, tol)
+    with threadpool_limits(1):
+        w, V, tol, rank = svd_rank(M, tol)
     basis = V[:, rank:]
     c = system.c
     norms = np.sqrt(np.sum(basis[:c] ** 2, axis=1) + np.sum(basis[c:] ** 2, axis=1))
