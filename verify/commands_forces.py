@@ -131,6 +131,9 @@ def cmd_forces(args: argparse.Namespace) -> int:
         "F_g_range": list(ranges.observables["F_g"]),
         "networks": rows, "png": [str(q) for q in paths],
     }
+    if len(networks) < args.networks:
+        summary["note"] = (f"only {len(networks)} distinct networks found (the admissible set "
+                           f"has few vertices); {args.networks} were asked for")
     with open(out / "forces.json", "w") as fh:
         json.dump(summary, fh, indent=1, default=float)
     if args.json:
@@ -156,6 +159,8 @@ def _print(system, s: dict) -> None:
         ok = "ok" if r["accepted"] else f"REJECTED ({r['scaled_residual']:.2g})"
         print(f"{r['name']:<28} {r['T']:>3} {r['NT']:>3} {r['R_max']:>8.4g} "
               f"{r['R_norm']:>8.4g} {r['F_g']:>8.4g} {max(map(abs, r['omega_dot'])):>10.4g}  {ok}")
+    if "note" in s:
+        print("note: " + s["note"])
     print("figures: " + ", ".join(s["png"]))
 
 

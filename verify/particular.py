@@ -354,8 +354,40 @@ def min_norm_solution(poly: Polyhedron, solver: str = "CLARABEL") -> Particular:
         if prob.status in ("infeasible", "infeasible_inaccurate"):
             raise EmptyPolyhedron(f"no admissible forces ({poly.description})")
         raise RuntimeError(f"{solver} ended with status {prob.status}")
-    return _particular(poly, np.asarray(x.value, dtype=float), f"min-norm ({solver.lower()})",
-                       prob.status)
+    x0 = np.asarray(x.value, dtype=float)
+    xp = _polish_min_norm(poly, x0)
+    polished = xp is not None
+    return _particular(poly, xp if polished else x0, f"min-norm ({solver.lower()})",
+                       prob.status + ("; active-set polished" if polished else ""))
+
+
+def _polish_min_norm(poly: Polyhedron, x: np.ndarray, active_tol: float = 1e-4
+                     ) -> np.ndarray | None:
+    """Active-set polish of a QP point: interior-point methods leave weakly active constraints
+    (zero multiplier, e.g. R = 0 where the objective's gradient vanishes) at ~sqrt(gap) from the
+    bound. The constraints within active_tol x scale of being tight are made equalities and the
+    minimum-norm solution of the resulting linear system (pinv) is taken; it is kept if it is
+    feasible to 1e-10 x scale and its norm is not larger (it is then the exact QP optimum
+    for that active set)."""
+    t = active_tol * poly.scale
+    rows = [poly.A_eq]
+    rhs = [poly.b_eq]
+    if poly.A_ub.size:
+        act = poly.b_ub - poly.A_ub @ x <= t
+        rows.append(poly.A_ub[act])
+        rhs.append(poly.b_ub[act])
+    for bound, sgn in ((poly.lb, 1.0), (poly.ub, -1.0)):
+        act = np.isfinite(bound) & (sgn * (x - bound) <= t)
+        E = np.eye(poly.n)[act]
+        rows.append(E)
+        rhs.append(bound[act])
+    A, b = np.vstack(rows), np.concatenate(rhs)
+    xp = np.linalg.pinv(A, rcond=1e-12) @ b
+    eq, viol = poly.residuals(xp)
+    ok = eq <= 1e-10 * max(poly.scale, 1.0) and viol <= 1e-10 * poly.scale
+    if ok and np.linalg.norm(xp) <= np.linalg.norm(x) * (1 + 1e-9) + 1e-12 * poly.scale:
+        return xp
+    return None
 
 
 def random_vertex(poly: Polyhedron, rng: np.random.Generator | int | None = None) -> Particular:
