@@ -16,23 +16,14 @@ For a vector of contact states, `models.contact_matrix` gives M x = b, x = [R (c
   `support_tol` = sqrt(eps); the perturbation bound on the computed null space (Wedin:
   sin angle <= ||dM|| / w_r, with w_r the smallest kept singular value) is reported beside it
   (`basis_error`) and is far smaller for these matrices;
-* a localized basis (`localized_basis`): each vector involves as few contacts as we can find,
-  so that the structures of Fig. 5 show (rows between the walls, the 12-contact hexagons of a
-  triangular array). Method: for every coordinate k in the support, the L1-smallest null vector
-  with x_k = 1 (a linear program; its optimal vertex is a *circuit*, a null vector of minimal
-  support), polished to an exact null vector of M restricted to that support; then the sparsest
-  circuits are taken greedily while they stay independent (the matroid greedy algorithm), and
-  any missing dimension is filled by an L1-smallest vector with a normalization that forces
-  independence. The paper notes (end of Sec. III B) that any basis is as good as another;
-  sparse ones are the readable ones.
+* a localized basis (`localized_basis`, in `verify.sparsenull`): each vector involves as few
+  contacts as we can find, so that the structures of Fig. 5 show (rows between the walls, the
+  12-contact hexagons of a triangular array); the local candidates come from `contact_patches`
+  (a disk and its neighbours). The paper notes (end of Sec. III B) that any basis is as good as
+  another; sparse ones are the readable ones.
 
-`rotation_loops` is the paper's kinematic reading of Fig. 5(b), 5(c), 5(e): in the regime of the
-paper (no particle displacement), the NS condition of contact alpha reduces to
-omega_i + omega_j = 0 (omega_i = 0 against an obstacle), and "three NS contacts of a loop of
-four disks imply the fourth" is a linear dependency among those equations -- a vector of the
-*left* null space of the contact-disk matrix K. See docs/verification.md: those loops are not
-null vectors of M (whose null vectors are self-equilibrated forces), but they have the same
-count.
+The kinematic reading of Fig. 5(b), 5(c), 5(e) (loops of NS contacts, which are not null vectors
+of M but have the same count) is in `verify.loops`; its names are re-exported here.
 """
 
 from __future__ import annotations
@@ -40,19 +31,25 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.optimize import linprog
 from threadpoolctl import threadpool_limits
 
 import models
 
-EPS = np.finfo(float).eps
-#: A row of the orthonormal null basis with a norm below this is zero (Eq. 3.2).
-SUPPORT_TOL = float(np.sqrt(EPS))
-#: Relative size below which an entry of a (max-normalized) localized vector is zero.
-ENTRY_TOL = 1e-9
-#: Components of x whose residual after projection on the chosen vectors counts as new.
-INDEPENDENCE_TOL = 1e-8
+from .loops import LoopBasis, closed_form_loops, rotation_loops, rotation_matrix
+from .sparsenull import (
+    ENTRY_TOL,
+    EPS,
+    INDEPENDENCE_TOL,
+    SUPPORT_TOL,
+    localized_basis,
+    svd_rank,
+)
+
+__all__ = [
+    "KINDS", "paper_states", "NullSpace", "null_space", "read_states", "contact_patches",
+    "svd_rank", "localized_basis", "EPS", "SUPPORT_TOL", "ENTRY_TOL", "INDEPENDENCE_TOL",
+    "LoopBasis", "rotation_loops", "rotation_matrix", "closed_form_loops",
+]
 
 KINDS = ("normal", "tangential")
 
@@ -79,25 +76,6 @@ def paper_states(
     else:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     return normal, tangential
-
-
-def svd_rank(M: np.ndarray, tol: float | None = None) -> tuple[np.ndarray, np.ndarray, float, int]:
-    """SVD of M (Eq. 3.1): (singular values w, descending; V; tol; numerical rank).
-
-    tol defaults to max(M.shape) * eps * w_max (see the module docstring).
-    """
-    M = np.asarray(M, dtype=float)
-    if M.ndim != 2 or not np.all(np.isfinite(M)):
-        raise ValueError("M must be a finite 2-D array")
-    if M.size == 0:
-        return np.zeros(0), np.eye(M.shape[1]), 0.0, 0
-    # V must be complete (all of R^n): full_matrices only matters when M has fewer rows.
-    _, w, Vt = np.linalg.svd(M, full_matrices=M.shape[0] < M.shape[1])
-    if tol is None:
-        tol = max(M.shape) * EPS * (w[0] if w.size else 0.0)
-    rank = int(np.sum(w > tol))
-    return w, Vt.T, float(tol), rank
-
 
 @dataclass
 class NullSpace:
@@ -260,53 +238,6 @@ def null_space(
     return ns
 
 
-def _l1_smallest(V: np.ndarray, a: np.ndarray) -> np.ndarray | None:
-    """argmin ||V y||_1 subject to a . y = 1, returned as x = V y (a linear program).
-
-    Variables (y, u), u >= 0 bounding |V y| from above; the dual simplex returns a vertex, i.e.
-    a null vector of minimal support (a circuit) in the generic case.
-    """
-    n, d = V.shape
-    Vs = sp.csr_matrix(V)
-    eye = sp.identity(n, format="csr")
-    A_ub = sp.vstack([sp.hstack([Vs, -eye]), sp.hstack([-Vs, -eye])], format="csr")
-    res = linprog(
-        np.r_[np.zeros(d), np.ones(n)], A_ub=A_ub, b_ub=np.zeros(2 * n),
-        A_eq=np.r_[a, np.zeros(n)][None, :], b_eq=[1.0],
-        bounds=[(None, None)] * d + [(0, None)] * n, method="highs-ds",
-    )
-    if res.status != 0:
-        return None
-    return V @ res.x[:d]
-
-
-def _polish(M: np.ndarray, x: np.ndarray, tol: float) -> np.ndarray:
-    """Zero the negligible entries of x; when its support carries exactly one null direction of
-    M (a circuit), return that direction computed from M restricted to the support."""
-    x = x / np.abs(x).max()
-    supp = np.flatnonzero(np.abs(x) > ENTRY_TOL)
-    w, V, _, rank = svd_rank(M[:, supp], tol)
-    if supp.size - rank == 1:
-        y = V[:, -1]
-        y = y if y @ x[supp] > 0 else -y
-        x = np.zeros_like(x)
-        x[supp] = y
-    else:
-        x[np.abs(x) <= ENTRY_TOL] = 0.0
-    k = np.argmax(np.abs(x))
-    x = x / x[k]
-    x[np.abs(x) <= ENTRY_TOL] = 0.0
-    return x + 0.0  # no negative zeros
-
-
-def _n_contacts(x: np.ndarray, contact_count: int | None) -> int:
-    nz = x != 0
-    if contact_count is None:
-        return int(nz.sum())
-    c = contact_count
-    return int(np.sum(nz[:c] | nz[c:]))
-
-
 def contact_patches(lattice: models.Lattice, radius: int = 1) -> list[np.ndarray]:
     """Column sets of x = [R; S] for local searches: for each disk k, the contacts whose disks
     all lie within `radius` pp-contact steps of k (obstacle contacts of those disks included).
@@ -328,200 +259,3 @@ def contact_patches(lattice: models.Lattice, radius: int = 1) -> list[np.ndarray
         a = np.flatnonzero(inside)
         patches.append(np.r_[a, a + c])
     return patches
-
-
-def localized_basis(
-    M: np.ndarray,
-    basis: np.ndarray,
-    contact_count: int | None = None,
-    patches: list[np.ndarray] = (),
-    exhaustive: bool | None = None,
-    seed: int = 0,
-) -> np.ndarray:
-    """A basis of ker M (given by an orthonormal `basis`) whose vectors have small supports.
-
-    Candidates: (1) for each column set in `patches`, the null vectors of M supported there
-    (ker M[:, patch], embedded), localized by L1 inside the patch -- these are genuine null
-    vectors of M and catch local structures such as the hexagons of Fig. 5(a), which a global
-    L1 minimum may trade for a longer but lighter vector; (2) for the coordinates of the support
-    not yet covered (all of them when `exhaustive`, the default when there are no patches and
-    2c <= 400), the global L1-smallest null vector with x_k = 1. Then the matroid greedy
-    algorithm keeps the sparsest independent ones, and a normalization orthogonal to the kept
-    span fills any missing dimension.
-
-    contact_count c: coordinates k and c + k belong to the same contact (x = [R; S] of Eq.
-    2.15); supports are then measured in contacts. Vectors are scaled so that their largest
-    entry is +1 and sorted by support size.
-    """
-    n, d = basis.shape
-    if d == 0:
-        return np.zeros((n, 0))
-    with threadpool_limits(1):  # small dense matrices: one BLAS thread is fastest (and much
-        return _localized_basis(M, basis, contact_count, patches, exhaustive, seed)  # faster
-        # on a loaded machine)
-
-
-def _localize_within(M: np.ndarray, V: np.ndarray, tol: float) -> list[np.ndarray]:
-    """L1 circuits of the span of V (orthonormal columns), one LP per support coordinate."""
-    if V.shape[1] == 1:
-        return [_polish(M, V[:, 0], tol)]
-    out = []
-    for k in np.flatnonzero(np.linalg.norm(V, axis=1) > SUPPORT_TOL):
-        x = _l1_smallest(V, V[k])
-        if x is not None:
-            out.append(_polish(M, x, tol))
-    return out
-
-
-def _representatives(basis: np.ndarray, contact_count: int | None) -> np.ndarray:
-    """One coordinate per contact of the support (its R, else its S): supports are counted in
-    contacts, so one L1 problem per contact suffices."""
-    nonzero = np.linalg.norm(basis, axis=1) > SUPPORT_TOL
-    if contact_count is None:
-        return np.flatnonzero(nonzero)
-    c = contact_count
-    a = np.flatnonzero(nonzero[:c] | nonzero[c:])
-    return np.where(nonzero[a], a, a + c)
-
-
-def _localized_basis(M: np.ndarray, basis: np.ndarray, contact_count: int | None,
-                     patches, exhaustive: bool | None, seed: int) -> np.ndarray:
-    n, d = basis.shape
-    tol = max(M.shape) * EPS * np.linalg.norm(M, 2)
-    found: list[np.ndarray] = []
-    covered = np.zeros(n, dtype=bool)
-    seen: set[tuple[int, ...]] = set()
-    for cols in patches:
-        _, V, _, rank = svd_rank(M[:, cols], tol)
-        if V.shape[1] - rank == 0 or tuple(cols) in seen:
-            continue
-        seen.add(tuple(cols))
-        for y in _localize_within(M[:, cols], V[:, rank:], tol):
-            x = np.zeros(n)
-            x[cols] = y
-            covered |= x != 0
-            found.append(x)
-    if exhaustive is None:
-        exhaustive = n <= 400
-    for k in _representatives(basis, contact_count):
-        if not exhaustive and covered[k]:
-            continue
-        x = _l1_smallest(basis, basis[k])
-        if x is None:
-            continue
-        x = _polish(M, x, tol)
-        covered |= x != 0
-        found.append(x)
-
-    def key(x: np.ndarray) -> tuple:
-        nz = np.flatnonzero(x)
-        return (_n_contacts(x, contact_count), nz.size, tuple(nz))
-
-    chosen: list[np.ndarray] = []
-    Q = np.zeros((n, 0))
-    for x in sorted(found, key=key):
-        r = x - Q @ (Q.T @ x)
-        if np.linalg.norm(r) > INDEPENDENCE_TOL * np.linalg.norm(x):
-            chosen.append(x)
-            Q = np.column_stack([Q, r / np.linalg.norm(r)])
-        if len(chosen) == d:
-            break
-    rng = np.random.default_rng(seed)
-    while len(chosen) < d:  # a normalization orthogonal to the chosen span forces independence
-        g = basis @ rng.standard_normal(d)
-        g -= Q @ (Q.T @ g)
-        x = _l1_smallest(basis, basis.T @ g)
-        x = basis @ (basis.T @ g) if x is None else _polish(M, x, tol)
-        r = x - Q @ (Q.T @ x)
-        chosen.append(x)
-        Q = np.column_stack([Q, r / np.linalg.norm(r)])
-    return np.column_stack(sorted(chosen, key=key))
-
-
-# -- the kinematic loops of Fig. 5(b), 5(c), 5(e) ------------------------------------------------
-
-
-def rotation_matrix(lattice: models.Lattice, ns: np.ndarray) -> np.ndarray:
-    """K (|NS| x p): the NS condition of contact alpha without translations (the paper's regime),
-    -r (omega_i + omega_j) = 0, or -r omega_i = 0 against an obstacle, divided by -r."""
-    ns = np.flatnonzero(ns)
-    K = np.zeros((ns.size, lattice.p))
-    K[np.arange(ns.size), lattice.i[ns]] = 1.0
-    disk = lattice.j[ns] >= 0
-    K[np.arange(ns.size)[disk], lattice.j[ns][disk]] += 1.0
-    return K
-
-
-@dataclass
-class LoopBasis:
-    """Dependencies among the NS equations of the no-displacement regime (left ker K)."""
-
-    lattice: models.Lattice
-    ns_contacts: np.ndarray  # the NS contacts (rows of K)
-    vectors: np.ndarray  # (|NS|, dim): coefficients of the dependent combinations
-
-    @property
-    def dim(self) -> int:
-        return self.vectors.shape[1]
-
-    def loops(self) -> list[dict[int, float]]:
-        """Each basis vector as {contact: coefficient} (the loops of Fig. 5b/5c/5e)."""
-        return [{int(self.ns_contacts[k]): float(v[k]) for k in np.flatnonzero(v)}
-                for v in self.vectors.T]
-
-
-def rotation_loops(lattice: models.Lattice, ns: np.ndarray) -> LoopBasis:
-    """The localized basis of left ker K for the NS contacts `ns` (a boolean mask).
-
-    Its dimension is |NS| - rank K = |NS| - p + (number of connected components of the graph
-    (disks, NS contacts) that are bipartite and touch no obstacle through an NS contact), K
-    being an unsigned incidence matrix (`closed_form_loops`).
-    """
-    ns = np.asarray(ns, dtype=bool)
-    K = rotation_matrix(lattice, ns)
-    idx = np.flatnonzero(ns)
-    if idx.size == 0:
-        return LoopBasis(lattice, idx, np.zeros((0, 0)))
-    w, V, _, rank = svd_rank(K.T)
-    return LoopBasis(lattice, idx, localized_basis(K.T, V[:, rank:]))
-
-
-def closed_form_loops(lattice: models.Lattice, ns: np.ndarray) -> int:
-    """|NS| - rank K, with rank K = p - (bipartite components without an obstacle NS contact).
-
-    A component of the graph (disks, NS pp contacts) has a nonzero rotation mode with
-    omega_i + omega_j = 0 on all its edges iff it is bipartite (alternate signs), and that mode
-    survives iff none of its disks has an NS contact with a wall or the plane.
-    """
-    ns = np.asarray(ns, dtype=bool)
-    p = lattice.p
-    parent = list(range(p))
-    parity = [0] * p  # parity relative to the parent
-
-    def find(k: int) -> tuple[int, int]:
-        par = 0
-        while parent[k] != k:
-            par ^= parity[k]
-            k = parent[k]
-        return k, par
-
-    bipartite = [True] * p
-    grounded = [False] * p
-    for a in np.flatnonzero(ns):
-        i, j = int(lattice.i[a]), int(lattice.j[a])
-        ri, pi = find(i)
-        if j < 0:
-            grounded[ri] = True
-            continue
-        rj, pj = find(j)
-        if ri == rj:
-            if pi == pj:  # an odd cycle
-                bipartite[ri] = False
-            continue
-        parent[rj] = ri
-        parity[rj] = pi ^ pj ^ 1  # i and j get opposite signs
-        bipartite[ri] = bipartite[ri] and bipartite[rj]
-        grounded[ri] = grounded[ri] or grounded[rj]
-    roots = {find(k)[0] for k in range(p)}
-    free_modes = sum(1 for r in roots if bipartite[r] and not grounded[r])
-    return int(ns.sum()) - (p - free_modes)
