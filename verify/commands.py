@@ -23,9 +23,12 @@ def register(sub) -> None:
 # -- rigidlcp nullspace --------------------------------------------------------------------------
 
 
-def add_nullspace(sub) -> None:
-    from .formulas import DEFAULT_MU
+#: Default friction of `rigidlcp nullspace`: one coefficient everywhere, so that the friction
+#: forces of a row sliding as a whole cancel and the rows of Fig. 5(d) stay local.
+NULLSPACE_MU = {"mu_pp": 0.3, "mu_plane": 0.3, "mu_wall": 0.3}
 
+
+def add_nullspace(sub) -> None:
     p = sub.add_parser(
         "nullspace", help="null space of the contact matrix (Eqs. 2.15, 3.1, 3.2; Fig. 5)",
         description="SVD of the paper's contact matrix M (Eq. 2.15) for a vector of contact "
@@ -41,7 +44,7 @@ def add_nullspace(sub) -> None:
     p.add_argument("--lx", type=int, default=4, help="disks in the rows touching both walls")
     p.add_argument("--ly", type=int, default=3, help="number of rows")
     p.add_argument("--states", default="tangential", metavar="normal|tangential|FILE")
-    for name, default in DEFAULT_MU.items():
+    for name, default in NULLSPACE_MU.items():
         p.add_argument("--" + name.replace("_", "-"), type=float, default=default,
                        help=f"friction coefficient (default {default}; 0 = frictionless)")
     p.add_argument("--loops", action="store_true",
