@@ -78,7 +78,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
             raise ValueError("--plot needs the localized basis (drop --no-localize)")
         ns_path = plot_null_space(ns, args.plot)
         loop_path = None
-        if loops is not None:
+        if loops is not None and loops.dim:
             stem = ns_path.with_name(ns_path.stem + "_loops" + ns_path.suffix)
             loop_path = plot_loops(system, loops, stem)
     if args.json:
@@ -91,7 +91,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     else:
         _print_null_space(ns, args.states, loops)
     if args.plot and not args.json:
-        print(f"plot: {ns_path}" + (f", {loop_path}" if loops is not None else ""))
+        print(f"plot: {ns_path}" + (f", {loop_path}" if loop_path is not None else ""))
     return 0
 
 

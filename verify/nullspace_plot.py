@@ -62,7 +62,7 @@ def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarr
     for ax, (R, S, title) in zip(axes.flat, vectors):
         _draw_vector(ax, system, R, S, title)
     if suptitle:
-        fig.suptitle(suptitle)
+        fig.suptitle(suptitle, y=1.0 + 0.12 / nrow)  # above the panel titles
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight")
