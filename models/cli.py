@@ -48,6 +48,9 @@ def main(argv: list[str] | None = None) -> int:
     except (ValueError, FileNotFoundError) as exc:
         print(f"rigidlcp {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":

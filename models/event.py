@@ -187,6 +187,10 @@ def contact_matrix(
     x = [R (c); S (c)]. normal[alpha]: True (T: a_n = 0, Eq. 2.9) or False (NT: R = 0, Eq. 2.8).
     tangential[alpha]: 0 (NS: a_t = 0, Eq. 2.12) or +1 / -1 (sliding with sgn(v_t) = +-1:
     S + sgn mu R = 0, Eq. 2.10). Rows 0..c-1 are the normal equations, c..2c-1 the tangential.
+
+    The states are taken literally, as the paper's iteration does: "NS" writes a_t = 0 even on a
+    frictionless contact (where Coulomb's law would give S = 0), so that the counts of Eq. (3.4)
+    can be computed with rough walls; admissibility of the states is the caller's business.
     """
     dyn = dyn or Dynamics(system)
     c = system.c
