@@ -104,7 +104,7 @@ class Certificate:
 
 def certify(
     problem, solution, tol: float = 1e-8, uniqueness: str = "auto", *,
-    delta: float = 1e-4, bound: float | None = None, time_limit: float = 10.0,
+    delta: float = 1e-4, bound: float | None = None, time_limit: float = 30.0,
     objective: str = "none", observables: dict[str, np.ndarray] | None = None,
 ) -> Certificate:
     """Certify `solution` (an `lcp.Solution` or a vector z) of `problem`.
