@@ -62,6 +62,7 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, help="directory for the PNGs")
     p.add_argument("--event", type=int, default=-1, help="event to draw (default: the last)")
     p.set_defaults(func=cmd_plot)
+    __import__("models.sweep_commands", fromlist=["register"]).register(sub)  # sweep, effective
 
 
 def cmd_simulate(args) -> int:
