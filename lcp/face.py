@@ -47,11 +47,15 @@ def face_minimum_norm(
     eps: float = 1e-10,
     max_walk: int = 20,
     keep: np.ndarray | None = None,
+    z_side: np.ndarray | None = None,
 ) -> FaceResult:
     """The point of the face of z minimizing c'y, then |G y| (see the module docstring).
 
     keep: indices whose degenerate pairs stay on the z side in the walk (the caller knows w_i
     must vanish there, e.g. a_n = 0 on every contact of an event without detachment).
+    z_side: a boolean mask prescribing, for every degenerate pair (z_i = w_i = 0), the side of
+    the face: True lets z_i grow (w_i = 0 kept), False lets w_i grow (z_i = 0 kept). Then each
+    step of the walk minimizes over that one face; without it both extreme faces are tried.
 
     With `c`, the linear stage walks from face to face: a minimizer of c'y on the face of z is
     again a solution, whose own face (its degenerate indices, z_i = w_i = 0, may now go either
@@ -75,7 +79,9 @@ def face_minimum_norm(
         for _ in range(max_walk):
             best = None
             w = M @ z + q
-            for in_A in (w <= tol, (w <= tol) & ((z > tol) | kept)):  # degenerate pairs: both
+            faces = ((w <= tol, (w <= tol) & ((z > tol) | kept)) if z_side is None
+                     else ((w <= tol) & ((z > tol) | z_side | kept),))
+            for in_A in faces:  # degenerate pairs: both sides, or the prescribed one
                 key = np.packbits(in_A).tobytes()
                 if key in seen:  # a face already minimized over
                     continue
@@ -87,7 +93,11 @@ def face_minimum_norm(
                 break
             z, best_value = best, c @ best
         bound = best_value
-    face = _Face(M, q, z, tol)
+    if z_side is None:
+        face = _Face(M, q, z, tol)
+    else:
+        w = M @ z + q
+        face = _Face(M, q, z, tol, A=np.flatnonzero((w <= tol) & ((z > tol) | z_side)))
     if face.nullity == 0:
         return FaceResult(z, 0, float(np.abs(z - z0).max()), "selected")
     GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
@@ -99,10 +109,18 @@ def face_minimum_norm(
         Aeq = (c[face.A] @ face.N)[None, :]
         beq = np.array([bound - c @ z])
     x, status = _qp(P, GN.T @ (GA @ z[face.A]), face.Aineq, face.bineq, Aeq, beq)
-    if x is None:
-        return FaceResult(z0, face.nullity, 0.0, f"failed: {status}")
-    y = face.point(x)
-    return FaceResult(y, face.nullity, float(np.abs(y - z0).max()), "selected")
+    # Every point returned is checked: an inaccurate one (rounding in a nearly singular face)
+    # gives way to the linear stage's vertex, and that to the solver's own solution.
+    limit = max(10.0 * _residual(M, q, z0), 1e-12 * scale)
+    for y, label in ((None if x is None else face.point(x), "selected"),
+                     (z, "selected (linear stage only)")):
+        if y is not None and _residual(M, q, y) <= limit:
+            return FaceResult(y, face.nullity, float(np.abs(y - z0).max()), label)
+    return FaceResult(z0, face.nullity, 0.0, f"failed: inaccurate face point ({status})")
+
+
+def _residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
+    return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
 
 
 class _Face:

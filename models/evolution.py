@@ -127,8 +127,8 @@ def simulate(
     max_events: int = 100_000,
     check_tol: float = 1e-8,
     warm_start: bool = True,
-    zeno_events: int = 1000,
-    zeno_time: float = 1e-9,
+    zeno_events: int = 200,
+    zeno_time: float = 1e-6,
     progress: Callable[[Run], None] | None = None,
     dump_dir: str | None = None,
     select: str = "face-min-norm",
@@ -193,6 +193,10 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
         if least_force is None or least_force.size != ep.lcp.n:
             least_force = np.zeros(ep.lcp.n)
             least_force[:c] = 1.0  # sum of R over the contacts: z = [R, tau, a_minus]
+        # Degenerate pairs open the way that keeps contacts closed and candidates non-sliding:
+        # R (a_n = 0), tau (a_plus = 0, S inside the cone), but not a_minus (a_minus = 0).
+        stick_side = np.zeros(ep.lcp.n, bool)
+        stick_side[: c + ep.k] = True
         options = {}
         if method == "pivoting" and warm_start and prev is not None:
             options["active"] = warm_active_set(ep, prev, state)
@@ -226,7 +230,7 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
         if select != "none":
             face = (global_selection(ep, z, least_force) if select == "global" else None)
             if face is None or face.status.startswith("failed"):
-                face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force, keep=np.arange(c))
+                face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force, z_side=stick_side)
             if face.status.startswith("selected"):
                 z = face.z
                 sol.residual = lcp.complementarity_residual(z, ep.lcp.M @ z + ep.lcp.q)
