@@ -9,7 +9,12 @@ that have the advertised property *by construction*, with the reason in its docs
 * ``lcps(matrices)``     -- ``lcp.LCP`` problems, optionally with a planted solution;
 * ``degenerate_lcps()``  -- solvable LCPs with zeros in q, degenerate complementary pairs and
                             duplicated rows/columns (the shape of this project's friction LCPs);
-* ``mlcps()``            -- ``lcp.MLCP`` problems with a nonsingular A (Schur-reducible).
+* ``mlcps()``            -- ``lcp.MLCP`` problems with a nonsingular A (Schur-reducible);
+* ``lattices()``         -- ``models.Lattice`` arrays (rectangular / triangular, valid sizes);
+* ``systems()``          -- ``models.System`` with drawn coefficients and driving;
+* ``contact_states(sys)``-- (normal, tangential) state vectors for ``models.contact_matrix``;
+* ``event_states(sys)``  -- ``models.State`` at an event: angular velocities and, per contact,
+                            sliding +1 / -1 or non-sliding candidate 0.
 
 Sizes may be an int or a strategy of ints, and matrix strategies can be passed to ``lcps``:
 ``lcps(p_matrices(st.integers(1, 6)), planted=True)``. Entries are kept O(1) and the
@@ -28,7 +33,7 @@ from lcp import LCP, MLCP
 
 __all__ = [
     "P_KINDS", "p_matrices", "symmetric_psd", "lcps", "degenerate_lcps", "mlcps",
-    "planted_solution",
+    "planted_solution", "lattices", "systems", "contact_states", "event_states",
 ]
 
 #: The constructions `p_matrices` draws from.
@@ -42,6 +47,8 @@ SMALL_DEGENERATE = st.integers(2, 8)
 FEW = st.integers(0, 2)
 NU = st.integers(1, 4)
 M_PAIRS = st.integers(1, 5)
+LX = st.integers(1, 8)
+LY = st.integers(1, 6)
 
 
 def _size(draw, n: SizeLike, least: int = 1) -> int:
@@ -239,3 +246,62 @@ def mlcps(draw, nu: SizeLike = NU, m: SizeLike = M_PAIRS) -> MLCP:
     B = draw(p_matrices(m_, kind="positive-definite"))
     a, b = _vector(draw, nu_), _vector(draw, m_)
     return MLCP(A, -D.T, D, B, a, b)
+
+
+# --- lattices, systems and contact states (models) ---------------------------------------------
+
+@st.composite
+def lattices(draw, kinds: tuple[str, ...] = ("rect", "tri"), lx: SizeLike = LX,
+             ly: SizeLike = LY):
+    """``models.Lattice`` of a drawn kind and size; triangular arrays of two or more rows get
+    lx >= 2 (their rows in the hollows hold lx - 1 disks)."""
+    import models
+
+    kind = draw(st.sampled_from(kinds))
+    n_rows = _size(draw, ly)
+    least = 2 if kind == "tri" and n_rows >= 2 else 1
+    n_cols = max(_size(draw, lx), least)
+    return models.make_lattice(kind, n_cols, n_rows)
+
+
+@st.composite
+def systems(draw, lattice=None, mu: st.SearchStrategy[float] | None = None,
+            gamma: st.SearchStrategy[float] | None = None):
+    """``models.System`` on ``lattice`` (a Lattice, a strategy of them, or None for
+    ``lattices()``), coefficients per kind from ``mu`` (default 0 to 0.5 on a grid, 0 included)
+    and driving acceleration from ``gamma`` (default -0.5 to 0.5)."""
+    import models
+
+    if lattice is None:
+        lattice = lattices()
+    lat = draw(lattice) if isinstance(lattice, st.SearchStrategy) else lattice
+    mu = _unit(0.0, 0.5) if mu is None else mu
+    gamma = _unit(-0.5, 0.5) if gamma is None else gamma
+    return models.System(lat, mu_pp=draw(mu), mu_plane=draw(mu), mu_wall=draw(mu),
+                         gamma=draw(gamma), V0=draw(_unit(-1.0, 1.0)))
+
+
+@st.composite
+def contact_states(draw, system):
+    """(normal, tangential) for ``models.contact_matrix``: normal[alpha] True (T) / False (NT),
+    tangential[alpha] in {0 (NS), +1, -1 (sliding)}."""
+    c = system.c
+    normal = draw(arrays(bool, c))
+    tangential = draw(arrays(np.int64, c, elements=st.sampled_from([0, 1, -1])))
+    return normal, tangential
+
+
+@st.composite
+def event_states(draw, system, candidates: st.SearchStrategy[float] | None = None):
+    """``models.State`` at t = 0: angular velocities in [-1, 1] (grid) and per contact +1 / -1
+    (sliding that way) or 0 (non-sliding candidate, drawn with probability ``candidates``,
+    default in [0, 1]); frictionless contacts carry 0."""
+    import models
+
+    p, c = system.p, system.c
+    omega = _vector(draw, p)
+    frac = draw(_unit(0.0, 1.0) if candidates is None else candidates)
+    stick = draw(arrays(np.float64, c, elements=_unit(0.0, 1.0))) < frac
+    signs = draw(arrays(np.int64, c, elements=st.sampled_from([1, -1])))
+    s = np.where(stick | (system.mu == 0), 0, signs)
+    return models.State(0.0, omega, float(system.V0), s)
