@@ -99,7 +99,8 @@ def face_minimum_norm(
         w = M @ z + q
         face = _Face(M, q, z, tol, A=np.flatnonzero((w <= tol) & ((z > tol) | z_side)))
     if face.nullity == 0:
-        return FaceResult(z, 0, float(np.abs(z - z0).max()), "selected")
+        moved = float(np.abs(z - z0).max())
+        return FaceResult(z, 0, moved, "selected" if moved > 0 else "unique")
     GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
     GN = GA @ face.N
     # min 1/2 |G_A (z_A + N x)|^2 + eps/2 |N x|^2  s.t.  the face's inequalities (and c'y bound)
