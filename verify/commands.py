@@ -18,6 +18,7 @@ def register(sub) -> None:
     add_nullspace(sub)
     add_verify_formulas(sub)
     __import__("verify.commands_forces", fromlist=["register"]).register(sub)  # rigidlcp forces
+    __import__("verify.reproduce_commands", fromlist=["register"]).register(sub)  # reproduce
     __import__("verify.bench_commands", fromlist=["register"]).register(sub)  # rigidlcp bench
 
 
