@@ -124,7 +124,7 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     pts = lat.x[lat.i] + lat.radius * lat.n
     for loop in fig5e_loops(run.system, run.last):
         axes[1].plot(pts[list(loop), 0], pts[list(loop), 1], "k*", ms=10)
-    axes[1].set_title("steady state; stars: contacts of the Fig. 5(e) loops")
+    axes[1].set_title("steady state; stars: Fig. 5(e) loop contacts")
     files["fig6"] = _save(fig, out / "fig6_omega.png")
     return files
 
@@ -204,6 +204,8 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
                 if c.error:
                     lines.append(f"  Evaluation error: `{_cell(c.error.splitlines()[0])}`")
         lines.append("")
+        if "eq" in prefixes and res.formulas:
+            lines += _formula_grids(res)
     path = out / "report.md"
     path.write_text("\n".join(lines) + "\n")
     (out / "claims.json").write_text(json.dumps(
@@ -212,6 +214,19 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
          "plan": res.plan, "claims": [dict(asdict(c), verdict=c.verdict) for c in claims]},
         indent=1, default=_json) + "\n")
     return path
+
+
+def _formula_grids(res: Results) -> list[str]:
+    """The SVD counts of Eqs. (3.3)/(3.4), Lx down and Ly across; "n [p]" where the paper's
+    closed form p differs from the count n (verify.formulas.format_grid)."""
+    from .formulas import format_grid
+
+    out = []
+    for lat in ("rect", "tri"):
+        for kind, eq in (("normal", "3.3"), ("tangential", "3.4")):
+            out += [f"{lat}, Eq. ({eq}), {kind} (SVD count [paper's value where it differs]):",
+                    "", format_grid(res.formulas, lat, kind), ""]
+    return out
 
 
 def _json(obj):
