@@ -84,7 +84,17 @@ def lemke(
             z=np.zeros(n), w=q.copy(), status="solved", method="lemke", iterations=0,
             basis=np.zeros(0, dtype=int), message="q >= 0: z = 0 solves the LCP",
         )
-    return _Lemke(M, q, d, tol).run(max_iter)
+    sol = _Lemke(M, q, d, tol).run(max_iter)
+    # Rounding can defeat the lexicographic rule on near-ties (tol too fine for the data):
+    # then restart with ties decided more coarsely, and say so.
+    retry = tol
+    while sol.info.get("cycling") and retry < 1e-6:
+        retry *= 100.0
+        first = sol.message
+        sol = _Lemke(M, q, d, retry).run(max_iter)
+        sol.message = f"{first}; restarted with tol = {retry:g}: {sol.message}".rstrip(": ")
+        sol.info["tol_used"] = retry
+    return sol
 
 
 def _covering_vector(d, n: int) -> np.ndarray:
@@ -250,14 +260,27 @@ class _Lemke:
         s = n
         pivots = 0
         pivot = self.pivot
+        # Zobrist hash of the basis: exact lexicographic Lemke never revisits a basis, so a
+        # repeat proves that rounding defeated the tie-breaking (numerical cycling).
+        keys = np.random.default_rng(0).integers(1, 2**63 - 1, size=2 * n + 1, dtype=np.int64)
+        keys = [int(k) for k in keys]
+        h, seen, ent = 0, set(), z0
         while True:
             leaving = pivot(r, s)
             pivots += 1
             if leaving == z0:
                 return self.solution(pivots)
+            h ^= keys[leaving] ^ keys[ent]
+            if h in seen:
+                sol = self.stopped(pivots)
+                sol.message = f"numerical cycling: a basis repeated after {pivots} pivots"
+                sol.info["cycling"] = True
+                return sol
+            seen.add(h)
             if pivots >= max_iter:
                 return self.stopped(pivots)
             entering = leaving + n if leaving < n else leaving - n
+            ent = entering
             s = slot_of[entering]
             a = T[:, s]
             amax = -float(amin_of(a))  # the largest pivot candidate alpha_i = -a_i

@@ -383,3 +383,40 @@ def test_lemke_is_registered():
     info = lcp.get_method("lemke")
     assert info.accepts == "any"
     assert set(info.options) == {"d", "max_iter", "tol"}
+
+
+def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
+    """A basis that repeats proves rounding defeated the lexicographic rule: Lemke says so and
+    restarts with coarser ties. Forced here: the first attempt reports a cycle."""
+    import lcp.lemke as lemke_module
+
+    M = np.array([[2.0, 1.0], [1.0, 2.0]])
+    q = np.array([-1.0, -1.0])
+    calls = {"n": 0}
+    original = lemke_module._Lemke.run
+
+    def run_cycling_once(self, max_iter):
+        calls["n"] += 1
+        if calls["n"] == 1:  # the first attempt reports a cycle, as a repeated basis would
+            sol = self.stopped(3)
+            sol.info["cycling"] = True
+            sol.message = "numerical cycling: a basis repeated after 3 pivots"
+            return sol
+        return original(self, max_iter)
+
+    monkeypatch.setattr(lemke_module._Lemke, "run", run_cycling_once)
+    sol = lcp.solve(lcp.LCP(M, q), "lemke")
+    assert sol.success and calls["n"] == 2
+    assert sol.info["tol_used"] == pytest.approx(1e-8) and "restarted" in sol.message
+
+
+def test_real_event_that_cycles_at_the_default_tolerance():
+    """Event 252 of `rigidlcp simulate --lx 20 --ly 10 --gamma 0.16 --seed 1` (n = 720): at
+    tol = 1e-10 rounding defeats the lexicographic rule and a basis repeats after 766 pivots
+    (before the check, Lemke ran to its 73000-pivot limit); with ties at 1e-8 it is solved."""
+    from pathlib import Path
+
+    P = lcp.load(Path(__file__).parent.parent / "data" / "event_rect20x10_cycling.npz")
+    sol = lcp.solve(P, "lemke")
+    assert sol.success and sol.residual < 1e-9
+    assert sol.info.get("tol_used") == pytest.approx(1e-8)
