@@ -141,6 +141,7 @@ def test_resume_after_kill_gives_the_uninterrupted_file(tmp_path):
 
 # --- executors ----------------------------------------------------------------------------------
 
+@pytest.mark.slow  # starting a LocalCluster takes 3-12 s on this shared machine
 def test_local_pool_and_dask_local_cluster_give_identical_files(tmp_path):
     pytest.importorskip("dask.distributed")
     sweep = small_sweep("0.1:0.4:4")
