@@ -72,6 +72,18 @@ NS = 2
 RCOND = 1e-12
 #: A fresh LU whose pivots span more than 1 / PIVOT_RATIO is treated as singular.
 PIVOT_RATIO = 1e-13
+#: SuperLU's column ordering: minimum degree on K + K' suits K, whose pattern is nearly
+#: symmetric (W's); SuperLU's default COLAMD fills ~10x more at 100 x 100 disks.
+PERMC = "MMD_AT_PLUS_A"
+#: SuperLU options: prefer the diagonal pivot (threshold 0.01) and keep the symmetric
+#: ordering; about 30% less fill and time than partial pivoting here. The pivot-ratio test,
+#: the capacitance condition test and the iterative refinement guard the accuracy.
+SPLU_OPTIONS = {"DiagPivotThresh": 0.01, "SymmetricMode": True}
+
+
+def factorize(K: sp.spmatrix):
+    """SuperLU factorization of an active system with the solver's ordering and options."""
+    return splu(K.tocsc(), permc_spec=PERMC, options=dict(SPLU_OPTIONS))
 
 
 def sparse_delassus(dyn: Dynamics) -> sp.csr_matrix:
@@ -233,7 +245,7 @@ class StateFactor:
         K = self.sys.matrix(normal, tang)
         t0 = time.perf_counter()
         try:
-            lu = splu(K.tocsc())
+            lu = factorize(K)
         except RuntimeError as exc:  # "Factor is exactly singular"
             raise SingularSystem(str(exc)) from None
         elapsed = time.perf_counter() - t0

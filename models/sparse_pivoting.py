@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .sparse_event import NS, ActiveSystem, SingularSystem, StateFactor
+from .sparse_event import NS, ActiveSystem, SingularSystem, StateFactor, factorize
 
 
 @dataclass
@@ -282,8 +282,6 @@ def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contac
     the other states fixed: the LCP of those unknowns is the principal pivot transform
     M_FF - M_Fa M_aa^-1 M_aF, q_F - M_Fa M_aa^-1 q_a (a: the basic unknowns outside F),
     solved by dense lexicographic Lemke. Sets the factor's states; False when it cannot."""
-    from scipy.sparse.linalg import splu
-
     import lcp
 
     c = ev.c
@@ -305,7 +303,7 @@ def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contac
     qF = ev.q[zF].copy()
     if aX.size:
         try:
-            lu = splu(M[aX][:, aX].tocsc())
+            lu = factorize(M[aX][:, aX])
         except RuntimeError:
             return False
         d = np.abs(lu.U.diagonal())
