@@ -113,7 +113,7 @@ def plot_profile(results: Sequence[Result], path: str | os.PathLike, title: str,
     finite = ratios[np.isfinite(ratios)]
     tau_max = max(2.0, float(finite.max()) * 2 if finite.size else 2.0)
     taus = np.logspace(0, np.log2(tau_max), 400, base=2.0)
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig, ax = plt.subplots(figsize=(7.6, 4.2))
     for k, method in enumerate(methods):
         rho = (ratios[:, k][None, :] <= taus[:, None]).mean(axis=1)
         ax.step(np.log2(taus), rho, where="post", label=method,
@@ -124,7 +124,7 @@ def plot_profile(results: Sequence[Result], path: str | os.PathLike, title: str,
     ax.set_xlim(0, np.log2(tau_max))
     ax.grid(alpha=0.3)
     ax.set_title(title, fontsize=10)
-    ax.legend(fontsize=8, loc="lower right")
+    ax.legend(fontsize=8, loc="center left", bbox_to_anchor=(1.01, 0.5))
     fig.tight_layout()
     path = Path(path)
     fig.savefig(path, dpi=110)
