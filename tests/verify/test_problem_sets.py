@@ -220,10 +220,15 @@ def test_a_folder_is_a_set_of_npz_and_siconos_files(tmp_path):
     b = lcp.LCP(random_p_matrix(4, rng), rng.standard_normal(4))
     a.save(tmp_path / "a.npz")
     write_siconos_lcp(b, tmp_path / "b.dat")
+    mlcp = lcp.MLCP(np.diag([2.0, 4.0]), -np.eye(2), np.eye(2), np.eye(2), [1.0, -2.0],
+                    [0.5, -1.0])
+    mlcp.save(tmp_path / "c.npz")
     (tmp_path / "notes.txt").write_text("ignored")
     problems = get_set(str(tmp_path))
-    assert [p.name for p in problems] == [f"{tmp_path.name}/a", f"{tmp_path.name}/b"]
+    assert [p.name for p in problems] == [f"{tmp_path.name}/{x}" for x in "abc"]
     assert np.array_equal(problems[0].M, a.M) and np.array_equal(problems[1].q, b.q)
+    reduced = mlcp.to_lcp()  # an MLCP enters as its Schur complement
+    assert np.allclose(problems[2].M, reduced.M) and np.allclose(problems[2].q, reduced.q)
     empty = tmp_path / "empty"
     empty.mkdir()
     with pytest.raises(ValueError, match="no \\*.npz"):
