@@ -173,7 +173,9 @@ def _singular_basis(
     b_exact = np.concatenate([zp, Mba @ zp + q[beta]])
     b_ub = b_exact + np.concatenate([np.full(alpha.size, tz), tw[beta]]) / 2
     # Rows that do not depend on y (e.g. duplicated columns) decide at once.
-    free_rows = np.max(np.abs(A_ub), axis=1) <= RCOND * (1.0 + float(np.max(np.abs(A_ub))))
+    absA = np.abs(A_ub)
+    biggest = float(np.max(absA, initial=0.0))
+    free_rows = np.max(absA, axis=1, initial=0.0) <= RCOND * (1.0 + biggest)
     if np.any(b_ub[free_rows] < 0):
         return None
     d = N.shape[1]

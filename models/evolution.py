@@ -155,6 +155,19 @@ def simulate(
     blas_threads: BLAS threads during the run (the event problems are small dense matrices, for
     which one thread is fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
+    if method == "sparse-pivoting":  # the sparse warm-started path (models.sparse_evolution)
+        if select != "none":
+            raise ValueError("method 'sparse-pivoting' keeps the pivoting's own solution: "
+                             "use select='none'")
+        if dump_dir is not None:
+            raise ValueError("method 'sparse-pivoting' does not dump problems (dump_dir)")
+        from .sparse_evolution import simulate_sparse
+
+        return simulate_sparse(system, state, omega=omega, seed=seed, t_max=t_max,
+                               max_events=max_events, check_tol=check_tol,
+                               warm_start=warm_start, zeno_events=zeno_events,
+                               zeno_time=zeno_time, progress=progress, fallback=fallback,
+                               blas_threads=blas_threads)
     if blas_threads is None:
         return _simulate(system, state, method=method, omega=omega, seed=seed, t_max=t_max,
                          max_events=max_events, check_tol=check_tol, warm_start=warm_start,

@@ -48,3 +48,13 @@ def test_simulate_bad_input(args, message, capsys):
 def test_plot_missing_file(tmp_path, capsys):
     assert main(["plot", str(tmp_path / "nope.npz"), "--out", str(tmp_path)]) == 2
     assert "no run file" in capsys.readouterr().err
+
+
+def test_simulate_sparse_path_from_the_command_line(capsys):
+    code = main(["simulate", "--lx", "4", "--ly", "2", "--gamma", "0.16", "--method",
+                 "sparse-pivoting", "--select", "none", "--no-progress", "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["status"] == "steady"
+    assert main(["simulate", "--lx", "4", "--ly", "2", "--method", "sparse-pivoting",
+                 "--no-progress"]) == 2
+    assert "use select='none'" in capsys.readouterr().err
