@@ -197,7 +197,7 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
     c = system.c
     tol_a = acceleration_tol(system)
     scale_v = max(np.abs(dyn.velocities(state.omega, state.V)).max(initial=0.0), 1e-300)
-    recent: list[float] = []
+    zeno = ZenoGuard(zeno_events, zeno_time)
     least_force = None
     prev: EventSolution | None = None
     start = _time.perf_counter()
@@ -285,15 +285,11 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
             run.status, run.message = "event_limit", f"{max_events} events"
             break
         new_state = _advance(state, es, dt, system)
-        # Every contact whose v_t reaches zero now (within rounding) becomes a candidate.
         vt_new = dyn.velocities(new_state.omega, new_state.V)[c:]
-        stuck = closing & ((dt_all <= dt * (1 + 1e-9)) | (np.abs(vt_new) <= 1e-12 * scale_v))
-        new_state.s = np.where(stuck, 0, s)
-        recent = [t for t in recent if new_state.t - t <= zeno_time] + [new_state.t]
-        if len(recent) > zeno_events:
-            run.status = "zeno"
-            run.message = (f"{len(recent)} events within {zeno_time:g} time units before t = "
-                           f"{new_state.t:.6g}: events accumulate")
+        new_state.s = np.where(reaching_zero(closing, dt_all, dt, vt_new, scale_v), 0, s)
+        message = zeno.add(new_state.t)
+        if message:
+            run.status, run.message = "zeno", message
             break
         state = new_state
         if progress is not None:
@@ -301,6 +297,28 @@ def _simulate(system, state, *, method, omega, seed, t_max, max_events, check_to
     run.final = state
     run.wall_time = _time.perf_counter() - start
     return run
+
+
+def reaching_zero(closing: np.ndarray, dt_all: np.ndarray, dt: float, vt_new: np.ndarray,
+                  scale_v: float) -> np.ndarray:
+    """The closing contacts whose v_t reaches zero at the event (within rounding): they become
+    non-sliding candidates together."""
+    return closing & ((dt_all <= dt * (1 + 1e-9)) | (np.abs(vt_new) <= 1e-12 * scale_v))
+
+
+class ZenoGuard:
+    """Events accumulate when more than `events` of them fall within `window` time units."""
+
+    def __init__(self, events: int, window: float):
+        self.events, self.window, self.recent = events, window, []
+
+    def add(self, t: float) -> str:
+        """Record an event time; a message when events accumulate, else ''."""
+        self.recent = [s for s in self.recent if t - s <= self.window] + [t]
+        if len(self.recent) > self.events:
+            return (f"{len(self.recent)} events within {self.window:g} time units before t = "
+                    f"{t:.6g}: events accumulate")
+        return ""
 
 
 def _advance(state: State, es: EventSolution, dt: float, system: System) -> State:

@@ -29,7 +29,7 @@ import numpy as np
 
 from .dynamics import Dynamics
 from .event import State, acceleration_tol, initial_state
-from .evolution import EventRecord, Run
+from .evolution import EventRecord, Run, ZenoGuard, reaching_zero
 from .observables import dissipation_rate, global_friction
 from .sparse_event import NS, ActiveSystem, SingularSystem, StateFactor, sparse_delassus
 from .sparse_pivoting import StateSolution, lcp_residual, solve_states
@@ -51,8 +51,8 @@ def simulate_sparse(
     max_events: int = 100_000,
     check_tol: float = 1e-8,
     warm_start: bool = True,
-    zeno_events: int = 1000,
-    zeno_time: float = 1e-9,
+    zeno_events: int = 200,
+    zeno_time: float = 1e-6,
     progress: Callable[[Run], None] | None = None,
     records: str = "full",
     tol: float = 1e-10,
@@ -97,7 +97,7 @@ def _simulate(system, state, *, omega, seed, t_max, max_events, check_tol, warm_
     run.sparse_info = info
     tol_a = acceleration_tol(system)
     scale_v = max(np.abs(dyn.velocities(state.omega, state.V)).max(initial=0.0), 1e-300)
-    recent: list[float] = []
+    zeno = ZenoGuard(zeno_events, zeno_time)
     factor: StateFactor | None = None
     prev_cand = np.zeros(c, dtype=bool)
     last_full: EventRecord | None = None
@@ -190,13 +190,10 @@ def _simulate(system, state, *, omega, seed, t_max, max_events, check_tol, warm_
             break
         new_state = _advance(state, omega_dot, new_s, dt, system)
         vt_new = dyn.velocities(new_state.omega, new_state.V)[c:]
-        stuck = closing & ((dt_all <= dt * (1 + 1e-9)) | (np.abs(vt_new) <= 1e-12 * scale_v))
-        new_state.s = np.where(stuck, 0, new_s)
-        recent = [t for t in recent if new_state.t - t <= zeno_time] + [new_state.t]
-        if len(recent) > zeno_events:
-            run.status = "zeno"
-            run.message = (f"{len(recent)} events within {zeno_time:g} time units before t = "
-                           f"{new_state.t:.6g}: events accumulate")
+        new_state.s = np.where(reaching_zero(closing, dt_all, dt, vt_new, scale_v), 0, new_s)
+        message = zeno.add(new_state.t)
+        if message:
+            run.status, run.message = "zeno", message
             break
         state = new_state
         if progress is not None:

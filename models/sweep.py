@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from .executors import default_jobs, iter_map
+from .runio import _json_default
 
 #: Sweepable parameters and their types (names as in `models.commands.add_system_arguments`).
 PARAMS: dict[str, type] = {
@@ -300,14 +301,6 @@ def _atomic_write_text(path: Path, text: str) -> None:
             os.unlink(tmp)
 
 
-def _json_default(obj):
-    import numpy as np
-
-    if isinstance(obj, (np.integer, np.floating, np.bool_)):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"not JSON serializable: {type(obj).__name__}")
 
 
 def read_results(out: str | os.PathLike) -> list[dict]:
