@@ -46,13 +46,10 @@ def face_minimum_norm(
     tol: float | None = None,
     eps: float = 1e-10,
     max_walk: int = 20,
-    keep: np.ndarray | None = None,
     z_side: np.ndarray | None = None,
 ) -> FaceResult:
     """The point of the face of z minimizing c'y, then |G y| (see the module docstring).
 
-    keep: indices whose degenerate pairs stay on the z side in the walk (the caller knows w_i
-    must vanish there, e.g. a_n = 0 on every contact of an event without detachment).
     z_side: a boolean mask prescribing, for every degenerate pair (z_i = w_i = 0), the side of
     the face: True lets z_i grow (w_i = 0 kept), False lets w_i grow (z_i = 0 kept). Then each
     step of the walk minimizes over that one face; without it both extreme faces are tried.
@@ -73,14 +70,11 @@ def face_minimum_norm(
         slack = 1e-11 * max(abs(c @ z), scale)
         best_value = c @ z
         seen: set[bytes] = set()
-        kept = np.zeros(q.size, bool)
-        if keep is not None:
-            kept[np.asarray(keep, int)] = True
         for _ in range(max_walk):
             best = None
             w = M @ z + q
-            faces = ((w <= tol, (w <= tol) & ((z > tol) | kept)) if z_side is None
-                     else ((w <= tol) & ((z > tol) | z_side | kept),))
+            faces = ((w <= tol, (w <= tol) & (z > tol)) if z_side is None
+                     else ((w <= tol) & ((z > tol) | z_side),))
             for in_A in faces:  # degenerate pairs: both sides, or the prescribed one
                 key = np.packbits(in_A).tobytes()
                 if key in seen:  # a face already minimized over
@@ -127,19 +121,14 @@ def _residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
 class _Face:
     """F(z) parametrized as y_A = z_A + N x (N: null space of M_AA), y_Ac = 0, Aineq x <= bineq.
 
-    A = {i : w_i = 0}, the largest face; with degenerate_in_A=False the indices where both
-    z_i = w_i = 0 go to the other side (z_i = 0 kept, w_i >= 0 free): the face that lets the
-    degenerate pairs open the other way.
+    A = {i : w_i = 0} (the largest face) unless the caller gives A.
     """
 
     def __init__(self, M: np.ndarray, q: np.ndarray, z: np.ndarray, tol: float,
-                 degenerate_in_A: bool = True, A: np.ndarray | None = None):
+                 A: np.ndarray | None = None):
         w = M @ z + q
         self.z = z
-        in_A = w <= tol
-        if not degenerate_in_A:
-            in_A &= z > tol
-        self.A = np.flatnonzero(in_A) if A is None else np.asarray(A)
+        self.A = np.flatnonzero(w <= tol) if A is None else np.asarray(A)
         Ac = np.setdiff1d(np.arange(q.size), self.A)
         if self.A.size == 0:
             self.nullity = 0
@@ -271,16 +260,6 @@ def _face_lp(M: np.ndarray, q: np.ndarray, A: np.ndarray, c: np.ndarray) -> np.n
     y = np.zeros(q.size)
     y[A] = np.maximum(np.asarray(h.getSolution().col_value), 0.0)
     return y
-
-
-def _lp(c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray):
-    """min c'x s.t. Aineq x <= bineq (x free), by HiGHS."""
-    from scipy.optimize import linprog
-
-    res = linprog(c, A_ub=Aineq, b_ub=bineq, bounds=(None, None), method="highs")
-    if res.status != 0:
-        return None, res.message
-    return res.x, "optimal"
 
 
 def _qp(P: np.ndarray, c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray,
