@@ -28,13 +28,10 @@ def register(sub) -> None:
         "angular velocities, the same for all networks), normal states varying. Segment "
         "widths are proportional to R, on a scale common to all panels. Prints the force "
         "ranges over the admissible set (linear programs), including the global friction F_g.")
-    p.add_argument("--lattice", choices=("rect", "tri"), default="tri")
-    p.add_argument("--lx", type=int, default=5, help="disks in the rows touching both walls")
-    p.add_argument("--ly", type=int, default=4, help="number of rows")
-    p.add_argument("--mu-pp", type=float, default=0.3, help="particle-particle friction")
-    p.add_argument("--mu-plane", type=float, default=0.3, help="particle-plane friction")
-    p.add_argument("--mu-wall", type=float, default=0.0, help="particle-wall friction")
-    p.add_argument("--gamma", type=float, default=0.0, help="acceleration of the box")
+    from models.commands import add_system_arguments
+
+    add_system_arguments(p)  # the system options of `rigidlcp simulate`, with Fig. 4's defaults
+    p.set_defaults(lattice="tri", lx=5, ly=4, mu_pp=0.3, mu_plane=0.3, mu_wall=0.0, gamma=0.0)
     p.add_argument("--seed", type=int, default=0, help="seed of the angular velocities")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
@@ -50,6 +47,7 @@ def register(sub) -> None:
 def cmd_forces(args: argparse.Namespace) -> int:
     import lcp
     import models
+    from models.commands import system_from_args
     from models.event import acceleration_tol
 
     from .certify import certify
@@ -66,9 +64,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
     if args.networks < 1:
         raise ValueError(f"--networks must be >= 1, got {args.networks}")
-    system = models.System(models.make_lattice(args.lattice, args.lx, args.ly),
-                           mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall,
-                           gamma=args.gamma)
+    system = system_from_args(args)
     state = models.initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
     ep = models.event_problem(system, state)
     sol = lcp.solve(ep.lcp, method=args.method)
