@@ -23,6 +23,7 @@ whose Schur complement is the LCP.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -88,11 +89,23 @@ class EventProblem:
     candidates: np.ndarray  # indices of the non-sliding candidates (v_t = 0, mu > 0)
     G: np.ndarray  # lambda = G z
     lcp: LCP
-    mlcp: MLCP = field(repr=False)
+    B: np.ndarray = field(repr=False)  # w = D u + B z + b (shared by the LCP and the MLCP)
+    b: np.ndarray = field(repr=False)
+    t: float = 0.0
 
     @property
     def k(self) -> int:
         return self.candidates.size
+
+    @cached_property
+    def mlcp(self) -> MLCP:
+        """The MLCP in Siconos's layout: M u - H^T G z - f = 0, w = D u + B z + b. Built on
+        first use (a run solves the LCP and never needs it)."""
+        c, k, dyn = self.system.c, self.k, self.dyn
+        H = dyn.H.toarray()
+        D = np.vstack([H[:c], H[c:][self.candidates], np.zeros((k, 3 * self.system.p))])
+        return MLCP(np.diag(1.0 / dyn.Minv), -(H.T @ self.G), D, self.B, -dyn.f, self.b,
+                    name="event", meta={"t": self.t})
 
     def forces(self, z: np.ndarray) -> np.ndarray:
         """lambda = [R; S] of a solution z."""
@@ -154,18 +167,12 @@ def event_problem(system: System, state: State, dyn: Dynamics | None = None) -> 
     slope = np.where(cand_mask, -mu, -s * mu)
     G[c + np.arange(c), np.arange(c)] = slope
     G[c + cand, c + np.arange(k)] = 1.0
-    # Complementarity rows: w = D u + B z + b.
-    H = dyn.H.toarray()
-    P = np.zeros((k, c))
-    P[np.arange(k), cand] = 1.0
-    D = np.vstack([H[:c], P @ H[c:], np.zeros((k, 3 * system.p))])
+    # Complementarity rows: w = D u + B z + b (D in EventProblem.mlcp).
     B = np.zeros((n, n))
     B[c : c + k, c + k :] = np.eye(k)  # a_plus = a_t + a_minus
-    B[c + k :, :c] = 2.0 * mu[cand, None] * P  # 2 mu R - tau
+    B[c + k + np.arange(k), cand] = 2.0 * mu[cand]  # 2 mu R - tau
     B[c + k :, c : c + k] = -np.eye(k)
     b = np.concatenate([dyn.u_obs_dot[:c], dyn.u_obs_dot[c:][cand], np.zeros(k)])
-    mass = 1.0 / dyn.Minv
-    mlcp = MLCP(np.diag(mass), -(H.T @ G), D, B, -dyn.f, b, name="event", meta={"t": state.t})
     # The Schur complement, assembled from W directly (cheaper than through the MLCP).
     WG = dyn.W @ G
     M = B.copy()
@@ -173,7 +180,7 @@ def event_problem(system: System, state: State, dyn: Dynamics | None = None) -> 
     M[c : c + k] += WG[c:][cand]
     q = np.concatenate([dyn.q[:c], dyn.q[c:][cand], np.zeros(k)])
     lcp = LCP(M, q, name="event", meta={"t": state.t, "c": c, "k": k})
-    return EventProblem(system, dyn, s, cand, G, lcp, mlcp)
+    return EventProblem(system, dyn, s, cand, G, lcp, B, b, state.t)
 
 
 def contact_matrix(
