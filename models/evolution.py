@@ -168,14 +168,11 @@ def simulate(
                                warm_start=warm_start, zeno_events=zeno_events,
                                zeno_time=zeno_time, progress=progress, fallback=fallback,
                                blas_threads=blas_threads)
-    if blas_threads is None:
-        return _simulate(system, state, method=method, omega=omega, seed=seed, t_max=t_max,
-                         max_events=max_events, check_tol=check_tol, warm_start=warm_start,
-                         zeno_events=zeno_events, zeno_time=zeno_time, progress=progress,
-                         dump_dir=dump_dir, select=select, fallback=fallback)
+    from contextlib import nullcontext
+
     from threadpoolctl import threadpool_limits
 
-    with threadpool_limits(blas_threads):
+    with nullcontext() if blas_threads is None else threadpool_limits(blas_threads):
         return _simulate(system, state, method=method, omega=omega, seed=seed, t_max=t_max,
                          max_events=max_events, check_tol=check_tol, warm_start=warm_start,
                          zeno_events=zeno_events, zeno_time=zeno_time, progress=progress,
