@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-import lcp
+from rigidlcp import lcp
 
 SYSTEM_PYTHON = "/usr/bin/python3"
 HELPER = Path(__file__).with_name("_siconos_lemke.py")

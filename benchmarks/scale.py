@@ -3,7 +3,7 @@
     python benchmarks/scale.py [--sizes 10,20,40,70,100] [--events 1000] [--budget 600]
                                [--gamma G] [--mu-pp M] [--seed S] [--lattice rect]
 
-For each rectangular array LxL, `models.sparse_evolution.simulate_sparse` runs from the seeded
+For each rectangular array LxL, `rigidlcp.models.engine.sparse.simulate_sparse` runs from the seeded
 random angular velocities for --events events, or to its
 steady state, or until the run's wall clock passes --budget seconds. Printed per size: disks,
 contacts, the events run and why the run stopped, the wall time, the median time per event
@@ -33,9 +33,9 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 import numpy as np  # noqa: E402
 
-import models  # noqa: E402
-from models.sparse_event import factorize  # noqa: E402
-from models.sparse_evolution import simulate_sparse  # noqa: E402
+from rigidlcp import models  # noqa: E402
+from rigidlcp.models.engine.sparse import simulate_sparse  # noqa: E402
+from rigidlcp.models.sparse_event import factorize  # noqa: E402
 
 
 class Budget(Exception):

@@ -23,7 +23,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 import numpy as np  # noqa: E402
 
-import models  # noqa: E402
+from rigidlcp import models  # noqa: E402
 
 CASES = {"rect10x4": ("rect", 10, 4, 0.16), "rect20x10": ("rect", 20, 10, 0.1),
          "rect40x20": ("rect", 40, 20, 0.1), "tri10x4": ("tri", 10, 4, 0.16)}

@@ -16,13 +16,7 @@ from typing import Any
 
 import numpy as np
 
-
-class InvalidProblem(ValueError):
-    """Bad input: the message names the offending argument and what was expected."""
-
-
-class NotApplicable(ValueError):
-    """A method (or a reduction) refuses a well-formed problem, and says why."""
+from .errors import InvalidProblem, NotApplicable
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:

@@ -4,6 +4,7 @@ Dependencies point lcp <- models <- verify: this package imports `lcp`, never `v
 """
 
 from .dynamics import Dynamics
+from .engine.dense import Run, simulate
 from .event import (
     EventProblem,
     EventSolution,
@@ -12,7 +13,6 @@ from .event import (
     event_problem,
     initial_state,
 )
-from .evolution import Run, simulate
 from .lattice import (
     LEFT_WALL,
     PLANE,

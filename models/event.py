@@ -27,7 +27,7 @@ from functools import cached_property
 
 import numpy as np
 
-from lcp import LCP, MLCP
+from rigidlcp.lcp import LCP, MLCP
 
 from .dynamics import Dynamics
 from .system import System

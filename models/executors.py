@@ -1,7 +1,7 @@
 """Executors for independent tasks: in-process, a local process pool, or Dask.
 
 `iter_map(func, items, jobs=..., dask=...)` yields (index, func(item)) as the items finish.
-Used by sweeps (`models.sweep`) and by the reproduction (`verify.reproduce`). func and the items
+Used by sweeps (`models.sweep`) and by the reproduction (reproduce). func and the items
 must be picklable (a module-level function or a picklable callable object); Dask workers must
 be able to import them (rigidlcp installed on every worker).
 """

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rigidlcp.lcp.errors import InvalidInput
+
 #: Codes of the obstacles in `Lattice.j` (disks have indices >= 0).
 LEFT_WALL, RIGHT_WALL, PLANE = -1, -2, -3
 OBSTACLE_NAMES = {LEFT_WALL: "left wall", RIGHT_WALL: "right wall", PLANE: "plane"}
@@ -26,7 +28,7 @@ OBSTACLE_NAMES = {LEFT_WALL: "left wall", RIGHT_WALL: "right wall", PLANE: "plan
 KINDS = ("pp", "plane", "wall")
 
 
-class InvalidSystem(ValueError):
+class InvalidSystem(InvalidInput):
     """A lattice or system that cannot be built; the message names the parameter."""
 
 

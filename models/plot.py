@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .evolution import Run
+from rigidlcp.models.engine.dense import Run
+
 from .lattice import LEFT_WALL, PLANE, RIGHT_WALL
 from .system import System
 

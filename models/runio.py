@@ -14,8 +14,9 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidlcp.models.engine.dense import EventRecord, Run
+
 from .event import State
-from .evolution import EventRecord, Run
 from .system import make_system
 
 FORMAT = "rigidlcp-run/1"

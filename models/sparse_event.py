@@ -61,6 +61,8 @@ from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
 from scipy.linalg.lapack import dgecon
 from scipy.sparse.linalg import splu
 
+from rigidlcp.lcp.errors import RigidLCPError
+
 from .dynamics import Dynamics
 from .event import State
 from .system import System
@@ -106,7 +108,7 @@ class SparseMLCP:
 
     def to_dense(self):
         """The same problem as an lcp.MLCP (small systems only)."""
-        from lcp import MLCP
+        from rigidlcp.lcp import MLCP
 
         return MLCP(*(m.toarray() for m in (self.A, self.C, self.D, self.B)), self.a, self.b)
 
@@ -210,7 +212,7 @@ class ActiveSystem:
         return out
 
 
-class SingularSystem(Exception):
+class SingularSystem(RigidLCPError):
     """The active system of a vector of states is singular (to the stated tolerance)."""
 
 

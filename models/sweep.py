@@ -39,7 +39,7 @@ from typing import Any
 from .executors import default_jobs, iter_map
 from .runio import _json_default
 
-#: Sweepable parameters and their types (names as in `models.commands.add_system_arguments`).
+#: Sweepable parameters and their types (names as in `rigidlcp.cli.simulate.add_system_arguments`).
 PARAMS: dict[str, type] = {
     "lattice": str, "lx": int, "ly": int, "mu_pp": float, "mu_plane": float,
     "mu_wall": float, "gamma": float, "v0": float, "inertia": float, "seed": int,
@@ -181,8 +181,9 @@ def run_point(point: dict, runs_dir: str | None = None) -> dict:
     status "error" with the message: they are results, deterministic like the others."""
     import time
 
+    from rigidlcp.models.engine.dense import simulate
+
     from .event import initial_state
-    from .evolution import simulate
     from .observables import state_counts
     from .system import make_system
 

@@ -29,7 +29,7 @@ import numpy as np
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from lcp import LCP, MLCP
+from rigidlcp.lcp import LCP, MLCP
 
 __all__ = [
     "P_KINDS", "p_matrices", "symmetric_psd", "lcps", "degenerate_lcps", "mlcps",
@@ -255,7 +255,7 @@ def lattices(draw, kinds: tuple[str, ...] = ("rect", "tri"), lx: SizeLike = LX,
              ly: SizeLike = LY):
     """``models.Lattice`` of a drawn kind and size; triangular arrays of two or more rows get
     lx >= 2 (their rows in the hollows hold lx - 1 disks)."""
-    import models
+    from rigidlcp import models
 
     kind = draw(st.sampled_from(kinds))
     n_rows = _size(draw, ly)
@@ -270,7 +270,7 @@ def systems(draw, lattice=None, mu: st.SearchStrategy[float] | None = None,
     """``models.System`` on ``lattice`` (a Lattice, a strategy of them, or None for
     ``lattices()``), coefficients per kind from ``mu`` (default 0 to 0.5 on a grid, 0 included)
     and driving acceleration from ``gamma`` (default -0.5 to 0.5)."""
-    import models
+    from rigidlcp import models
 
     if lattice is None:
         lattice = lattices()
@@ -296,7 +296,7 @@ def event_states(draw, system, candidates: st.SearchStrategy[float] | None = Non
     """``models.State`` at t = 0: angular velocities in [-1, 1] (grid) and per contact +1 / -1
     (sliding that way) or 0 (non-sliding candidate, drawn with probability ``candidates``,
     default in [0, 1]); frictionless contacts carry 0."""
-    import models
+    from rigidlcp import models
 
     p, c = system.p, system.c
     omega = _vector(draw, p)

@@ -11,8 +11,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import lcp
-from lcp.lemke import lemke
+from rigidlcp import lcp
+from rigidlcp.lcp.lemke import lemke
 
 # --------------------------------------------------------------------------------------------
 # Exact reference: Lemke's method with the lexicographic ratio test, in rational arithmetic.
@@ -388,7 +388,7 @@ def test_lemke_is_registered():
 def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
     """A basis that repeats proves rounding defeated the lexicographic rule: Lemke says so and
     restarts with coarser ties. Forced here: the first attempt reports a cycle."""
-    import lcp.lemke as lemke_module
+    import rigidlcp.lcp.lemke as lemke_module
 
     M = np.array([[2.0, 1.0], [1.0, 2.0]])
     q = np.array([-1.0, -1.0])

@@ -7,9 +7,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import lcp
-from lcp.enumeration import enumerate_solutions
-from verify.strategies import degenerate_lcps, lcps, mlcps, p_matrices, symmetric_psd
+from rigidlcp import lcp
+from rigidlcp.lcp.enumeration import enumerate_solutions
+from rigidlcp.verify.strategies import degenerate_lcps, lcps, mlcps, p_matrices, symmetric_psd
 
 SETTINGS = settings(max_examples=40, deadline=None,
                     suppress_health_check=[HealthCheck.too_slow])

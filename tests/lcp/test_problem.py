@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import lcp
+from rigidlcp import lcp
 
 GOOD_M, GOOD_Q = np.eye(2), np.array([-1.0, 1.0])
 

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from models.effective import derivative, from_rows, legendre
+from rigidlcp.models.effective import derivative, from_rows, legendre
 
 M_G = 10.0
 

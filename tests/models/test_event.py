@@ -8,11 +8,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import lcp
-import models
-from models.dynamics import Dynamics
-from models.event import State, contact_matrix, event_problem
-from verify.laws import check_contact_laws
+from rigidlcp import lcp, models
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.event import State, contact_matrix, event_problem
+from rigidlcp.verify.certificates.laws import check_contact_laws
 
 TOL = 1e-8
 

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import models
-from models.lattice import LEFT_WALL, PLANE, RIGHT_WALL, InvalidSystem
+from rigidlcp import models
+from rigidlcp.models.lattice import LEFT_WALL, PLANE, RIGHT_WALL, InvalidSystem
 
 
 def contact_count(kind: str, lx: int, ly: int) -> int:

@@ -8,11 +8,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import lcp
-import models
-from models.dynamics import Dynamics
-from models.event import State, contact_matrix, event_problem, initial_state
-from models.sparse_event import (
+from rigidlcp import lcp, models
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.engine.sparse import simulate_sparse
+from rigidlcp.models.engine.sparse_pivoting import solve_states
+from rigidlcp.models.event import State, contact_matrix, event_problem, initial_state
+from rigidlcp.models.sparse_event import (
     NS,
     ActiveSystem,
     SingularSystem,
@@ -20,8 +21,6 @@ from models.sparse_event import (
     sparse_delassus,
     sparse_mlcp,
 )
-from models.sparse_evolution import simulate_sparse
-from models.sparse_pivoting import solve_states
 
 FIG9 = dict(mu_pp=0.1, mu_plane=0.2, mu_wall=0.0, gamma=0.16)
 

@@ -9,8 +9,8 @@ import time
 
 import pytest
 
-from models.cli import main
-from models.sweep import (
+from rigidlcp.cli.main import main
+from rigidlcp.models.sweep import (
     RESULTS,
     ResultsFile,
     Sweep,
@@ -102,7 +102,7 @@ def test_results_file_ignores_a_torn_line(tmp_path):
 # --- resume after kill -9 -----------------------------------------------------------------------
 
 def _cli(*args: str) -> list[str]:
-    return [sys.executable, "-c", "import sys; from models.cli import main; "
+    return [sys.executable, "-c", "import sys; from rigidlcp.cli.main import main; "
             "sys.exit(main(sys.argv[1:]))", *args]
 
 

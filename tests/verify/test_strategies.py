@@ -8,8 +8,15 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import lcp
-from verify.strategies import P_KINDS, degenerate_lcps, lcps, mlcps, p_matrices, symmetric_psd
+from rigidlcp import lcp
+from rigidlcp.verify.strategies import (
+    P_KINDS,
+    degenerate_lcps,
+    lcps,
+    mlcps,
+    p_matrices,
+    symmetric_psd,
+)
 
 SETTINGS = settings(max_examples=60, deadline=None)
 

@@ -4,10 +4,9 @@ they make are well formed and solved by Lemke with the contact laws holding."""
 import numpy as np
 from hypothesis import given, settings
 
-import lcp
-import models
-from verify.laws import check_contact_laws
-from verify.strategies import contact_states, event_states, lattices, systems
+from rigidlcp import lcp, models
+from rigidlcp.verify.certificates.laws import check_contact_laws
+from rigidlcp.verify.strategies import contact_states, event_states, lattices, systems
 
 
 @settings(max_examples=30, deadline=None)

@@ -1,0 +1,1 @@
+"""The event engine: one event loop (Sec. II C) with dense and sparse backends."""

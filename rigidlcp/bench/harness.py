@@ -1,0 +1,220 @@
+"""The solver-comparison harness behind ``rigidlcp bench`` (issue 6).
+
+Every method is run on every problem of the chosen sets, one solve at a time, with a time limit
+per solve, and every answer is checked here, never taken from the solver:
+
+* a claimed solution ("solved") is certified by `verify.certify` (uniqueness "none": the
+  residual certificate only, scaled residual <= tol); uncertified counts as a failure;
+* a claim that no solution exists ("infeasible", or Lemke's "ray") is accepted only when an LP
+  (HiGHS) finds a Farkas certificate y >= 0, M'y <= 0, q'y < 0, i.e. proves that no z >= 0
+  has M z + q >= 0. (An LCP can be feasible and still have no solution when M is not
+  copositive-plus; such a claim cannot be certified this way and counts as a failure.)
+* a solve longer than the time limit, a refusal (NotApplicable), an exception, or any other
+  status (max_iter, not_converged, failed) is a failure.
+
+Isolation: rigidlcp's methods run in a worker process forked from this one (so methods
+registered at run time, e.g. test doubles, are there too); a solve that does not answer within
+the limit is killed with its worker, and a fresh worker takes the next solve. The time is
+measured in the worker around `lcp.solve` (validation, the method, w = M z + q); each method
+first solves a 2 x 2 problem, untimed, in every fresh worker (imports, caches). The worker
+uses one BLAS thread (threadpoolctl): solves never run in parallel.
+
+Siconos's Lemke, enumeration and PGS ("siconos-lemke", "siconos-enum", "siconos-pgs") run in
+a long-lived /usr/bin/python3 subprocess (verify/_siconos_bench_helper.py, problems passed as
+.npy files, only the driver call timed) when that interpreter can import siconos.numerics.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from collections.abc import Callable, Iterable
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+from scipy.optimize import linprog
+
+from rigidlcp import lcp
+from rigidlcp.lcp import LCP, MLCP
+from rigidlcp.verify.certificates.certify import certify
+
+from .runners import GRACE, SICONOS_METHODS, LocalRunner, SiconosRunner
+
+__all__ = ["Result", "judge", "run_bench", "farkas_certificate", "write_csv", "read_csv",
+           "available_methods", "LocalRunner", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
+
+#: Claims that no solution exists.
+NO_SOLUTION = ("infeasible", "ray")
+
+
+@dataclass
+class Result:
+    """One (problem, method) solve. outcome: "solved" (certified solution), "infeasible"
+    (certified: an LP proved it), or the failure: "uncertified", "timeout", "not_applicable",
+    "error", "unproved_infeasible", or the method's own status (max_iter, not_converged,
+    failed, ray on a feasible problem, ...)."""
+
+    set: str
+    problem: str
+    n: int
+    method: str
+    outcome: str
+    success: bool
+    status: str  # what the method said
+    time: float  # seconds of the solve (the time limit for timeouts)
+    iterations: int | None
+    residual: float  # max|min(z, w)| with w = M z + q recomputed here (nan: no point)
+    scaled_residual: float  # verify.certify's acceptance measure (nan: no point)
+    expected: str
+    message: str = ""
+
+
+CSV_FIELDS = [f.name for f in fields(Result)]
+
+
+# --------------------------------------------------------------------------------------------
+# certification of claims that no solution exists
+# --------------------------------------------------------------------------------------------
+
+def farkas_certificate(M: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+    """y >= 0 with M'y <= 0 and q'y <= -1 (scaled), found by an LP, or None.
+
+    Such a y proves that {z >= 0 : M z + q >= 0} is empty: y'(M z + q) = (M'y)'z + q'y < 0.
+    The LP is solved on M, q scaled to max|entry| = 1; the certificate is re-checked with a
+    margin of 1e-9 relative to |y| and the data.
+    """
+    n = q.size
+    s = max(float(np.abs(M).max(initial=0.0)), float(np.abs(q).max(initial=0.0)), 1e-300)
+    Ms, qs = M / s, q / s
+    A = np.vstack([Ms.T, qs[None, :]])
+    b = np.concatenate([np.zeros(n), [-1.0]])
+    res = linprog(np.zeros(n), A_ub=A, b_ub=b, bounds=[(0, None)] * n, method="highs")
+    if res.status != 0:
+        return None
+    y = np.maximum(res.x, 0.0)
+    ynorm = float(np.abs(y).sum())
+    if qs @ y >= -0.5 or np.any(Ms.T @ y > 1e-9 * max(ynorm, 1.0)):
+        return None
+    return y
+
+
+# --------------------------------------------------------------------------------------------
+# the run
+# --------------------------------------------------------------------------------------------
+
+def judge(problem: LCP, method: str, set_name: str, raw: dict, time_limit: float,
+          tol: float) -> Result:
+    """Turn a runner's raw answer into a Result, certifying it (see the module doc)."""
+    expected = str(problem.meta.get("expected", "unknown"))
+    base = dict(set=set_name, problem=problem.name, n=problem.n, method=method,
+                expected=expected, message=raw.get("message", ""))
+    kind = raw["kind"]
+    if kind != "answer":
+        t = time_limit if kind == "timeout" else float(raw.get("time", 0.0))
+        return Result(**base, outcome=kind, success=False, status=kind, time=t,
+                      iterations=None, residual=math.nan, scaled_residual=math.nan)
+    status, t, z = raw["status"], float(raw["time"]), raw["z"]
+    res = scaled = math.nan
+    if z.shape == (problem.n,) and np.all(np.isfinite(z)):
+        with np.errstate(all="ignore"):
+            cert = certify(problem, z, tol=tol, uniqueness="none")
+        res, scaled = cert.residual, cert.scaled_residual
+        accepted = cert.accepted
+    else:
+        accepted = False
+    if t > time_limit:
+        outcome = "timeout"
+    elif status == "solved":
+        outcome = "solved" if accepted else "uncertified"
+    elif status in NO_SOLUTION:
+        proved = farkas_certificate(problem.M, problem.q) is not None
+        outcome = "infeasible" if proved else "unproved_infeasible"
+    else:
+        outcome = status
+    return Result(**base, outcome=outcome, success=outcome in ("solved", "infeasible"),
+                  status=status, time=min(t, time_limit) if outcome != "timeout" else time_limit,
+                  iterations=raw.get("iterations"), residual=res, scaled_residual=scaled)
+
+
+def available_methods(siconos: SiconosRunner | None) -> list[str]:
+    """rigidlcp's registered methods, and Siconos's when its runner is available."""
+    names = [m.name for m in lcp.methods()]
+    if siconos is not None and siconos.available:
+        names += list(SICONOS_METHODS)
+    return names
+
+
+def run_bench(
+    sets: dict[str, list[LCP | MLCP]], methods: Iterable[str], *, time_limit: float = 10.0,
+    tol: float = 1e-8, isolate: bool = True, siconos: SiconosRunner | None = None,
+    progress: Callable[[Result], None] | None = None, grace: float = GRACE,
+) -> list[Result]:
+    """Run every method on every problem of `sets` ({set name: problems}); one Result each.
+
+    methods: rigidlcp method names (lcp.methods()) and "siconos-*" names (need `siconos`,
+    an available SiconosRunner). An unknown name raises ValueError before anything runs.
+    time_limit: seconds per solve; grace: extra seconds allowed for passing data to and from
+    the worker before it is killed (a solve measured above time_limit fails either way).
+    """
+    methods = list(methods)
+    known = {m.name for m in lcp.methods()}
+    for m in methods:
+        if m not in known and m not in SICONOS_METHODS:
+            raise ValueError(f"unknown method {m!r}; available: "
+                             f"{', '.join(sorted(known) + list(SICONOS_METHODS))}")
+        if m in SICONOS_METHODS and (siconos is None or not siconos.available):
+            raise ValueError(f"{m} needs Siconos: "
+                             f"{siconos.reason if siconos else 'no Siconos runner given'}")
+    local = LocalRunner(isolate, grace)
+    results: list[Result] = []
+    try:
+        for set_name, problems in sets.items():
+            for problem in problems:
+                if isinstance(problem, MLCP):
+                    problem = problem.to_lcp()
+                for method in methods:
+                    runner = siconos if method in SICONOS_METHODS else local
+                    raw = runner.solve(problem, method, time_limit)
+                    r = judge(problem, method, set_name, raw, time_limit, tol)
+                    results.append(r)
+                    if progress is not None:
+                        progress(r)
+    finally:
+        local.close()
+    return results
+
+
+def write_csv(results: list[Result], path: str | os.PathLike) -> Path:
+    """results.csv: one row per (problem, method), the columns of `Result`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
+        writer.writeheader()
+        for r in results:
+            row = asdict(r)
+            row["time"] = f"{r.time:.6g}"
+            for key in ("residual", "scaled_residual"):
+                row[key] = "" if math.isnan(row[key]) else f"{row[key]:.3e}"
+            row["iterations"] = "" if r.iterations is None else r.iterations
+            writer.writerow(row)
+    return path
+
+
+def read_csv(path: str | os.PathLike) -> list[Result]:
+    """Results back from results.csv (e.g. to redo a report)."""
+    out = []
+    with open(path, newline="") as fh:
+        for row in csv.DictReader(fh):
+            out.append(Result(
+                set=row["set"], problem=row["problem"], n=int(row["n"]), method=row["method"],
+                outcome=row["outcome"], success=row["success"] == "True", status=row["status"],
+                time=float(row["time"]),
+                iterations=int(row["iterations"]) if row["iterations"] else None,
+                residual=float(row["residual"]) if row["residual"] else math.nan,
+                scaled_residual=(float(row["scaled_residual"]) if row["scaled_residual"]
+                                 else math.nan),
+                expected=row["expected"], message=row["message"]))
+    return out

@@ -1,0 +1,152 @@
+"""`rigidlcp bench`: run LCP methods on named problem sets, certify every answer, and write
+DIR/results.csv, DIR/report.md and performance profiles (bench.harness, bench.report).
+Usage: docs/bench.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import platform
+import shlex
+import sys
+
+DEFAULT_METHODS = "lemke,pivoting,pgs,qp-clarabel,qp-osqp,enumerate"
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "bench", help="compare LCP methods on named problem sets, every answer certified",
+        description="Run every method on every problem of the sets with a time limit per "
+        "solve, certify each answer with verify (an uncertified answer is a failure), and "
+        "write OUT/results.csv, OUT/report.md (success rate, shifted geometric mean of the "
+        "solve time, iterations, worst residual per set and method) and Dolan-More "
+        "performance profiles OUT/profile_*.png. Siconos's Lemke, enumeration and PGS are "
+        "added when /usr/bin/python3 can import siconos.numerics.",
+        epilog="Sets: see --list; a directory of *.npz / *.dat (Siconos format) files is a "
+        "set too. Methods: rigidlcp's (`rigidlcp methods`) and siconos-lemke, siconos-enum, "
+        "siconos-pgs. Exit status 0 when the run completed (whatever the success rates).")
+    p.add_argument("--set", dest="sets", metavar="NAME[,NAME]",
+                   help="problem sets (names or directories), comma-separated")
+    p.add_argument("--methods", default=None, metavar="M[,M]",
+                   help=f"methods, comma-separated (default: {DEFAULT_METHODS}, plus "
+                   "siconos-lemke,siconos-enum,siconos-pgs when Siconos is available)")
+    p.add_argument("--out", metavar="DIR", help="output directory")
+    p.add_argument("--time-limit", type=float, default=10.0, metavar="S",
+                   help="seconds per solve; a longer solve is killed and fails (default 10)")
+    p.add_argument("--tol", type=float, default=1e-8,
+                   help="certification tolerance on the scaled residual (default 1e-8)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the generated sets")
+    p.add_argument("--sizes", default=None, metavar="N[,N]",
+                   help="sizes n for the generated sets (default: each set's own)")
+    p.add_argument("--per-size", type=int, default=None, help="problems per size")
+    p.add_argument("--cache", default=None, metavar="DIR",
+                   help="where event sets are harvested (default $RIGIDLCP_CACHE or "
+                   "~/.cache/rigidlcp)")
+    p.add_argument("--no-siconos", action="store_true", help="do not look for Siconos")
+    p.add_argument("--no-isolation", action="store_true",
+                   help="solve in this process (the time limit is then checked afterwards, "
+                   "a solve cannot be interrupted)")
+    p.add_argument("--list", action="store_true", help="list the sets and methods and exit")
+    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.set_defaults(func=cmd_bench)
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from rigidlcp import lcp
+    from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, run_bench, write_csv
+    from rigidlcp.bench.problem_sets import SETS, get_set, list_sets
+    from rigidlcp.bench.report import write_report
+
+    siconos = None if args.no_siconos else SiconosRunner()
+    try:
+        if args.list:
+            print("sets:")
+            for s in list_sets():
+                print(f"  {s.name:<13} {s.problem_class}; expected: {s.expected}. "
+                      f"{s.description}")
+            print("  DIR           a directory of *.npz / *.dat (Siconos format) files")
+            print("methods:")
+            for m in lcp.methods():
+                print(f"  {m.name}")
+            for m in SICONOS_METHODS:
+                state = ("available" if siconos is not None and siconos.available
+                         else f"unavailable: {siconos.reason if siconos else '--no-siconos'}")
+                print(f"  {m:<13} ({state})")
+            return 0
+        if not args.sets or not args.out:
+            raise ValueError("--set and --out are required (or --list)")
+        if args.time_limit <= 0 or args.tol <= 0:
+            raise ValueError("--time-limit and --tol must be positive")
+        notes: list[str] = []
+        siconos_ok = siconos is not None and siconos.available
+        if args.methods:
+            methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        else:
+            methods = DEFAULT_METHODS.split(",") + (list(SICONOS_METHODS) if siconos_ok else [])
+        absent = [m for m in methods if m in SICONOS_METHODS and not siconos_ok]
+        if absent:
+            why = siconos.reason if siconos is not None else "--no-siconos"
+            notes.append(f"skipped {', '.join(absent)}: Siconos unavailable ({why})")
+            methods = [m for m in methods if m not in absent]
+        elif not siconos_ok and not args.methods:
+            why = siconos.reason if siconos is not None else "--no-siconos"
+            notes.append(f"Siconos methods not run: {why}")
+        if siconos_ok and any(m in SICONOS_METHODS for m in methods):
+            notes.append(f"Siconos: python3-siconos {siconos.version} in a {siconos.python} "
+                         "subprocess; only its driver call is timed; siconos-lemke is given "
+                         "max_iter = 1000 + 100 n (as rigidlcp's lemke), siconos-pgs tol "
+                         "1e-10 and 10000 sweeps (as rigidlcp's pgs), siconos-enum n <= 20; "
+                         "a nonzero Siconos info is a failure (it proves nothing)")
+        params = {}
+        if args.sizes:
+            params["sizes"] = tuple(int(s) for s in args.sizes.split(","))
+        if args.per_size is not None:
+            params["per_size"] = args.per_size
+        sets, set_info = {}, {}
+        for spec in [s.strip() for s in args.sets.split(",") if s.strip()]:
+            kw = params if spec in SETS and not spec.startswith("events-") else {}
+            problems = get_set(spec, seed=args.seed, cache_dir=args.cache, **kw)
+            name = spec if spec in SETS else os.path.basename(os.path.normpath(spec))
+            sets[name] = problems
+            info = SETS.get(spec)
+            set_info[name] = (f"{info.problem_class}; expected answer: {info.expected}."
+                              if info else f"folder {spec}.")
+        load0 = os.getloadavg()[0]
+        started = datetime.datetime.now().isoformat(timespec="seconds")
+        total = sum(len(p) for p in sets.values()) * len(methods)
+        done = [0]
+
+        def progress(r) -> None:
+            done[0] += 1
+            if not args.quiet:
+                print(f"[{done[0]}/{total}] {r.problem:<40} {r.method:<14} {r.outcome:<14} "
+                      f"{1e3 * r.time:10.2f} ms", flush=True)
+
+        results = run_bench(sets, methods, time_limit=args.time_limit, tol=args.tol,
+                            isolate=not args.no_isolation, siconos=siconos, progress=progress)
+        import numpy as np
+
+        header = [
+            f"Command: `rigidlcp bench {' '.join(shlex.quote(a) for a in sys.argv[2:])}`"
+            if sys.argv[1:2] == ["bench"] else "Command: `rigidlcp bench` (called from Python)",
+            "",
+            f"Started {started}; Python {platform.python_version()}, numpy {np.__version__}, "
+            f"{os.cpu_count()} CPUs; load average {load0:.2f} at the start, "
+            f"{os.getloadavg()[0]:.2f} at the end. One solve at a time, one BLAS thread; the "
+            "machine may be shared with other jobs, so times are indicative.",
+            "",
+            f"Sets: {', '.join(sets)}; methods: {', '.join(methods)}; time limit "
+            f"{args.time_limit:g} s per solve; seed {args.seed}.",
+        ]
+        csv_path = write_csv(results, os.path.join(args.out, "results.csv"))
+        report = write_report(results, args.out, time_limit=args.time_limit, tol=args.tol,
+                              set_info=set_info, header=header, notes=notes)
+        print(f"wrote {csv_path} and {report}")
+        for line in notes:
+            print(f"note: {line}")
+        return 0
+    finally:
+        if siconos is not None:
+            siconos.close()

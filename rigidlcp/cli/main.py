@@ -1,0 +1,69 @@
+"""The `rigidlcp` command line: the parser, and the one place that turns errors into messages.
+
+Each module in `COMMAND_MODULES` adds its sub-commands with `register(subparsers)` and keeps
+its heavy imports inside the commands, so that `rigidlcp --help` stays fast. An error raised on
+purpose by the toolkit (`rigidlcp.lcp.errors.RigidLCPError`), a bad value, or a file that is
+missing, exists already or cannot be written, is printed as one line naming the problem, with
+exit status 2: never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from rigidlcp.lcp.errors import RigidLCPError
+
+#: The command modules, in the order of `rigidlcp --help`.
+COMMAND_MODULES = (
+    "rigidlcp.cli.solve",  # methods, solve
+    "rigidlcp.cli.simulate",  # simulate, plot
+    "rigidlcp.cli.sweep",  # sweep, effective
+    "rigidlcp.cli.nullspace",  # nullspace, verify-formulas
+    "rigidlcp.cli.forces",  # forces
+    "rigidlcp.cli.bench",  # bench
+    "rigidlcp.cli.reproduce",  # reproduce
+)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from rigidlcp import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="rigidlcp",
+        description="Rigid disks with Signorini's condition and exact Coulomb friction as LCPs "
+        "(Radjai, Brendel & Roux, PRE 54, 861, 1996).",
+    )
+    parser.add_argument("--version", action="version", version=f"rigidlcp {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (RigidLCPError, ValueError, OSError) as exc:
+        print(f"rigidlcp {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more
+        sys.stderr.close()
+        return 0
+
+
+def _one_line(exc: BaseException) -> str:
+    """The message of an error on one line (OSError: 'strerror: filename')."""
+    if isinstance(exc, OSError) and exc.filename and not isinstance(exc, RigidLCPError):
+        text = f"{exc.strerror or type(exc).__name__}: {exc.filename}"
+    else:
+        text = str(exc) or type(exc).__name__
+    return " ".join(text.split())
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,56 @@
+"""`rigidlcp reproduce`: the paper's Sec. IV experiments, claims table and figures."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "reproduce", help="run the paper's experiments and judge each claim (report.md)",
+        description="Runs the experiments of Sec. IV (Figs. 6-13) and Eqs. (3.3)-(3.4) at the "
+        "parameters of the captions, and writes OUT/report.md: each claim of the paper, the "
+        "measured number, the criterion and PASS/FAIL, with the figures as PNGs and the "
+        "claims as OUT/claims.json. A few minutes with the default executor "
+        "(docs/reproduction.md). Exit status 0 when every claim was evaluated (whatever its "
+        "verdict), 1 when an evaluation failed.")
+    p.add_argument("--out", required=True, help="directory of the report")
+    p.add_argument("--quick", action="store_true",
+                   help="small sizes (seconds; for tests): every claim is evaluated, but the "
+                   "sizes are not the paper's")
+    p.add_argument("--jobs", "-j", type=int, default=None,
+                   help="worker processes (default: the CPUs available; 1: in this process)")
+    p.add_argument("--dask", default=None, metavar="tcp://HOST:PORT|local",
+                   help="run the jobs on a dask.distributed scheduler or a LocalCluster")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=cmd_reproduce)
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from rigidlcp.reproduce.claims import evaluate
+    from rigidlcp.reproduce.experiments import plan, run_all
+    from rigidlcp.reproduce.report import figures, write_report
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    command = "rigidlcp reproduce " + " ".join(
+        shlex.quote(a) for a in (sys.argv[2:] if sys.argv[1:2] == ["reproduce"] else
+                                 ["--out", str(out)] + (["--quick"] if args.quick else [])))
+    p = plan(quick=args.quick)
+    res = run_all(p, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
+    claims = evaluate(res)
+    files = figures(res, out)
+    path = write_report(res, claims, out, files, command)
+    width = max(len(c.id) for c in claims)
+    for c in claims:
+        print(f"{c.verdict}  {c.id:<{width}}  {c.measured}")
+    n_pass = sum(c.passed for c in claims)
+    print(f"{n_pass} PASS, {len(claims) - n_pass} FAIL; report: {path} "
+          f"({res.wall_time:.0f} s on {res.executor})")
+    errors = [c for c in claims if c.error]
+    for c in errors:
+        print(f"{c.id}: evaluation error: {c.error}", file=sys.stderr)
+    return 1 if errors else 0

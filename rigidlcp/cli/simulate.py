@@ -1,0 +1,144 @@
+"""`rigidlcp simulate` and `rigidlcp plot`."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+
+import numpy as np
+
+
+def add_system_arguments(p: argparse.ArgumentParser) -> None:
+    """The options that define a system (shared with other commands)."""
+    g = p.add_argument_group("system")
+    g.add_argument("--lattice", choices=("rect", "tri"), default="rect")
+    g.add_argument("--lx", type=int, default=10, help="disks in the rows touching both walls")
+    g.add_argument("--ly", type=int, default=4, help="number of rows")
+    g.add_argument("--mu-pp", type=float, default=0.1, help="particle-particle friction")
+    g.add_argument("--mu-plane", type=float, default=0.2, help="particle-plane friction")
+    g.add_argument("--mu-wall", type=float, default=0.0, help="particle-wall friction")
+    g.add_argument("--gamma", type=float, default=0.1,
+                   help="acceleration of the box relative to the plane, in g "
+                   "(0: constant velocity)")
+    g.add_argument("--v0", type=float, default=0.0,
+                   help="initial velocity of the box relative to the plane (sqrt(g r))")
+    g.add_argument("--inertia", type=float, default=None,
+                   help="moment of inertia (default m r^2/2)")
+
+
+def system_from_args(args):
+    from rigidlcp.models.system import make_system
+
+    return make_system(args.lattice, args.lx, args.ly, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
+                       mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
+
+
+def register(sub) -> None:
+    p = sub.add_parser("simulate", help="evolve an array event by event to its steady state",
+                       description="Exact event-driven evolution of a disk array (Sec. II C, IV).")
+    add_system_arguments(p)
+    g = p.add_argument_group("run")
+    g.add_argument("--seed", type=int, default=1, help="seed of the initial angular velocities")
+    g.add_argument("--omega-scale", type=float, default=1.0,
+                   help="initial angular velocities uniform in [-scale, scale]")
+    g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
+    g.add_argument("--fallback", default="lemke",
+                   help="method used at an event where --method fails ('none': stop)")
+    g.add_argument("--select", choices=("face-min-norm", "none"), default="face-min-norm",
+                   help="particular solution when an event's solution is not unique")
+    g.add_argument("--t-max", type=float, default=np.inf)
+    g.add_argument("--max-events", type=int, default=100_000)
+    g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")
+    g.add_argument("--dump-problems", default=None, metavar="DIR",
+                   help="write every event's LCP to DIR/event_NNNNNN.npz")
+    g.add_argument("--json", action="store_true", help="print the summary as JSON")
+    g.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=cmd_simulate)
+
+    p = sub.add_parser("plot", help="figures of a saved run (Figs. 7-10, 13)")
+    p.add_argument("run", help="a run saved by `rigidlcp simulate --out`")
+    p.add_argument("--out", required=True, help="directory for the PNGs")
+    p.add_argument("--event", type=int, default=-1, help="event to draw (default: the last)")
+    p.set_defaults(func=cmd_plot)
+
+
+def cmd_simulate(args) -> int:
+    from rigidlcp.models.engine.dense import simulate
+    from rigidlcp.models.event import initial_state
+    from rigidlcp.models.observables import state_counts
+    from rigidlcp.models.runio import save_run
+
+    system = system_from_args(args)
+    if args.omega_scale < 0 or not np.isfinite(args.omega_scale):
+        raise ValueError(f"--omega-scale must be a finite number >= 0, got {args.omega_scale}")
+    if args.max_events < 1:
+        raise ValueError(f"--max-events must be >= 1, got {args.max_events}")
+    state = initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
+    fallback = None if args.fallback == "none" else args.fallback
+    bar = None
+    if not args.no_progress:
+        from tqdm import tqdm
+
+        bar = tqdm(desc="events", unit="ev", file=sys.stderr, dynamic_ncols=True)
+    last_save = [time.monotonic()]
+
+    def progress(run) -> None:
+        if bar is not None:
+            bar.update(1)
+            bar.set_postfix(t=f"{run.last.t:.4g}", mu_g=f"{run.last.mu_g:.4f}", refresh=False)
+        if args.out and time.monotonic() - last_save[0] > 30:  # checkpoint long runs
+            run.final = None
+            save_run(run, args.out)
+            last_save[0] = time.monotonic()
+
+    run = simulate(system, state, method=args.method, t_max=args.t_max,
+                   max_events=args.max_events, progress=progress, dump_dir=args.dump_problems,
+                   select=args.select, fallback=fallback)
+    if bar is not None:
+        bar.close()
+    if args.out:
+        path = save_run(run, args.out)
+    summary = run.summary()
+    if args.json:
+        print(json.dumps(summary, indent=2, default=float))
+    else:
+        lat = system.lattice
+        print(f"{lat.name} {lat.lx}x{lat.ly}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+              f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
+              f"gamma = {system.gamma} g, V0 = {system.V0}")
+        rows = [("status", run.status), ("message", run.message), ("events", run.n_events),
+                ("wall time (s)", f"{run.wall_time:.3f}"), ("method", run.method)]
+        if run.records:
+            last = run.last
+            counts = state_counts(system, last)
+            rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{last.mu_g:.6f}"),
+                     ("F_g", f"{last.mu_g * system.total_mass * system.g:.6f}"),
+                     ("dissipation rate", f"{last.dissipation:.6g}"),
+                     ("transmitting / not", f"{counts['T']} / {counts['NT']}"),
+                     ("non-sliding pp/plane/wall", f"{counts['NS_pp']} / {counts['NS_plane']}"
+                      f" / {counts['NS_wall']}"),
+                     ("sliding pp/plane/wall", f"{counts['sliding_pp']} / "
+                      f"{counts['sliding_plane']} / {counts['sliding_wall']}"),
+                     ("fallback solves", sum(r.fallback for r in run.records))]
+        if args.out:
+            rows.append(("saved", str(path)))
+        width = max(len(k) for k, _ in rows)
+        for k, v in rows:
+            print(f"  {k:<{width}}  {v}")
+    return 0 if run.status in ("steady", "time_limit", "event_limit") else 1
+
+
+def cmd_plot(args) -> int:
+    from rigidlcp.models.plot import plot_run
+    from rigidlcp.models.runio import load_run
+
+    run = load_run(args.run)
+    if not run.records:
+        raise ValueError(f"{args.run} has no event to draw")
+    if not -run.n_events <= args.event < run.n_events:
+        raise ValueError(f"--event must be in [-{run.n_events}, {run.n_events - 1}]")
+    for path in plot_run(run, args.out, event=args.event):
+        print(path)
+    return 0

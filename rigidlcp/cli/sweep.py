@@ -1,0 +1,258 @@
+"""`rigidlcp sweep` (steady states over a parameter grid) and `rigidlcp effective` (Eqs. 4.1-4.2).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+GRID_HELP = "a value, a list A,B,C, or a range START:STOP:NUM (NUM values, ends included)"
+
+
+def register(sub) -> None:
+    add_sweep(sub)
+    add_effective(sub)
+
+
+# -- rigidlcp sweep ------------------------------------------------------------------------------
+
+
+def add_sweep(sub) -> None:
+    from rigidlcp.models.sweep import DEFAULTS, RUN_OPTIONS
+
+    p = sub.add_parser(
+        "sweep", help="steady states over a grid of parameters (resumable; local or Dask)",
+        description="One run to the steady state per point of the grid (the product of the "
+        "values of every option below). Each point's summary is appended to OUT/results.jsonl "
+        "as soon as it finishes; rerunning the same command skips the finished points. "
+        "When the grid is done the file is rewritten in grid order.",
+        epilog="Every system option takes " + GRID_HELP + ", e.g. --gamma 0:1.0:41. "
+        "Example (Fig. 11): rigidlcp sweep --lattice rect --lx 10 --ly 1 --mu-pp 0.05 "
+        "--mu-plane 0.1 --mu-wall 0 --gamma 0:1.0:41 --out sweep/ ; then "
+        "rigidlcp effective sweep/")
+    g = p.add_argument_group("system (each a grid)")
+    g.add_argument("--lattice", default=DEFAULTS["lattice"], help="rect, tri or rect,tri")
+    for name, text in (("lx", "disks in the rows touching both walls"),
+                       ("ly", "number of rows"), ("mu_pp", "particle-particle friction"),
+                       ("mu_plane", "particle-plane friction"),
+                       ("mu_wall", "particle-wall friction"),
+                       ("gamma", "acceleration of the box relative to the plane, in g"),
+                       ("v0", "initial velocity of the box relative to the plane"),
+                       ("inertia", "moment of inertia ('default': m r^2/2)"),
+                       ("seed", "seed of the initial angular velocities")):
+        default = DEFAULTS[name]
+        g.add_argument("--" + name.replace("_", "-"), default=default,
+                       help=f"{text} (default {'default' if default is None else default})")
+    r = p.add_argument_group("run (fixed for the sweep)")
+    r.add_argument("--method", default=RUN_OPTIONS["method"], help="LCP method")
+    r.add_argument("--fallback", default=RUN_OPTIONS["fallback"],
+                   help="method used where --method fails ('none': stop)")
+    r.add_argument("--select", choices=("face-min-norm", "global", "none"),
+                   default=RUN_OPTIONS["select"],
+                   help="particular solution when an event's solution is not unique")
+    r.add_argument("--max-events", type=int, default=RUN_OPTIONS["max_events"])
+    r.add_argument("--t-max", type=float, default=None)
+    r.add_argument("--omega-scale", type=float, default=RUN_OPTIONS["omega_scale"],
+                   help="initial angular velocities uniform in [-scale, scale]")
+    e = p.add_argument_group("execution")
+    e.add_argument("--out", required=True, help="directory of the sweep (results.jsonl)")
+    e.add_argument("--jobs", "-j", type=int, default=None,
+                   help="worker processes (default: the CPUs available; 1: in this process)")
+    e.add_argument("--dask", default=None, metavar="tcp://HOST:PORT|local",
+                   help="run the points on a dask.distributed scheduler, or on a LocalCluster "
+                   "of --jobs workers on 127.0.0.1 ('local'); needs rigidlcp[dask]")
+    e.add_argument("--save-runs", action="store_true",
+                   help="also save every run to OUT/runs/<id>.npz (see `rigidlcp plot`)")
+    e.add_argument("--json", action="store_true", help="print the rows as JSON lines")
+    e.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=cmd_sweep)
+
+
+def sweep_from_args(args: argparse.Namespace):
+    """A `Sweep` from the parsed options: options with several values are the axes."""
+    from rigidlcp.models.sweep import PARAMS, Sweep, parse_grid
+
+    axes, fixed = {}, {}
+    for name in PARAMS:
+        values = parse_grid(name, getattr(args, name))
+        if len(values) > 1:
+            axes[name] = values
+        else:
+            fixed[name] = values[0]
+    if args.max_events < 1:
+        raise ValueError(f"--max-events must be >= 1, got {args.max_events}")
+    if not args.omega_scale >= 0:
+        raise ValueError(f"--omega-scale must be >= 0, got {args.omega_scale}")
+    options = {"method": args.method, "select": args.select, "max_events": args.max_events,
+               "t_max": args.t_max, "omega_scale": args.omega_scale,
+               "fallback": None if args.fallback == "none" else args.fallback}
+    from rigidlcp import lcp
+
+    for name in (options["method"], options["fallback"]):
+        if name is not None:
+            lcp.get_method(name)  # unknown methods fail here, not once per point
+    return Sweep(axes, fixed, options)
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from rigidlcp.models.sweep import run_sweep, varying
+
+    sweep = sweep_from_args(args)
+    n = len(sweep.points())
+    print(f"sweep: {n} point(s); axes: " + (", ".join(
+        f"{k} ({len(v)})" for k, v in sweep.axes.items()) or "none") + f"; out: {args.out}",
+        file=sys.stderr)
+    try:
+        res = run_sweep(sweep, args.out, jobs=args.jobs, dask=args.dask,
+                        progress=not args.no_progress, save_runs=args.save_runs)
+    except KeyboardInterrupt:
+        print(f"\ninterrupted: the finished points are in {Path(args.out) / 'results.jsonl'};"
+              " rerun the same command to resume", file=sys.stderr)
+        return 130
+    if args.json:
+        for row in res.rows:
+            print(json.dumps(row))
+    else:
+        cols = varying(res.rows) or list(sweep.axes)
+        print_table(res.rows, cols)
+        print(f"{len(res.rows)} points: {res.ran} run now, {res.skipped} found done; "
+              f"results: {res.out / 'results.jsonl'}")
+    bad = [r for r in res.rows if r["status"] not in ("steady",)]
+    if bad:
+        print(f"{len(bad)} point(s) did not reach a steady state (status: "
+              + ", ".join(sorted({r['status'] for r in bad})) + ")", file=sys.stderr)
+    return 0
+
+
+def print_table(rows: list[dict], cols: list[str]) -> None:
+    head = cols + ["status", "events", "mu_g", "F_g", "dissipation", "NS", "sliding"]
+    table = []
+    for r in rows:
+        ns = sum(r.get(f"NS_{k}") or 0 for k in ("pp", "plane", "wall"))
+        sl = sum(r.get(f"sliding_{k}") or 0 for k in ("pp", "plane", "wall"))
+        table.append([_fmt(r.get(c)) for c in cols] + [
+            str(r["status"]), str(r["events"]), _fmt(r.get("mu_g")), _fmt(r.get("F_g")),
+            _fmt(r.get("dissipation")), str(ns), str(sl)])
+    widths = [max(len(h), *(len(t[k]) for t in table)) for k, h in enumerate(head)]
+    print("  ".join(h.rjust(w) for h, w in zip(head, widths)))
+    for t in table:
+        print("  ".join(v.rjust(w) for v, w in zip(t, widths)))
+
+
+def _fmt(v) -> str:
+    if v is None:
+        return "-"
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+# -- rigidlcp effective --------------------------------------------------------------------------
+
+
+def add_effective(sub) -> None:
+    p = sub.add_parser(
+        "effective", help="effective inertia and friction of a gamma sweep (Eqs. 4.1-4.2)",
+        description="Legendre transform of the steady-state F_g(gamma) of a sweep (Sec. IV B): "
+        "a = dF_g/dgamma, b = F_g - a gamma, m_e = m_g + a, mu_e = b / (m_g g). The derivative "
+        "is a least-residual local polynomial fit that does not straddle the kinks of F_g "
+        "(docs/reproduction.md, models/effective.py). One curve per combination of the other "
+        "parameters; non-steady points are left out and listed.")
+    p.add_argument("sweep", help="a sweep directory (or its results.jsonl)")
+    p.add_argument("--out", default=None,
+                   help="directory for mu_g.png (Fig. 11), effective.png (Fig. 12) and "
+                   "effective.json (default: the sweep directory)")
+    p.add_argument("--degree", type=int, default=1, help="degree of the local fits")
+    p.add_argument("--window", type=int, default=3, help="points per local fit")
+    p.add_argument("--json", action="store_true", help="print the table as JSON")
+    p.set_defaults(func=cmd_effective)
+
+
+def cmd_effective(args: argparse.Namespace) -> int:
+    from rigidlcp.models.effective import from_rows
+    from rigidlcp.models.sweep import read_results
+
+    rows = read_results(args.sweep)
+    groups = from_rows(rows, window=args.window, degree=args.degree)
+    usable = [(p, e, lo) for p, e, lo in groups if e is not None]
+    if not usable:
+        raise ValueError(f"{args.sweep}: no group with steady states at two or more gammas")
+    out = Path(args.out) if args.out else (Path(args.sweep) if Path(args.sweep).is_dir()
+                                           else Path(args.sweep).parent)
+    from rigidlcp.models.sweep import PARAMS
+
+    labels = []
+    for params, _, _ in usable:
+        diff = [k for k in PARAMS if k not in ("gamma", "seed")
+                and len({json.dumps(p.get(k)) for p, _, _ in usable}) > 1]
+        labels.append(", ".join(f"{k}={params[k]}" for k in diff) or
+                      f"{params['lattice']} {params['lx']}x{params['ly']}")
+    payload = [{"group": p, "label": lab, "m_g": e.m_g, "rows": e.rows(),
+                "left_out": [{"gamma": r["gamma"], "seed": r["seed"], "status": r["status"]}
+                             for r in lo]}
+               for (p, e, lo), lab in zip(usable, labels)]
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "effective.json").write_text(json.dumps(payload, indent=1) + "\n")
+    files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out)
+    if args.json:
+        print(json.dumps(payload, indent=1))
+        return 0
+    for item in payload:
+        print(f"{item['label']}: m_g = {item['m_g']:g}")
+        print(f"  {'gamma':>8} {'mu_g':>10} {'a':>10} {'m_e':>10} {'mu_e':>10}  fit")
+        for r in item["rows"]:
+            print(f"  {r['gamma']:8.4g} {r['mu_g']:10.6f} {r['a']:10.5g} {r['m_e']:10.5g} "
+                  f"{r['mu_e']:10.6f}  {'exact' if r['exact'] else 'kink'}")
+        for r in item["left_out"]:
+            print(f"  left out: gamma = {r['gamma']}, seed = {r['seed']}: {r['status']}")
+    n_out = sum(len(lo) for _, _, lo in usable)
+    if n_out:
+        print(f"{n_out} point(s) left out (not steady)", file=sys.stderr)
+    print("fit: 'exact' = the local fit matched F_g within rounding (no kink in its window)")
+    for f in files:
+        print(f)
+    return 0
+
+
+def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
+    """mu_g(gamma) (Fig. 11) and m_e(gamma), mu_e(gamma) (Fig. 12) for labelled curves."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    files = []
+    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    for label, e in curves:
+        ax.plot(e.gamma, e.mu_g, "o-", ms=3, label=label)
+    ax.set_xlabel(r"$\gamma$ / g")
+    ax.set_ylabel(r"$\mu_g$")
+    ax.set_title("global friction coefficient (Fig. 11)")
+    if len(curves) > 1:
+        ax.legend(fontsize="small")
+    path = out / "mu_g.png"
+    fig.savefig(path, dpi=130, bbox_inches="tight")
+    plt.close(fig)
+    files.append(path)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11.0, 4.0))
+    for label, e in curves:
+        ax1.plot(e.gamma, e.m_e, "o-", ms=3, label=label)
+        ax2.plot(e.gamma, e.mu_e, "o-", ms=3, label=label)
+    for _, e in curves[:1]:
+        ax1.axhline(e.m_g, color="grey", lw=0.8, ls="--", label=r"$m_g$")
+    ax1.set_xlabel(r"$\gamma$ / g")
+    ax1.set_ylabel(r"$m_e = m_g + \partial F_g/\partial\gamma$")
+    ax1.set_title("(a) effective inertia (Fig. 12)")
+    ax2.set_xlabel(r"$\gamma$ / g")
+    ax2.set_ylabel(r"$\mu_e = (F_g - \gamma\,\partial F_g/\partial\gamma) / (m_g g)$")
+    ax2.set_title("(b) effective friction coefficient (Fig. 12)")
+    ax1.legend(fontsize="small")
+    if len(curves) > 1:
+        ax2.legend(fontsize="small")
+    path = out / "effective.png"
+    fig.savefig(path, dpi=130, bbox_inches="tight")
+    plt.close(fig)
+    files.append(path)
+    return files

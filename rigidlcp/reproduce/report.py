@@ -1,0 +1,240 @@
+"""Figures and report.md of `rigidlcp reproduce` (from `experiments.Results` and the claims)."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import asdict
+from pathlib import Path
+
+import numpy as np
+
+from rigidlcp.models.modes import fig5e_loops, row_modes
+from rigidlcp.models.plot import dissipation_curve, draw_forces, draw_lattice, step_series
+
+from .experiments import SELECT, Claim, Results, provenance
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path: Path) -> Path:
+    plt = _plt()
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def _size(system) -> tuple[float, float]:
+    lat = system.lattice
+    return max(5.0, 0.5 * lat.lx + 1.5), max(2.2, 0.5 * lat.ly + 1.2)
+
+
+def figures(res: Results, out: Path) -> dict[str, Path]:
+    """Every figure of the report; returns {name: path}."""
+    from rigidlcp.cli.sweep import plot_effective
+
+    plt = _plt()
+    files: dict[str, Path] = {}
+    # Fig. 7: angular accelerations at three stages of one run.
+    run = res.seeds("fig7")[0]
+    w, h = _size(run.system)
+    fig, axes = plt.subplots(1, 3, figsize=(3 * w, h))
+    for ax, k in zip(axes, (0, run.n_events // 2, run.n_events - 1)):
+        rec = run.records[k]
+        draw_lattice(ax, run.system, rec.omega_dot, label=r"$\dot\omega$")
+        ax.set_title(f"event {k}, t = {rec.t:.3g}" + (" (steady)" if k == run.n_events - 1
+                                                      else ""))
+    files["fig7"] = _save(fig, out / "fig7_stages.png")
+    # Fig. 8: angular accelerations, normal and friction forces of the steady state.
+    run = res.seeds("fig8")[0]
+    w, h = _size(run.system)
+    fig, axes = plt.subplots(3, 1, figsize=(w, 3 * h))
+    draw_lattice(axes[0], run.system, run.last.omega_dot, label=r"$\dot\omega$")
+    axes[0].set_title("(a) angular accelerations; first-row modes "
+                      + row_modes(run.system, run.last).text())
+    for ax, F, signed, title in ((axes[1], run.last.R, False, "(b) normal forces"),
+                                 (axes[2], run.last.S, True, "(c) friction forces")):
+        draw_lattice(ax, run.system)
+        draw_forces(ax, run.system, F, signed=signed)
+        ax.set_title(title)
+    files["fig8"] = _save(fig, out / "fig8_steady_state.png")
+    # Fig. 9: steady angular accelerations against position, per row.
+    run = res.seeds("fig9")[0]
+    lat = run.system.lattice
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for row in range(lat.ly):
+        sel = np.flatnonzero(lat.row == row)
+        sel = sel[np.argsort(lat.x[sel, 0])]
+        ax.plot(lat.x[sel, 0], run.last.omega_dot[sel], "o-", label=f"row {row + 1}")
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set_xlabel("x / r")
+    ax.set_ylabel(r"$\dot\omega$ (g / r)")
+    ax.set_title(f"first row modes {row_modes(run.system, run.last).text()}")
+    ax.legend(fontsize="small")
+    files["fig9"] = _save(fig, out / "fig9_rows.png")
+    # Fig. 10: mu_g(t) from several initial states.
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    for seed, run in zip(res.plan["fig10"]["seeds"], res.seeds("fig10")):
+        t, mu = step_series(run, "mu_g")
+        ax.step(t, mu, where="post", label=f"seed {seed}")
+    ax.set_xlabel("t (sqrt(r/g))")
+    ax.set_ylabel(r"$\mu_g$")
+    ax.legend(fontsize="small")
+    files["fig10"] = _save(fig, out / "fig10_mu_g.png")
+    # Figs. 11-12 (base system) and Sec. IV B (three systems).
+    d = out / "fig11_12"
+    d.mkdir(exist_ok=True)
+    base = res.effective("fig11")
+    mu_g_png, eff_png = plot_effective([("10x1, mu 0.05 / 0.1 / 0", base)], d)
+    files["fig11"], files["fig12"] = mu_g_png, eff_png
+    d = out / "ivb"
+    d.mkdir(exist_ok=True)
+    curves = [(f"mu_pp {res.plan[n]['mu_pp']}, mu_plane {res.plan[n]['mu_plane']}",
+               res.effective(n)) for n in ("fig11", "ivb_plane", "ivb_pp")]
+    files["ivb_mu_g"], files["ivb"] = plot_effective(curves, d)
+    # Fig. 13: dissipation rate at constant velocity, rectangular and triangular.
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4))
+    for ax, name in zip(axes, ("fig13", "fig13_tri")):
+        for seed, run in zip(res.plan[name]["seeds"], res.seeds(name)):
+            t, D = dissipation_curve(run)
+            ax.plot(t, D, lw=1, label=f"seed {seed}")
+        lat = run.system.lattice
+        ax.set_title(f"{lat.name} {lat.lx}x{lat.ly}, constant velocity")
+        ax.set_xlabel("t (sqrt(r/g))")
+        ax.set_ylabel(r"$D = -\sum S\,v_t$")
+        ax.legend(fontsize="small")
+    files["fig13"] = _save(fig, out / "fig13_dissipation.png")
+    # Fig. 6: initial and final angular velocities, and the loops of Fig. 5(e).
+    run = res.seeds("fig6")[0]
+    lat = run.system.lattice
+    fig, axes = plt.subplots(1, 2, figsize=(12, 3.2))
+    k = np.arange(lat.p)
+    axes[0].bar(k - 0.2, run.records[0].omega, 0.4, label="t = 0")
+    axes[0].bar(k + 0.2, run.last.omega, 0.4, label=f"steady, t = {run.last.t:.3g}")
+    axes[0].set_xlabel("disk")
+    axes[0].set_ylabel(r"$\omega$")
+    axes[0].legend(fontsize="small")
+    draw_lattice(axes[1], run.system, run.last.omega, label=r"$\omega$")
+    pts = lat.x[lat.i] + lat.radius * lat.n
+    for loop in fig5e_loops(run.system, run.last):
+        axes[1].plot(pts[list(loop), 0], pts[list(loop), 1], "k*", ms=10)
+    axes[1].set_title("steady state; stars: Fig. 5(e) loop contacts")
+    files["fig6"] = _save(fig, out / "fig6_omega.png")
+    return files
+
+
+SECTIONS = [
+    ("Fig. 7 / Fig. 10: steady state", ("fig7", "fig10"), ("fig7", "fig10")),
+    ("Figs. 8-9: collective modes", ("fig8", "fig9"), ("fig8", "fig9")),
+    ("Figs. 11-12: global friction, effective inertia and friction", ("fig11", "fig12"),
+     ("fig11", "fig12")),
+    ("Sec. IV B: dependence on the coefficients", ("ivb",), ("ivb_mu_g", "ivb")),
+    ("Fig. 13 / Sec. IV C: dissipation at constant velocity", ("fig13",), ("fig13",)),
+    ("Fig. 6 / Fig. 5(e): the alternating indeterminate mode", ("fig6",), ("fig6",)),
+    ("Eqs. (3.3)-(3.4)", ("eq",), ()),
+]
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, Path],
+                 command: str) -> Path:
+    """report.md (claims table, sizes, figures, notes) and claims.json."""
+    n_pass = sum(c.passed for c in claims)
+    code = provenance()
+    lines = [
+        "# Reproduction of Radjai, Brendel & Roux, PRE 54, 861 (1996)",
+        "",
+        f"Generated by `{command}` on {res.executor}; {len(claims)} claims, "
+        f"**{n_pass} PASS, {len(claims) - n_pass} FAIL**; computing time {res.wall_time:.0f} s; "
+        f"code: git {code}.",
+        "Conventions: gamma > 0 accelerates the box to +x relative to the plane (the paper's "
+        "figures accelerate to the left: mirror image, same physics); r = m = g = 1, "
+        "I = m r^2 / 2; steady states by exact event-driven evolution with Lemke's method and "
+        f"the particular-solution rule select='{SELECT}' at non-unique events (docs/theory.md).",
+        "",
+        "## Claims",
+        "",
+        "| id | where | claim | measured | criterion | result |",
+        "|---|---|---|---|---|---|",
+    ]
+    for c in claims:
+        lines.append(f"| {c.id} | {c.where} | {_cell(c.claim)} | {_cell(c.measured)} | "
+                     f"{_cell(c.criterion)} | **{c.verdict}** |")
+    lines += ["", "## Sizes and parameters", "",
+              "| experiment | lattice | size | gamma (g) | V0 | mu_pp / mu_plane / mu_wall | "
+              "seeds |", "|---|---|---|---|---|---|---|"]
+    for name, cfg in res.plan.items():
+        if name == "formulas":
+            lines.append(f"| {name} | rect, tri | Lx {cfg['lx'][0]}-{cfg['lx'][1]}, Ly "
+                         f"{cfg['ly'][0]}-{cfg['ly'][1]} | - | - | SVD counts | - |")
+            continue
+        seeds = cfg.get("seeds", (cfg.get("seed"),))
+        extra = f"; also gamma = {', '.join(map(str, cfg['scan']))}" if cfg.get("scan") else ""
+        lines.append(f"| {name} | {cfg['lattice']} | {cfg['lx']}x{cfg['ly']} | "
+                     f"{cfg['gamma']}{extra} | {cfg.get('V0', 0.0)} | {cfg['mu_pp']} / "
+                     f"{cfg['mu_plane']} / {cfg['mu_wall']} | {', '.join(map(str, seeds))} |")
+    lines += ["", "Sizes: the captions' where given (Fig. 9 10x4, Fig. 10 10x2, Fig. 13 10x3, "
+              "Fig. 12 m_g = 10 hence 10x1); Figs. 7-8 give none: 10x4 like Fig. 9. Fig. 13 "
+              "gives no coefficients: those of Figs. 7, 9, 10 (0.1 / 0.2 / 0). Fig. 6 gives no "
+              "driving: gamma = 0.05 g (at constant velocity the seven disks decouple). "
+              "See docs/reproduction.md.", ""]
+    by_prefix = {}
+    for c in claims:
+        by_prefix.setdefault(c.id.split("-")[0], []).append(c)
+    for title, prefixes, figs in SECTIONS:
+        lines += [f"## {title}", ""]
+        for name in figs:
+            if name in files:
+                rel = files[name].relative_to(out)
+                lines += [f"![{name}]({rel.as_posix()})", ""]
+        for p in prefixes:
+            for c in [c for k, v in by_prefix.items() if k.startswith(p) for c in v]:
+                lines.append(f"* **{c.id}: {c.verdict}.** {c.measured}")
+                if c.note and (not c.passed or c.id.startswith(("fig12", "fig13-min", "fig9"))):
+                    lines.append(f"  {c.note}")
+                if c.error:
+                    lines.append(f"  Evaluation error: `{_cell(c.error.splitlines()[0])}`")
+        lines.append("")
+        if "eq" in prefixes and res.formulas:
+            lines += _formula_grids(res)
+    path = out / "report.md"
+    path.write_text("\n".join(lines) + "\n")
+    (out / "claims.json").write_text(json.dumps(
+        {"command": command, "wall_time_s": res.wall_time, "executor": res.executor,
+         "code": code, "select": SELECT,
+         "plan": res.plan, "claims": [dict(asdict(c), verdict=c.verdict) for c in claims]},
+        indent=1, default=_json) + "\n")
+    return path
+
+
+def _formula_grids(res: Results) -> list[str]:
+    """The SVD counts of Eqs. (3.3)/(3.4), Lx down and Ly across; "n [p]" where the paper's
+    closed form p differs from the count n (rigidlcp.verify.nullspace.formulas.format_grid)."""
+    from rigidlcp.verify.nullspace.formulas import format_grid
+
+    out = []
+    for lat in ("rect", "tri"):
+        for kind, eq in (("normal", "3.3"), ("tangential", "3.4")):
+            out += [f"{lat}, Eq. ({eq}), {kind} (SVD count [paper's value where it differs]):",
+                    "", format_grid(res.formulas, lat, kind), ""]
+    return out
+
+
+def _json(obj):
+    if isinstance(obj, (np.integer, np.floating, np.bool_)):
+        return obj.item()
+    if isinstance(obj, tuple):
+        return list(obj)
+    raise TypeError(type(obj).__name__)
+
+
+__all__ = ["figures", "write_report"]

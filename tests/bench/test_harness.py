@@ -1,0 +1,220 @@
+"""bench.harness / bench_report / `rigidlcp bench`: the harness never trusts a solver (wrong
+answers, false infeasibility claims and overlong solves are failures), the metrics are the
+stated ones, and the command writes its files. No timing assertions."""
+
+from __future__ import annotations
+
+import csv
+import math
+import time
+
+import numpy as np
+import pytest
+
+from rigidlcp import lcp
+from rigidlcp.bench.harness import (
+    LocalRunner,
+    Result,
+    SiconosRunner,
+    farkas_certificate,
+    read_csv,
+    run_bench,
+    write_csv,
+)
+from rigidlcp.bench.problem_sets import get_set
+from rigidlcp.bench.report import profile_data, shifted_geometric_mean, summarize
+from rigidlcp.cli.main import main as cli_main
+from rigidlcp.lcp.api import _REGISTRY
+
+SMALL = dict(sizes=(3, 6), per_size=2)
+
+
+@pytest.fixture
+def doubles():
+    """Test doubles registered with lcp.register (and removed afterwards)."""
+
+    @lcp.register("test-wrong", accepts="any", description="claims z = 1 solves everything")
+    def wrong(M, q):
+        z = np.ones(q.size)
+        return lcp.Solution(z=z, w=M @ z + q, status="solved", method="test-wrong")
+
+    @lcp.register("test-liar", accepts="any", description="claims nothing has a solution")
+    def liar(M, q):
+        return lcp.Solution(z=np.zeros(q.size), w=q.copy(), status="infeasible",
+                            method="test-liar")
+
+    @lcp.register("test-slow", accepts="any", description="sleeps, then answers rightly")
+    def slow(M, q):
+        if q.size > 2:  # the 2 x 2 warm-up problem is answered at once
+            time.sleep(60)
+        return lcp.solve(lcp.LCP(M, q), method="lemke")
+
+    yield
+    for name in ("test-wrong", "test-liar", "test-slow"):
+        _REGISTRY.pop(name, None)
+
+
+def small_sets():
+    return {"random-p": get_set("random-p", **SMALL),
+            "infeasible": get_set("infeasible", **SMALL),
+            "murty": get_set("murty", sizes=(3, 5))}
+
+
+def test_a_wrong_solver_fails_every_problem(doubles):
+    sets = small_sets()
+    results = run_bench(sets, ["test-wrong", "lemke"], time_limit=30)
+    wrong = [r for r in results if r.method == "test-wrong"]
+    assert len(wrong) == sum(len(p) for p in sets.values())
+    assert all(not r.success and r.outcome == "uncertified" and r.status == "solved"
+               for r in wrong)
+    right = [r for r in results if r.method == "lemke"]
+    assert all(r.success for r in right)  # the same harness accepts right answers
+    assert {r.outcome for r in right} == {"solved", "infeasible"}
+
+
+def test_a_false_infeasibility_claim_fails_and_a_true_one_passes(doubles):
+    results = run_bench(small_sets(), ["test-liar"], time_limit=30)
+    for r in results:
+        if r.expected == "infeasible":
+            assert r.success and r.outcome == "infeasible"
+        else:
+            assert not r.success and r.outcome == "unproved_infeasible"
+
+
+def test_a_solve_over_the_time_limit_is_killed_and_fails(doubles):
+    sets = {"random-p": get_set("random-p", sizes=(4,), per_size=2)}
+    t0 = time.perf_counter()
+    results = run_bench(sets, ["test-slow", "lemke"], time_limit=0.3, grace=0.2)
+    assert time.perf_counter() - t0 < 30  # two killed solves, not two 60 s sleeps
+    slow = [r for r in results if r.method == "test-slow"]
+    assert [r.outcome for r in slow] == ["timeout", "timeout"]
+    assert all(r.time == 0.3 and not r.success for r in slow)
+    assert all(r.success for r in results if r.method == "lemke")  # a fresh worker took over
+
+
+def test_in_process_mode_checks_the_limit_afterwards():
+    runner = LocalRunner(isolate=False)
+    problem = get_set("random-p", sizes=(4,), per_size=1)[0]
+    raw = runner.solve(problem, "lemke", 10.0)
+    assert raw["kind"] == "answer" and raw["status"] == "solved"
+
+
+def test_refusals_and_unknown_methods():
+    sets = {"events": get_set("random-p", sizes=(25,), per_size=1)}
+    results = run_bench(sets, ["enumerate"], time_limit=30)  # registered for n <= 20
+    assert results[0].outcome == "not_applicable" and not results[0].success
+    with pytest.raises(ValueError, match="unknown method"):
+        run_bench(sets, ["no-such-method"])
+
+
+def test_farkas_certificate_only_for_infeasible_problems():
+    for p in get_set("infeasible", **SMALL):
+        y = farkas_certificate(p.M, p.q)
+        assert y is not None and np.all(y >= 0) and p.q @ y < 0
+    for p in get_set("random-psd", **SMALL):
+        assert farkas_certificate(p.M, p.q) is None
+
+
+def test_siconos_absent_is_reported_not_fatal():
+    runner = SiconosRunner(python="/nonexistent/python3")
+    assert not runner.available and "not found" in runner.reason
+    with pytest.raises(ValueError, match="needs Siconos"):
+        run_bench({"s": get_set("random-p", sizes=(3,), per_size=1)}, ["siconos-lemke"],
+                  siconos=runner)
+    runner.close()
+
+
+def test_siconos_methods_when_available():
+    runner = SiconosRunner()
+    if not runner.available:
+        runner.close()
+        pytest.skip(f"Siconos unavailable: {runner.reason}")
+    try:
+        sets = {"random-p": get_set("random-p", sizes=(5,), per_size=2),
+                "infeasible": get_set("infeasible", sizes=(5,), per_size=1)}
+        results = run_bench(sets, ["siconos-lemke", "siconos-enum"], siconos=runner,
+                            time_limit=30)
+    finally:
+        runner.close()
+    for r in results:
+        # Siconos proves nothing when it fails: an infeasible problem is never a success.
+        assert r.success == (r.set == "random-p"), r
+
+
+# --- metrics --------------------------------------------------------------------------------
+
+def _r(problem, method, success, t, set_="s"):
+    return Result(set=set_, problem=problem, n=3, method=method,
+                  outcome="solved" if success else "timeout", success=success,
+                  status="solved" if success else "timeout", time=t, iterations=4,
+                  residual=0.0, scaled_residual=1e-12 if success else math.nan,
+                  expected="solution")
+
+
+def test_shifted_geometric_mean():
+    assert shifted_geometric_mean([0.0, 0.0]) == pytest.approx(0.0, abs=1e-15)
+    t = [0.001, 0.1]
+    expected = math.sqrt((0.001 + 0.01) * (0.1 + 0.01)) - 0.01
+    assert shifted_geometric_mean(t) == pytest.approx(expected)
+    assert math.isnan(shifted_geometric_mean([]))
+
+
+def test_summary_counts_failures_at_the_time_limit():
+    results = [_r("a", "m", True, 0.002), _r("b", "m", False, 5.0), _r("a", "k", True, 0.004),
+               _r("b", "k", True, 0.008)]
+    by = {s.method: s for s in summarize(results, time_limit=5.0)}
+    assert by["m"].successes == 1 and by["m"].rate == 0.5
+    assert by["m"].sgm_time == pytest.approx(shifted_geometric_mean([0.002, 5.0]))
+    assert by["m"].failures == {"timeout": 1}
+    assert by["k"].median_iterations == 4 and by["k"].worst_residual == 1e-12
+
+
+def test_performance_profile_ratios():
+    results = [_r("a", "m", True, 0.002), _r("b", "m", False, 5.0), _r("a", "k", True, 0.004),
+               _r("b", "k", True, 0.008), _r("c", "m", False, 1), _r("c", "k", False, 1)]
+    methods, ratios = profile_data(results)
+    assert methods == ["m", "k"]
+    np.testing.assert_allclose(ratios[0], [1.0, 2.0])
+    assert ratios[1, 0] == np.inf and ratios[1, 1] == 1.0
+    assert np.all(np.isinf(ratios[2]))  # nobody solved c
+
+
+def test_csv_round_trip(tmp_path):
+    results = [_r("a", "m", True, 0.002), _r("b", "m", False, 5.0)]
+    back = read_csv(write_csv(results, tmp_path / "r.csv"))
+    assert [(r.problem, r.success, r.outcome, r.time) for r in back] == \
+        [(r.problem, r.success, r.outcome, r.time) for r in results]
+    assert math.isnan(back[1].scaled_residual) and back[0].iterations == 4
+
+
+# --- the command ----------------------------------------------------------------------------
+
+def test_bench_command_writes_csv_report_and_profiles(tmp_path, capsys):
+    out = tmp_path / "out"
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    for p in get_set("random-psd", sizes=(3,), per_size=2):
+        p.save(folder / (p.name.split("/")[-1] + ".npz"))
+    code = cli_main(["bench", "--set", f"random-p,infeasible,{folder}", "--sizes", "3,5",
+                     "--per-size", "1", "--methods", "lemke,pivoting,siconos-lemke", "--out",
+                     str(out), "--no-siconos", "--quiet"])
+    assert code == 0
+    with open(out / "results.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == (2 + 2 + 2) * 2  # siconos-lemke skipped
+    assert {r["method"] for r in rows} == {"lemke", "pivoting"}
+    report = (out / "report.md").read_text()
+    for heading in ("## All sets", "## random-p", "## infeasible", "## mine"):
+        assert heading in report
+    assert "skipped siconos-lemke" in report and "shift 10 ms" in report
+    for name in ("profile_all.png", "profile_random-p.png", "profile_mine.png"):
+        assert (out / name).read_bytes()[:4] == b"\x89PNG"
+    assert "wrote" in capsys.readouterr().out
+
+
+def test_bench_command_lists_and_rejects(capsys):
+    assert cli_main(["bench", "--list", "--no-siconos"]) == 0
+    listed = capsys.readouterr().out
+    assert "events-rect" in listed and "siconos-lemke" in listed
+    assert cli_main(["bench", "--set", "random-p", "--no-siconos"]) == 2  # no --out
+    assert cli_main(["bench", "--set", "nope", "--out", "/tmp/x", "--no-siconos"]) == 2

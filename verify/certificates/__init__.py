@@ -1,0 +1,1 @@
+"""Certificates of solutions: residuals, uniqueness (P-matrix test, enumeration, MILP), laws."""

@@ -1,0 +1,99 @@
+"""Drawings of null-space basis vectors on the lattice (matplotlib, Agg backend).
+
+One panel per basis vector: the disks, walls and plane (`models.plot.draw_lattice`), every
+contact as a thin grey segment, and the contacts that the vector involves as thick segments,
+width ~ sqrt(R^2 + S^2), red where R > 0, blue where R < 0, green where only S is nonzero.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from rigidlcp import models
+
+from .contact import LoopBasis, NullSpace
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _draw_vector(ax, system: models.System, R: np.ndarray, S: np.ndarray, title: str) -> None:
+    from matplotlib.collections import LineCollection
+
+    from rigidlcp.models.plot import contact_points, draw_lattice
+
+    draw_lattice(ax, system)
+    a, b = contact_points(system)
+    segs = np.stack([a, b], axis=1)
+    ax.add_collection(LineCollection(segs, colors="0.8", linewidths=0.6))
+    mag = np.hypot(R, S)
+    scale = max(mag.max(initial=0.0), 1e-300)
+    on = mag > 1e-9 * scale
+    colors = np.where(R > 1e-9 * scale, "tab:red", np.where(R < -1e-9 * scale, "tab:blue",
+                                                             "tab:green"))
+    if np.any(on):
+        ax.add_collection(LineCollection(segs[on], colors=list(colors[on]),
+                                         linewidths=1.0 + 4.0 * mag[on] / scale))
+    ax.set_title(title, fontsize="small")
+
+
+def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarray, str]],
+                 out: str | Path, suptitle: str = "", max_panels: int = 30) -> Path:
+    """Write one figure with a panel per (R, S, title) to `out` (PNG); returns the path."""
+    plt = _plt()
+    vectors = vectors[:max_panels]
+    k = max(len(vectors), 1)
+    ncol = min(k, 4)
+    nrow = -(-k // ncol)
+    lat = system.lattice
+    w = max(2.5, 0.45 * lat.lx + 0.8)
+    h = max(1.8, 0.45 * lat.ly * (0.87 if lat.name == "tri" else 1.0) + 0.9)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(w * ncol, h * nrow), squeeze=False)
+    for ax in axes.flat[len(vectors):]:
+        ax.axis("off")
+    for ax, (R, S, title) in zip(axes.flat, vectors):
+        _draw_vector(ax, system, R, S, title)
+    if suptitle:
+        fig.suptitle(suptitle, y=1.0 + 0.12 / nrow)  # above the panel titles
+    path = Path(out)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return path
+
+
+def plot_null_space(ns: NullSpace, out: str | Path, max_panels: int = 30) -> Path:
+    """The localized basis of a null space (Fig. 5), one panel per vector."""
+    if ns.localized is None:
+        raise ValueError("compute the localized basis first (null_space(..., localize=True))")
+    c = ns.c
+    vectors = [(x[:c], x[c:], f"v{k + 1}: {len(ns.contacts_of(x))} contacts")
+               for k, x in enumerate(ns.localized.T)]
+    lat = ns.system.lattice
+    title = f"{lat.name} {lat.lx}x{lat.ly}: ker M, dimension {ns.dim}"
+    if ns.dim > max_panels:
+        title += f" (first {max_panels} vectors)"
+    return plot_vectors(ns.system, vectors, out, title, max_panels)
+
+
+def plot_loops(system: models.System, loops: LoopBasis, out: str | Path,
+               max_panels: int = 30) -> Path:
+    """The kinematic loops (left ker K), coefficients drawn as R (Fig. 5b, 5c, 5e)."""
+    c = system.c
+    vectors = []
+    for k, loop in enumerate(loops.loops()):
+        R = np.zeros(c)
+        for a, v in loop.items():
+            R[a] = v
+        vectors.append((R, np.zeros(c), f"loop {k + 1}: {len(loop)} NS contacts"))
+    lat = system.lattice
+    title = f"{lat.name} {lat.lx}x{lat.ly}: loops of NS contacts, {loops.dim}"
+    return plot_vectors(system, vectors, out, title, max_panels)
