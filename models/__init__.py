@@ -4,7 +4,7 @@ Dependencies point lcp <- models <- verify: this package imports `lcp`, never `v
 """
 
 from .dynamics import Dynamics
-from .engine.dense import Run, simulate
+from .engine import Run, simulate
 from .event import (
     EventProblem,
     EventSolution,

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidlcp.models.engine.dense import Run
+from rigidlcp.models.engine.records import Run
 
 from .lattice import LEFT_WALL, PLANE, RIGHT_WALL
 from .system import System

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidlcp.models.engine.dense import EventRecord, Run
+from rigidlcp.models.engine.records import EventRecord, Run
 
 from .event import State
 from .system import make_system

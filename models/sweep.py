@@ -181,7 +181,7 @@ def run_point(point: dict, runs_dir: str | None = None) -> dict:
     status "error" with the message: they are results, deterministic like the others."""
     import time
 
-    from rigidlcp.models.engine.dense import simulate
+    from rigidlcp.models.engine import simulate
 
     from .event import initial_state
     from .observables import state_counts

@@ -65,7 +65,7 @@ def register(sub) -> None:
 
 
 def cmd_simulate(args) -> int:
-    from rigidlcp.models.engine.dense import simulate
+    from rigidlcp.models.engine import simulate
     from rigidlcp.models.event import initial_state
     from rigidlcp.models.observables import state_counts
     from rigidlcp.models.runio import save_run

@@ -1,8 +1,8 @@
 """`rigidlcp methods` and `rigidlcp solve` (over rigidlcp.lcp).
 
-Listed in rigidlcp/cli/main.py's COMMAND_MODULES. Exit codes of ``solve``: 0 solved, 1 the method did not solve it (any
-other status: infeasible, ray, max_iter, not_converged, failed), 2 bad input (unreadable
-file, invalid problem, unknown method or option, a method that refuses the problem).
+Exit codes of ``solve``: 0 solved, 1 the method did not solve it (any other status: infeasible,
+ray, max_iter, not_converged, failed), 2 bad input (unreadable file, invalid problem, unknown
+method or option, a method that refuses the problem).
 """
 
 from __future__ import annotations

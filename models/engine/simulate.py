@@ -1,0 +1,88 @@
+"""`simulate`: the event-driven evolution of a system, on the dense or the sparse backend."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
+
+import numpy as np
+
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.event import State, initial_state
+from rigidlcp.models.system import System
+
+from .dense import DenseBackend
+from .loop import Limits, run_events
+from .records import Run
+from .sparse import SparseBackend
+
+
+def simulate(
+    system: System,
+    state: State | None = None,
+    *,
+    method: str = "lemke",
+    omega: np.ndarray | None = None,
+    seed: int | None = None,
+    t_max: float = np.inf,
+    max_events: int = 100_000,
+    check_tol: float = 1e-8,
+    warm_start: bool = True,
+    zeno_events: int = 200,
+    zeno_time: float = 1e-6,
+    progress: Callable[[Run], None] | bool | None = None,
+    dump_dir: str | None = None,
+    select: str = "face-min-norm",
+    fallback: str | None = "lemke",
+    blas_threads: int | None = 1,
+) -> Run:
+    """Evolve `system` from `state` (or from omega / a seed) event by event (Sec. II C, IV).
+
+    method: any `lcp` method, solving each event's dense LCP (models/engine/dense.py; "pivoting"
+    is warm-started from the previous event's contact states when warm_start is true), or
+    "sparse-pivoting": the sparse backend (models/engine/sparse.py; select "none" only, no
+    dump_dir). Every solution's residual max|min(z, w)| must be <= check_tol (in units of the
+    problem's scale), or the run stops with "solver_failed"; the other stop rules and their
+    parameters (t_max, max_events, zeno_events, zeno_time) are models/engine/loop.py's.
+
+    select: the particular solution of an event whose solution is not unique: "face-min-norm"
+    (default), "global" or "none" (see `DenseBackend`). fallback: when `method` fails at an
+    event (no solution, cycling, iteration limit), that event is solved again by this method
+    (None: stop); each use is counted in the record. progress: called with the run after each
+    event (None or False: not called). blas_threads: BLAS threads during the run (the event
+    problems are small dense matrices, for which one thread is fastest, and much faster on a
+    loaded machine); None leaves BLAS alone.
+    """
+    dyn = Dynamics(system)
+    if method == "sparse-pivoting":
+        if select != "none":
+            raise ValueError("method 'sparse-pivoting' keeps the pivoting's own solution: "
+                             "use select='none'")
+        if dump_dir is not None:
+            raise ValueError("method 'sparse-pivoting' does not dump problems (dump_dir)")
+        backend = SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback)
+    else:
+        backend = DenseBackend(system, dyn, method=method, fallback=fallback, select=select,
+                               warm_start=warm_start, dump_dir=dump_dir, check_tol=check_tol)
+    if state is None:
+        state = initial_state(system, omega=omega, seed=seed)
+    limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
+    if progress is True or progress is False:
+        progress = None if progress is False else _print_progress
+    with blas_limit(blas_threads):
+        return run_events(system, state, backend, limits, progress or None)
+
+
+def blas_limit(threads: int | None) -> AbstractContextManager:
+    """BLAS limited to `threads` threads while the context is open (None: left alone)."""
+    if threads is None:
+        return nullcontext()
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(threads)
+
+
+def _print_progress(run: Run) -> None:
+    """progress=True: one line per 100 events."""
+    if run.n_events % 100 == 0:
+        print(f"event {run.n_events}: t = {run.last.t:.6g}", flush=True)
