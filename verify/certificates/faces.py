@@ -27,6 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..uniqueness import quiet_highs
+
 #: HiGHS tolerances for the face LPs (its defaults are 1e-7).
 _TOL = 1e-10
 
@@ -105,7 +107,8 @@ class FaceLP:
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
             K.indptr, K.indices, K.data)
-        h = highspy.Highs()
+        with quiet_highs():  # the banner HiGHS prints on fd 1 when first constructed
+            h = highspy.Highs()
         for key, value in (("output_flag", False), ("presolve", "off"),
                            ("primal_feasibility_tolerance", _TOL),
                            ("dual_feasibility_tolerance", _TOL)):

@@ -217,7 +217,7 @@ class _Stages:
         differs in L by more than delta s_L."""
         res = independent_residual(self.M, self.q, y)
         diff = float(np.max(np.abs(L @ (y - self.z)))) / self.s_L(L)
-        if res > 1e-8 or diff <= self.delta:
+        if res > 1e-8 or diff <= 0.99 * self.delta:  # (the MILP polishes to 0.999 delta)
             return None
         pat = sign_pattern(y, self.M @ y + self.q, self.zs, self.ws, 1e-6)
         # a pair changes state when it flips (z_i > 0 <-> w_i > 0); reaching a degenerate
@@ -290,10 +290,16 @@ class _Stages:
                     elif st == "optimal":
                         lj = float(L[j] @ y)
                         v.lo[j], v.hi[j] = min(v.lo[j], lj), max(v.hi[j], lj)
-            if best[1] is None:  # only rays: take a point in a box
-                st, y = FaceLP(M, q, P, D, next(iter(lps)), BOUND_FACTOR * self.zs).solve(-mix)
-                if st == "optimal":
-                    best = (0.0, y)
+            if best[0] <= self.delta * self.s_L(L):  # rays (or nothing): points in a box
+                for side in lps:
+                    boxed = FaceLP(M, q, P, D, side, BOUND_FACTOR * self.zs)
+                    for cost in (mix, -mix):
+                        st, y = boxed.solve(cost)
+                        n_lp += 1
+                        dev = (float(np.max(np.abs(L[moving] @ y - val[moving])))
+                               if st == "optimal" else 0.0)
+                        if dev > best[0]:
+                            best = (dev, y)
             w = None if best[1] is None else self.witness(best[1], L, "face LP")
             if w is not None:
                 self.seen.append(w.z)
@@ -352,6 +358,10 @@ class _Stages:
             L = self.obs[v.name]
             s = milp_search(self.M, self.q, self.z, "values", L, delta=self.delta, bound=U,
                             time_limit=time_limit)
+            if s.status == "found" and s.deviation < 1e-3 and self.delta < 1e-2:
+                s2 = milp_search(self.M, self.q, self.z, "values", L, delta=1e-2, bound=U,
+                                 time_limit=time_limit)  # a clearly different one, if any
+                s = s2 if s2.status == "found" else s
             rejected = int(s.info.get("rejected_bases", 0))
             self.out.log.append(f"milp {v.name}: {s.status}, {s.message}")
             scope = f"0 <= z <= {U:.3g} (box), margin {s.delta:g}"
