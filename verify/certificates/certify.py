@@ -44,7 +44,7 @@ from .uniqueness import Search, milp_search, p_matrix_test, scales, sign_pattern
 
 #: "auto" enumerates the complementary bases up to this n (2^n bases; singular ones need LPs).
 ENUM_AUTO_MAX_N = 10
-UNIQUENESS_METHODS = ("auto", "p-matrix", "enumeration", "milp", "none")
+UNIQUENESS_METHODS = ("auto", "p-matrix", "enumeration", "milp", "staged", "none")
 
 
 @dataclass
@@ -73,6 +73,7 @@ class Certificate:
     bound: float | None = None  # the MILP's box 0 <= z <= bound (verdicts relative to it)
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
+    staged: object | None = None  # uniqueness="staged": the verify.certificates StagedCertificate
 
     @staticmethod
     def verdict(flag: bool | None) -> str:
@@ -194,6 +195,10 @@ def certify(
         return cert
     M, q = lcp_form.M, lcp_form.q
     n = q.size
+    if uniqueness == "staged":
+        _staged(cert, lcp_form, z, obs, delta, bound, time_limit)
+        cert.seconds = time.perf_counter() - t0
+        return cert
     method = uniqueness
     if uniqueness in ("auto", "p-matrix"):
         pt = p_matrix_test(M)
@@ -220,6 +225,30 @@ def certify(
         ctx.by_milp()
     cert.seconds = time.perf_counter() - t0
     return cert
+
+
+def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: float,
+            bound: float | None, time_limit: float) -> None:
+    """uniqueness="staged": the verdicts of verify.certificates.stages.certify_stages."""
+    from .certificates.stages import OTHER, UNIQUE, certify_stages
+
+    staged = certify_stages(problem, z, delta=delta, bound=bound, time_limit=time_limit,
+                            observables={"z": np.eye(problem.n), "w": problem.M, **obs})
+    flag = {UNIQUE: True, OTHER: False}
+    v = staged.verdicts
+    cert.method, cert.staged = "staged", staged
+    cert.z_unique, cert.w_unique = flag.get(v["z"].verdict), flag.get(v["w"].verdict)
+    cert.observables = {name: flag.get(v[name].verdict) for name in obs}
+    cert.pattern_unique = flag.get(v["states"].verdict)
+    for name, verdict in v.items():
+        if verdict.witness is not None:
+            cert.others.append(verdict.witness.z)
+            if cert.other is None:
+                cert.other, cert.other_reason = verdict.witness.z, f"{name} ({verdict.stage})"
+                cert.other_distance = verdict.witness.distance
+        if verdict.verdict != UNIQUE or verdict.scope:
+            cert.notes.append(f"{name}: {verdict.verdict} [{verdict.stage}] {verdict.reason}"
+                              + (f" (scope: {verdict.scope})" if verdict.scope else ""))
 
 
 def _norm_inf(A: np.ndarray) -> float:

@@ -50,8 +50,9 @@ UNIQUE, OTHER, UNKNOWN = "unique", "another solution exists", "unknown"
 @dataclass
 class Witness:
     """Another solution z: its independent scaled residual, |z - z*|_inf / z_s (distance), the
-    relative difference in the observable, the pairs whose sign pattern changes, and how it
-    was found."""
+    relative difference in the observable, the pairs whose sign pattern flips (changed), the
+    degenerate pairs of z* it leaves (z_i > 0 or w_i > 0 where z*_i = w*_i = 0: e.g. R > 0 at
+    a contact where z* had R = a_n = 0), and how it was found."""
 
     z: np.ndarray
     residual: float
@@ -60,11 +61,13 @@ class Witness:
     changed: list[int]
     same_states: bool
     found_by: str
+    degenerate_left: list[int] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"residual": self.residual, "distance": self.distance,
                 "difference": self.difference, "changed": self.changed,
-                "same_states": self.same_states, "found_by": self.found_by}
+                "same_states": self.same_states, "found_by": self.found_by,
+                "degenerate_left": self.degenerate_left}
 
 
 @dataclass
@@ -126,7 +129,8 @@ class StagedCertificate:
                 w = v.witness
                 lines.append(f"  {'':<14}  witness ({w.found_by}): residual {w.residual:.1e}, "
                              f"|dz|/z_s = {w.distance:.3g}, d{v.name} = {w.difference:.3g}, "
-                             f"{len(w.changed)} pairs change state")
+                             f"{len(w.changed)} pairs change state, leaves "
+                             f"{len(w.degenerate_left)} degenerate pairs")
         lines += [f"  stage: {s}" for s in self.log]
         return "\n".join(lines)
 
@@ -223,8 +227,9 @@ class _Stages:
         # a pair changes state when it flips (z_i > 0 <-> w_i > 0); reaching a degenerate
         # 0 (a vertex of the face) is not a change
         changed = np.flatnonzero(pat * self.pat == -1).tolist()
+        left = np.flatnonzero((self.pat == 0) & (pat != 0)).tolist()
         return Witness(y, res, float(np.max(np.abs(y - self.z))) / self.zs, diff, changed,
-                       not changed, found_by)
+                       not changed, found_by, left)
 
     def decide(self, v: Verdict, verdict: str, stage: str, reason: str, t: float,
                witness: Witness | None = None, scope: str = "") -> None:

@@ -188,3 +188,34 @@ def test_drawn_event_verdicts_agree_with_enumeration(data):
     if sol.z is None or not certify(ep, sol.z, uniqueness="none").accepted:
         return  # no solution (Painleve) or an inaccurate one: nothing to certify
     _agrees_on_event(ep, sol.z)
+
+
+def test_certify_staged_fills_the_classic_certificate():
+    problem = _lcp([[1, 2], [2, 1]], [-1, -1])
+    cert = certify(problem, np.array([1.0, 0.0]), uniqueness="staged")
+    assert cert.method == "staged" and cert.staged is not None
+    assert cert.z_unique is False and cert.w_unique is False and cert.pattern_unique is False
+    assert certify(problem, cert.other, uniqueness="none").accepted
+    cert = certify(_lcp([[0, 1], [-1, 0]], [1, 1]), np.zeros(2), uniqueness="staged")
+    assert cert.z_unique is True and cert.w_unique is True
+
+
+def test_fig9_size_event_witness_keeps_the_tangential_states():
+    # rect 10x4 (Fig. 9's array), seed 1: at the first event the accelerations are not unique,
+    # and the witness is a solution with the same tangential states (a face witness)
+    from verify.polyhedra import event_z
+
+    system = models.System(models.rectangular(10, 4), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.16)
+    run = models.simulate(system, models.initial_state(system, seed=1), max_events=1)
+    ep = models.event_problem(system, run.state_at(0))
+    rec = run.records[0]
+    z = event_z(ep, np.r_[rec.R, rec.S])
+    cert = certify_stages(ep, z, milp=False)
+    v = cert.verdicts["accelerations"]
+    assert v.verdict == OTHER and v.stage == "face (a)"
+    a, b = ep.unpack(z), ep.unpack(v.witness.z)
+    assert np.array_equal(a.s, b.s)
+    assert np.max(np.abs(a.omega_dot - b.omega_dot)) > 1e-3
+    assert np.max(np.abs(a.trans_acc - b.trans_acc)) < 1e-9  # no displacement either way
+    _check_witness(ep.lcp, cert)
