@@ -162,7 +162,7 @@ def certify_stages(
     """Decide uniqueness of each observable of `solution` (stages 0, a, b, c above).
 
     problem: an `lcp.LCP` or a `models.EventProblem`; solution: an `lcp.Solution` or z.
-    delta: relative margin for "differs"; time_limit: seconds for each MILP (stage c2);
+    delta: relative margin for "differs"; time_limit: seconds of MILP per question (c2);
     tries: other-solver attempts (stage c1); bound: the MILP box (default: 1e3 z_s, raised to
     contain every solution seen); milp: False stops after stage c1 ("unknown" if undecided);
     ranges: also the range of every moving row of each observable over the face (two LPs
@@ -363,9 +363,10 @@ class _Stages:
             L = self.obs[v.name]
             s = milp_search(self.M, self.q, self.z, "values", L, delta=self.delta, bound=U,
                             time_limit=time_limit)
-            if s.status == "found" and s.deviation < 1e-3 and self.delta < 1e-2:
+            left = time_limit - (time.perf_counter() - t)  # one budget per question
+            if s.status == "found" and s.deviation < 1e-3 and self.delta < 1e-2 and left > 0.1:
                 s2 = milp_search(self.M, self.q, self.z, "values", L, delta=1e-2, bound=U,
-                                 time_limit=time_limit)  # a clearly different one, if any
+                                 time_limit=left)  # a clearly different one, if any
                 s = s2 if s2.status == "found" else s
             rejected = int(s.info.get("rejected_bases", 0))
             self.out.log.append(f"milp {v.name}: {s.status}, {s.message}")
