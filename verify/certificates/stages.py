@@ -275,13 +275,13 @@ class _Stages:
             # one LP along a random combination of the moving rows first (the witness), then,
             # when asked, the range of every moving row (two LPs each, on each face)
             mix = self.rng.choice((-1.0, 1.0), moving.size) @ L[moving]
-            jobs = [(None, mix), (None, -mix)]
+            jobs = [(None, 1.0, mix), (None, -1.0, -mix)]
             if self.ranges:
-                jobs += [(j, sgn * L[j]) for j in moving for sgn in (1.0, -1.0)]
+                jobs += [(j, sgn, sgn * L[j]) for j in moving for sgn in (1.0, -1.0)]
             for side in lps:
                 if lps[side] is None:
                     lps[side] = FaceLP(M, q, P, D, side)
-                for j, cost in jobs:
+                for j, sgn, cost in jobs:
                     st, y = lps[side].solve(cost)
                     n_lp += 1
                     if st == "optimal":
@@ -290,8 +290,8 @@ class _Stages:
                             best = (dev, y)
                     if j is None:
                         continue
-                    if st == "unbounded":
-                        (v.lo if cost[j] > 0 else v.hi)[j] = -np.sign(cost[j]) * np.inf
+                    if st == "unbounded":  # min of sgn L_j is -inf
+                        (v.lo if sgn > 0 else v.hi)[j] = -sgn * np.inf
                     elif st == "optimal":
                         lj = float(L[j] @ y)
                         v.lo[j], v.hi[j] = min(v.lo[j], lj), max(v.hi[j], lj)

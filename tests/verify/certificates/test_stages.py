@@ -219,3 +219,14 @@ def test_fig9_size_event_witness_keeps_the_tangential_states():
     assert np.max(np.abs(a.omega_dot - b.omega_dot)) > 1e-3
     assert np.max(np.abs(a.trans_acc - b.trans_acc)) < 1e-9  # no displacement either way
     _check_witness(ep.lcp, cert)
+
+
+def test_unbounded_ranges_are_infinite():
+    # M = [[1, -1], [-1, 1]], q = 0: the ray z1 = z2 = t >= 0 is a face of solutions
+    problem = _lcp([[1, -1], [-1, 1]], [0, 0])
+    cert = certify_stages(problem, np.array([1.0, 1.0]))
+    v = cert.verdicts["z"]
+    assert v.verdict == OTHER and v.stage == "face (a)"
+    np.testing.assert_allclose(v.lo, [0, 0], atol=1e-9)
+    assert np.all(np.isinf(v.hi))
+    assert cert.verdicts["w"].verdict == UNIQUE
