@@ -18,11 +18,10 @@ import time
 
 import numpy as np
 
-import lcp
-import models
-from verify.certificates.run import certify_run
-from verify.certificates.stages import UNIQUE, certify_stages, observables_of
-from verify.polyhedra import event_z
+from rigidlcp import lcp, models
+from rigidlcp.verify.certificates.run import certify_run
+from rigidlcp.verify.certificates.stages import UNIQUE, certify_stages, observables_of
+from rigidlcp.verify.forces.polyhedra import event_z
 
 RUNS = {  # name: (lattice, lx, ly, mu_pp, mu_plane, mu_wall, gamma, V0, seed)
     "fig9 rect 10x4": ("rect", 10, 4, 0.1, 0.2, 0.0, 0.16, 0.0, 1),

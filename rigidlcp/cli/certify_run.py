@@ -1,5 +1,5 @@
 """`rigidlcp certify-run RUN.npz --out DIR`: uniqueness verdicts at every event of a saved run
-(verify.certificates.run). Registered by verify.commands."""
+(rigidlcp.verify.certificates.run)."""
 
 from __future__ import annotations
 
@@ -50,9 +50,8 @@ def parse_events(text: str | None) -> list[int] | None:
 def cmd_certify_run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from models.runio import run_paths
-
-    from .run import certify_run, format_totals
+    from rigidlcp.models.runio import run_paths
+    from rigidlcp.verify.certificates.run import certify_run, format_totals
 
     if args.resume and args.force:
         raise ValueError("--resume and --force exclude each other")

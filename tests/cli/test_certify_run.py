@@ -7,10 +7,10 @@ import json
 
 import pytest
 
-import models
-from models.cli import main
-from models.runio import save_run
-from verify.certificates.run import FIGURE, LINES, SUMMARY, certify_run
+from rigidlcp import models
+from rigidlcp.cli import main
+from rigidlcp.models.runio import save_run
+from rigidlcp.verify.certificates.run import FIGURE, LINES, SUMMARY, certify_run
 
 VERDICTS = ("accelerations", "forces", "states")
 

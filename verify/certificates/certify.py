@@ -230,7 +230,7 @@ def certify(
 def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: float,
             bound: float | None, time_limit: float) -> None:
     """uniqueness="staged": the verdicts of verify.certificates.stages.certify_stages."""
-    from .certificates.stages import OTHER, UNIQUE, certify_stages
+    from .stages import OTHER, UNIQUE, certify_stages
 
     staged = certify_stages(problem, z, delta=delta, bound=bound, time_limit=time_limit,
                             observables={"z": np.eye(problem.n), "w": problem.M, **obs})

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..uniqueness import quiet_highs
+from .uniqueness import quiet_highs
 
 #: HiGHS tolerances for the face LPs (its defaults are 1e-7).
 _TOL = 1e-10

@@ -23,12 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from models.event import event_problem
-from models.evolution import Run
-from models.runio import load_run
-from models.sweep import ResultsFile, _atomic_write_text
+from rigidlcp.models.engine.records import Run
+from rigidlcp.models.event import event_problem
+from rigidlcp.models.runio import load_run
+from rigidlcp.models.sweep import ResultsFile, _atomic_write_text
 
-from ..polyhedra import event_z
+from ..forces.polyhedra import event_z
 from .stages import OTHER, UNIQUE, UNKNOWN, certify_stages
 
 LINES, SUMMARY, FIGURE, OPTIONS = ("certificates.jsonl", "summary.json", "determinacy.png",
@@ -90,7 +90,7 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
     ranges: the range LPs of each observable over the face (slower); events: which events
     (default all); jobs: worker processes (models.executors.iter_map).
     """
-    from models.executors import iter_map
+    from rigidlcp.models.executors import iter_map
 
     if not isinstance(run, Run):
         run = load_run(run)

@@ -38,11 +38,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lcp import LCP, Solution, solve
+from rigidlcp.lcp import LCP, Solution, solve
 
-from ..certify import certify
-from ..uniqueness import BOUND_FACTOR, milp_search, p_matrix_test, scales, sign_pattern
+from .certify import certify
 from .faces import FaceLP, null_directions
+from .uniqueness import BOUND_FACTOR, milp_search, p_matrix_test, scales, sign_pattern
 
 UNIQUE, OTHER, UNKNOWN = "unique", "another solution exists", "unknown"
 

@@ -9,13 +9,18 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-import lcp
-import models
-from verify import certify
-from verify.certificates import certify_stages
-from verify.certificates.stages import OTHER, UNIQUE, UNKNOWN, independent_residual
-from verify.strategies import degenerate_lcps, event_states, lcps, symmetric_psd, systems
-from verify.uniqueness import scales
+from rigidlcp import lcp, models
+from rigidlcp.verify import certify
+from rigidlcp.verify.certificates import certify_stages
+from rigidlcp.verify.certificates.stages import OTHER, UNIQUE, UNKNOWN, independent_residual
+from rigidlcp.verify.certificates.uniqueness import scales
+from rigidlcp.verify.strategies import (
+    degenerate_lcps,
+    event_states,
+    lcps,
+    symmetric_psd,
+    systems,
+)
 
 
 def _lcp(M, q) -> lcp.LCP:
@@ -146,7 +151,7 @@ def _agrees_on_event(ep, z):
     assert cert.accepted
     _check_witness(ep.lcp, cert)
     sols = lcp.enumerate_solutions(ep.lcp)
-    from verify.certificates.stages import observables_of
+    from rigidlcp.verify.certificates.stages import observables_of
 
     _, obs = observables_of(ep)
     zs, _ = scales(ep.lcp.M, ep.lcp.q, z)
@@ -161,7 +166,7 @@ def _agrees_on_event(ep, z):
 
 
 def test_event_verdicts_agree_with_enumeration(small_runs):
-    from verify.polyhedra import event_z
+    from rigidlcp.verify.forces.polyhedra import event_z
 
     seen = unique = 0
     for run in small_runs:
@@ -203,7 +208,7 @@ def test_certify_staged_fills_the_classic_certificate():
 def test_fig9_size_event_witness_keeps_the_tangential_states():
     # rect 10x4 (Fig. 9's array), seed 1: at the first event the accelerations are not unique,
     # and the witness is a solution with the same tangential states (a face witness)
-    from verify.polyhedra import event_z
+    from rigidlcp.verify.forces.polyhedra import event_z
 
     system = models.System(models.rectangular(10, 4), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
                            gamma=0.16)
