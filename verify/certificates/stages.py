@@ -18,8 +18,9 @@ c. other contact states: (c1) other solvers (Lemke with random covering vectors,
    state iteration from random active sets), each answer verified, any that differs in L is a
    witness; (c2) the MILP of verify.uniqueness.milp_search ("values" target) in a box that
    contains every solution seen (at least 1e3 z_s), with a time limit. "none" => "unique"
-   (within the box, to the margin); a MILP that stopped, or that cut bases it could not confirm,
-   => "unknown" with the reason.
+   (within the box, to the margin; global when verify.certificates.bounds proves that no
+   solution has |z|_1 >= the box, which is said in the verdict's scope); a MILP that stopped,
+   or that cut bases it could not confirm, => "unknown" with the reason.
 
 Every witness is re-checked by `independent_residual` (w recomputed in extended precision) and
 its difference in L measured against the margin delta (relative to s_L = max(|L|_inf z_s,
@@ -40,6 +41,7 @@ import numpy as np
 
 from rigidlcp.lcp import LCP, Solution, solve
 
+from .bounds import no_solution_beyond
 from .certify import certify
 from .faces import FaceLP, null_directions
 from .uniqueness import BOUND_FACTOR, milp_search, p_matrix_test, scales, sign_pattern
@@ -376,6 +378,11 @@ class _Stages:
                 self.decide(v, OTHER, "milp (c2)", f"MILP: {s.message}", t, w, scope=scope)
             elif s.status == "none" and rejected == 0:
                 prior = f"; {v.reason}" if v.reason else ""
+                left = max(time_limit - (time.perf_counter() - t), 0.5)
+                nb = no_solution_beyond(self.M, self.q, U, time_limit=left)
+                self.out.log.append(f"norm bound: {nb.message}")
+                scope = ("global: " + nb.message if nb.proved else
+                         f"{scope}; not global: {nb.message}")
                 self.decide(v, UNIQUE, "milp (c2)", f"MILP infeasible: {s.message}{prior}", t,
                             scope=scope)
             else:
