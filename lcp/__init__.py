@@ -1,13 +1,14 @@
 """rigidlcp's pure mathematics: LCP/MLCP problems, solvers, residuals. Knows nothing of disks."""
 
 from .api import MethodInfo, get_method, methods, register, solve
+from .friction import FrictionContact2D, natural_residual
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable, load
 from .solution import STATUSES, Solution, complementarity_residual
 
 __all__ = [
     "LCP", "MLCP", "InvalidProblem", "NotApplicable", "load", "Solution", "STATUSES",
     "complementarity_residual", "solve", "methods", "get_method", "register", "MethodInfo",
-    "enumerate_solutions",
+    "enumerate_solutions", "FrictionContact2D", "natural_residual",
 ]
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +22,7 @@ ACCEPTS = {
     "any": "any square M",
     "symmetric-psd": "symmetric positive semidefinite M only",
     "small-n": "any M, but only small n (exhaustive)",
+    "friction-2d": "2D friction-contact problems (lcp.FrictionContact2D) only",
 }
 
 
@@ -33,6 +34,8 @@ class MethodInfo:
     options: tuple[str, ...]
     max_n: int | None
     func: Callable[..., Solution]
+    #: problem kind ("mlcp", "friction-2d") -> a function taking that problem object itself
+    native: dict[str, Callable[..., Solution]] = field(default_factory=dict)
 
     def __str__(self) -> str:
         limit = f", n <= {self.max_n}" if self.max_n else ""
@@ -44,15 +47,19 @@ class MethodInfo:
 _REGISTRY: dict[str, MethodInfo] = {}
 
 
-def register(name: str, *, accepts: str, description: str, max_n: int | None = None):
-    """Decorator adding a method to the registry."""
+def register(name: str, *, accepts: str, description: str, max_n: int | None = None,
+             native: dict[str, Callable[..., Solution]] | None = None):
+    """Decorator adding a method to the registry. `native` maps a problem kind ("mlcp",
+    "friction-2d") to a function `fn(problem, **options)` that solves it without reduction;
+    a method that accepts "friction-2d" is itself such a function."""
     if accepts not in ACCEPTS:
         raise ValueError(f"accepts must be one of {sorted(ACCEPTS)}, got {accepts!r}")
 
     def deco(func: Callable[..., Solution]) -> Callable[..., Solution]:
         params = inspect.signature(func).parameters
         options = tuple(p for p in params if params[p].kind is inspect.Parameter.KEYWORD_ONLY)
-        _REGISTRY[name] = MethodInfo(name, accepts, description, options, max_n, func)
+        _REGISTRY[name] = MethodInfo(name, accepts, description, options, max_n, func,
+                                     dict(native or {}))
         return func
 
     return deco
@@ -80,9 +87,12 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
-    if not isinstance(problem, (LCP, MLCP)):
+    from .friction import FrictionContact2D
+
+    if not isinstance(problem, (LCP, MLCP, FrictionContact2D)):
         raise InvalidProblem(
-            f"problem must be an lcp.LCP or lcp.MLCP, got {type(problem).__name__}"
+            f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
+            f"{type(problem).__name__}"
         )
     info = get_method(method)
     unknown = set(options) - set(info.options)
@@ -91,6 +101,18 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
             f"method {method!r} does not accept option(s) {sorted(unknown)}; "
             f"it accepts {list(info.options) or 'none'}"
         )
+    if isinstance(problem, FrictionContact2D):
+        from .friction import solve_friction
+
+        return solve_friction(problem, info, dict(options))
+    if info.accepts == "friction-2d":
+        raise NotApplicable(f"method {method!r} solves 2D friction-contact problems only")
+    if isinstance(problem, MLCP):
+        from .mlcp_full import solve_mlcp_unreduced
+
+        sol = solve_mlcp_unreduced(problem, info, options)
+        if sol is not None:
+            return sol
     lcp = problem.to_lcp() if isinstance(problem, MLCP) else problem
     if info.max_n is not None and lcp.n > info.max_n:
         raise NotApplicable(

@@ -212,11 +212,21 @@ def _save_npz(path, kind: str, arrays: dict, name: str, meta: dict) -> Path:
     return path
 
 
-def load(path: str | os.PathLike) -> LCP | MLCP:
-    """Read an LCP or MLCP written by `.save` (or any .npz with M, q or A, C, D, B, a, b)."""
+def load(path: str | os.PathLike):
+    """Read a problem file, detecting its kind: an .npz written by `.save` (or any .npz with
+    M, q or A, C, D, B, a, b), or a Siconos text file (LCP, MLCP or 2D friction contact:
+    lcp.io; returns an LCP, MLCP or FrictionContact2D). A file of no known kind raises
+    InvalidProblem (lcp.io.text.FileFormatError) naming the file, the line and what was
+    expected."""
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"no problem file at {path}")
+    with open(path, "rb") as fh:
+        magic = fh.read(4)
+    if magic[:2] != b"PK":  # not a zip archive (.npz): a Siconos text file
+        from verify.siconos_format import read_siconos  # TODO(rebase): .io.siconos
+
+        return read_siconos(path)
     with np.load(path, allow_pickle=False) as data:
         keys = set(data.files)
         header = json.loads(str(data["__header__"])) if "__header__" in keys else {}

@@ -43,9 +43,12 @@ solved by the Schur-complement (capacitance) method,
 
 where each column of Y costs one solve with the LU (cached per row) and C is a small dense
 matrix. K is singular exactly when C is (checked by LAPACK's condition estimate); a base is
-refactored when the rows replaced since its factorization exceed `max_updates`, or when the
-solves spent on Y cost more than the factorization did. A solve is followed by one step of
-iterative refinement against K itself.
+refactored when the rows replaced since its factorization exceed `max_updates`, or when more
+than `refactor_solves` columns of Y have been solved for since (a count, not a clock, so that
+a solve is deterministic: same pivots, same answer on every run; the default is the measured
+cost of one factorization in column solves on the 2020-contact Siconos problem, about 23); a
+change of more rows than that budget allows is a fresh factorization. A solve is followed by
+one step of iterative refinement against K itself.
 """
 
 from __future__ import annotations
@@ -74,6 +77,8 @@ NS = 2
 RCOND = 1e-12
 #: A fresh LU whose pivots span more than 1 / PIVOT_RATIO is treated as singular.
 PIVOT_RATIO = 1e-13
+#: Refactor after this many column solves with the base LU (see the module doc).
+REFACTOR_SOLVES = 24
 #: SuperLU's column ordering: minimum degree on K + K' suits K, whose pattern is nearly
 #: symmetric (W's); SuperLU's default COLAMD fills ~10x more at 100 x 100 disks.
 PERMC = "MMD_AT_PLUS_A"
@@ -234,9 +239,10 @@ class StateFactor:
     capacitance method (see the module doc). `normal`, `tang` are the current states."""
 
     def __init__(self, system: ActiveSystem, normal: np.ndarray, tang: np.ndarray,
-                 max_updates: int = 400):
+                 max_updates: int = 400, refactor_solves: int = REFACTOR_SOLVES):
         self.sys = system
         self.max_updates = max_updates
+        self.refactor_solves = refactor_solves
         self.stats = {"factorizations": 0, "factor_seconds": 0.0, "update_solves": 0,
                       "update_seconds": 0.0}
         self.refactor(normal, tang)
@@ -260,15 +266,16 @@ class StateFactor:
         self.last_factor_seconds = elapsed
         self.Y = np.zeros((self.sys.N, 32))
         self.spent = 0.0
+        self.solves_since = 0
         self.update = _Update()
         self.normal, self.tang = normal.copy(), tang.copy()
 
     @property
     def worn(self) -> bool:
-        """Refactor? (more replaced rows than max_updates, or their solves cost more than the
-        factorization did)"""
+        """Refactor? (more replaced rows than max_updates, or more than refactor_solves
+        column solves since the factorization: counts, never clocks)"""
         return (len(self.update.rows) > self.max_updates
-                or self.spent > max(self.last_factor_seconds, 1e-3))
+                or self.solves_since > self.refactor_solves)
 
     # -- row updates ------------------------------------------------------------------------
     def _delta(self, r: int, normal: np.ndarray, tang: np.ndarray):
@@ -305,6 +312,7 @@ class StateFactor:
         dt = time.perf_counter() - t0
         self.spent += dt
         self.stats["update_solves"] += m - m_old
+        self.solves_since += m - m_old
         self.stats["update_seconds"] += dt
         Ym = self.Y[:, :m]
         C = np.eye(m)
@@ -336,8 +344,10 @@ class StateFactor:
         changed = np.flatnonzero(np.concatenate([normal != self.normal, tang != self.tang]))
         if changed.size == 0:
             return
-        if len(set(self.update.rows) | set(changed.tolist())) > self.max_updates:
-            self.refactor(normal, tang)
+        rows = set(self.update.rows)
+        new = len(set(changed.tolist()) - rows)
+        if len(rows) + new > self.max_updates or self.solves_since + new > self.refactor_solves:
+            self.refactor(normal, tang)  # cheaper than `new` column solves and their update
             return
         self.update = self._propose(normal, tang, changed)
         self.normal, self.tang = normal.copy(), tang.copy()
