@@ -223,7 +223,7 @@ def load(path: str | os.PathLike):
         raise FileNotFoundError(f"no problem file at {path}")
     with open(path, "rb") as fh:
         magic = fh.read(4)
-    if magic[:2] != b"PK":  # not a zip archive (.npz): a Siconos text file
+    if magic[:2] != b"PK" and path.suffix != ".npz":  # not an .npz: a Siconos text file
         from verify.siconos_format import read_siconos  # TODO(rebase): .io.siconos
 
         return read_siconos(path)

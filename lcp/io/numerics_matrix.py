@@ -36,8 +36,10 @@ STORAGE = {0: "dense", 1: "sparse-block", 2: "sparse"}
 NSM_ORIGIN = {1: "triplet", 2: "csc"}
 
 
-def read_numerics_matrix(tok: Tokens, name: str) -> tuple[np.ndarray | sp.csc_matrix, str]:
-    """(matrix, storage name) of the NumericsMatrix at the tokens' position."""
+def read_numerics_matrix(tok: Tokens, name: str, expect: tuple[int, int] | None = None
+                         ) -> tuple[np.ndarray | sp.csc_matrix, str]:
+    """(matrix, storage name) of the NumericsMatrix at the tokens' position; `expect`: the
+    shape the problem needs, checked as soon as the header gives it."""
     line = tok.line
     storage = tok.integer(f"the storage type of {name} (0 dense, 1 sparse block, 2 sparse)")
     if storage not in STORAGE:
@@ -45,6 +47,9 @@ def read_numerics_matrix(tok: Tokens, name: str) -> tuple[np.ndarray | sp.csc_ma
                         "1 (sparse block) or 2 (sparse)", line)
     size0 = tok.integer(f"the number of rows of {name}", low=1)
     size1 = tok.integer(f"the number of columns of {name}", low=1)
+    if expect is not None and (size0, size1) != expect:
+        raise tok.error(f"{name} is {size0} x {size1}, the problem's size needs {expect[0]} x "
+                        f"{expect[1]}", line)
     if storage == 0:
         line = tok.line
         rows, cols = tok.integer(f"rows of {name} again"), tok.integer(f"columns of {name} again")

@@ -77,11 +77,7 @@ def read_siconos_lcp(path: str | os.PathLike) -> LCP:
 
 def _read_lcp(tok: Tokens, path: Path) -> LCP:
     n = tok.integer("the problem size n", low=1)
-    line = tok.line
-    M, storage = read_numerics_matrix(tok, "M")
-    if not n == M.shape[0] == M.shape[1]:
-        raise tok.error(f"an LCP needs a square M of the problem's size; got n = {n}, M "
-                        f"{M.shape[0]} x {M.shape[1]}", line)
+    M, storage = read_numerics_matrix(tok, "M", expect=(n, n))
     q = tok.numbers(n, f"q ({n} numbers)")
     extra = tok.trailing_numbers()
     if extra:

@@ -44,11 +44,7 @@ def read_fc2d_tokens(tok: Tokens, path: Path) -> FrictionContact2D:
                             "rigidlcp reads 2D ones")
         raise tok.error(f"dimension {d} where 2 was expected", line)
     c = tok.integer("the number of contacts", low=1)
-    line = tok.line
-    W, storage = read_numerics_matrix(tok, "W")
-    if W.shape != (2 * c, 2 * c):
-        raise tok.error(f"W is {W.shape[0]} x {W.shape[1]}, expected 2 x {c} contacts = "
-                        f"{2 * c} square", line)
+    W, storage = read_numerics_matrix(tok, "W", expect=(2 * c, 2 * c))
     q = tok.numbers(2 * c, f"q ({2 * c} numbers)")
     mu = tok.numbers(c, f"mu ({c} numbers, one per contact)")
     extra = tok.trailing_numbers()  # Siconos's files often end with a "1"; Siconos ignores it

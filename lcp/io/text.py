@@ -49,7 +49,7 @@ class Tokens:
             self.lines += [k] * len(parts)
         self.pos = 0
         self.path = str(path)
-        self.nlines = text.count("\n") + 1
+        self.nlines = self.lines[-1] if self.lines else 1  # the last line with an item
 
     @property
     def line(self) -> int:

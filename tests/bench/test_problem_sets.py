@@ -260,11 +260,11 @@ def test_siconos_reader_reads_the_documented_layout(tmp_path):
 
 
 @pytest.mark.parametrize("text, match", [
-    ("2\n0\n2\n2\n2\t2\n1 3\n2 4\n-1\n", "ends where an entry of q"),
-    ("2\n0\n3\n3\n3\t3\n", "square M of the problem's size"),
-    ("2\n2\n2\n2\n", "storage type 2"),
-    ("2\n0\n2\n2\n2\t2\n1 x\n2 4\n-1 -2\n", "should be an entry of M"),
-    ("2\n7\n2\n2\n", "unknown matrix storage"),
+    ("2\n0\n2\n2\n2\t2\n1 3\n2 4\n-1\n", "line 8: the file ends after 1 of the 2 numbers of q"),
+    ("2\n0\n3\n3\n3\t3\n", "line 2: M is 3 x 3, the problem's size needs 2 x 2"),
+    ("2\n2\n2\n2\n", "line 4: the file ends where the sparse origin of M"),
+    ("2\n0\n2\n2\n2\t2\n1 x\n2 4\n-1 -2\n", "line 6: 'x' where the entries of M"),
+    ("2\n7\n2\n2\n", "line 2: unknown storage type 7"),
 ])
 def test_siconos_reader_names_what_is_wrong(tmp_path, text, match):
     (tmp_path / "bad.dat").write_text(text)

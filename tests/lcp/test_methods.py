@@ -67,7 +67,8 @@ def test_p_matrix_lcps_every_applicable_method_agrees_with_enumeration(problem):
     assert len(ref) == 1 and not ref[0].info["continuum"], "a P-matrix LCP has one solution"
     z_ref = ref[0].z
     for name, info in registered().items():
-        if info.accepts == "symmetric-psd" and not is_symmetric_psd(problem.M):
+        if info.accepts == "symmetric-psd" and not is_symmetric_psd(problem.M) or \
+                info.accepts == "friction-2d":
             with pytest.raises(lcp.NotApplicable):
                 lcp.solve(problem, name)
             continue
@@ -343,12 +344,19 @@ def test_mlcp_schur_reduction_agrees_with_the_assembled_lcp(problem):
             assert close(sol.v, s.z[2 * nu:], 1e-7) and close(sol.u, u, 1e-7)
 
 
-def test_mlcp_with_singular_a_is_not_applicable_and_says_why():
+def test_mlcp_with_singular_a_is_solved_on_the_full_system_not_refused():
+    # Issue 12: a singular A is no reason to refuse. Here u1 + u2 + v = 0 (twice) and
+    # w = u1 + u2 + v - 1 = -1 < 0 for every u, v: no solution, never "solved".
     singular = lcp.MLCP(np.array([[1.0, 1.0], [1.0, 1.0]]), np.ones((2, 1)), np.ones((1, 2)),
                         np.eye(1), np.zeros(2), -np.ones(1))
-    with pytest.raises(lcp.NotApplicable, match="singular"):
-        lcp.solve(singular, "pivoting")
+    for name in ("pivoting", "lemke", "newton-min", "newton-fb", "enumerate-mlcp"):
+        assert lcp.solve(singular, name).status != "solved", name
+    # A zero mass: u1 + v = 0, 0 u2 + v = 0, w = u1 + u2 + v - 1: v = 0, u1 = 0, u2 >= 1.
     zero_mass = lcp.MLCP(np.diag([1.0, 0.0]), np.ones((2, 1)), np.ones((1, 2)), np.eye(1),
                          np.zeros(2), -np.ones(1))
-    with pytest.raises(lcp.NotApplicable, match="singular"):
-        lcp.solve(zero_mass, "enumerate")
+    # (Lemke on the split LCP ends on a ray here: that M is not copositive-plus.)
+    for name in ("enumerate", "newton-min", "newton-fb", "enumerate-mlcp"):
+        sol = lcp.solve(zero_mass, name)
+        assert sol.status == "solved", (name, sol)
+        assert sol.eq_residual <= 1e-12 and sol.residual <= 1e-12, name
+        assert abs(sol.v[0]) <= 1e-12 and abs(sol.u[0]) <= 1e-12 and sol.u[1] >= 1 - 1e-12
