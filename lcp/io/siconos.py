@@ -48,6 +48,7 @@ from pathlib import Path
 from ..problem import LCP, MLCP
 from .numerics_matrix import STORAGE, read_numerics_matrix, write_numerics_matrix
 from .text import (
+    KIND_NAMES,
     FileFormatError,
     Tokens,
     UnsupportedProblem,
@@ -72,6 +73,10 @@ def read_siconos_lcp(path: str | os.PathLike) -> LCP:
     path = Path(path)
     tok = Tokens(path.read_text(errors="replace"), str(path))
     check_kind(tok, "lcp")
+    kind = siconos_kind(tok)  # a tiny MLCP's header is also an LCP's: which reader fits?
+    if kind not in ("lcp", None):
+        raise WrongKind(str(path), 1, f"this is a Siconos {KIND_NAMES[kind]} file, not an LCP")
+    tok.pos = 0
     return _read_lcp(tok, path)
 
 
@@ -95,17 +100,21 @@ def siconos_kind(tok: Tokens) -> str | None:
     fits = header_kinds(tok)
     if len(fits) <= 1:
         return fits[0] if fits else None
-    # several headers fit (tiny problems): the kind whose reader takes the whole file
+    # several headers fit (tiny problems): the kind whose reader takes the whole file, else
+    # the one whose reader got furthest (its error is the telling one)
+    furthest, best = -1, fits[0]
     for kind in fits:
         tok.pos = 0
         try:
             _READERS[kind](tok, Path(tok.path))
         except FileFormatError:
+            if tok.pos > furthest:
+                furthest, best = tok.pos, kind
             continue
         except UnsupportedProblem:
             return kind
         return kind
-    return fits[0]
+    return best
 
 
 def read_siconos(path: str | os.PathLike) -> LCP | MLCP:
