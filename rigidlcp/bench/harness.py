@@ -12,8 +12,14 @@ per solve, and every answer is checked here, never taken from the solver:
 * a solve longer than the time limit, a refusal (NotApplicable), an exception, or any other
   status (max_iter, not_converged, failed) is a failure.
 
-Isolation: rigidlcp's methods run in a worker process forked from this one (so methods
-registered at run time, e.g. test doubles, are there too); a solve that does not answer within
+Problems: LCPs, MLCPs (given to the methods as they are: a singular A is the method's affair,
+see lcp.mlcp_full), 2D friction-contact problems (certified by their natural-map residual,
+verify.certify) and `Unreadable` files (one row, method "-", outcome "unreadable", with the
+reason). A claim that no solution exists is certified for LCPs only (Farkas).
+
+Isolation: rigidlcp's methods run in a worker process started by "forkserver" (or "spawn"),
+never forked from this multi-threaded process; a method registered at run time is sent to it
+by reference (a module-level function, e.g. the test doubles); a solve that does not answer within
 the limit is killed with its worker, and a fresh worker takes the next solve. The time is
 measured in the worker around `lcp.solve` (validation, the method, w = M z + q); each method
 first solves a 2 x 2 problem, untimed, in every fresh worker (imports, caches). The worker
@@ -37,9 +43,10 @@ import numpy as np
 from scipy.optimize import linprog
 
 from rigidlcp import lcp
-from rigidlcp.lcp import LCP, MLCP
+from rigidlcp.lcp import LCP, MLCP, Solution
 from rigidlcp.verify.certificates.certify import certify
 
+from .problem_sets import Unreadable
 from .runners import GRACE, SICONOS_METHODS, LocalRunner, SiconosRunner
 
 __all__ = ["Result", "judge", "run_bench", "farkas_certificate", "write_csv", "read_csv",
@@ -104,9 +111,14 @@ def farkas_certificate(M: np.ndarray, q: np.ndarray) -> np.ndarray | None:
 # the run
 # --------------------------------------------------------------------------------------------
 
-def judge(problem: LCP, method: str, set_name: str, raw: dict, time_limit: float,
+def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
           tol: float) -> Result:
     """Turn a runner's raw answer into a Result, certifying it (see the module doc)."""
+    if isinstance(problem, Unreadable):
+        return Result(set=set_name, problem=problem.name, n=0, method="-",
+                      outcome="unreadable", success=False, status="unreadable", time=0.0,
+                      iterations=None, residual=math.nan, scaled_residual=math.nan,
+                      expected="-", message=problem.reason)
     expected = str(problem.meta.get("expected", "unknown"))
     base = dict(set=set_name, problem=problem.name, n=problem.n, method=method,
                 expected=expected, message=raw.get("message", ""))
@@ -118,8 +130,9 @@ def judge(problem: LCP, method: str, set_name: str, raw: dict, time_limit: float
     status, t, z = raw["status"], float(raw["time"]), raw["z"]
     res = scaled = math.nan
     if z.shape == (problem.n,) and np.all(np.isfinite(z)):
+        answer = Solution(z=z, w=np.zeros(0), status=status, method=method, u=raw.get("u"))
         with np.errstate(all="ignore"):
-            cert = certify(problem, z, tol=tol, uniqueness="none")
+            cert = certify(problem, answer, tol=tol, uniqueness="none")
         res, scaled = cert.residual, cert.scaled_residual
         accepted = cert.accepted
     else:
@@ -129,7 +142,7 @@ def judge(problem: LCP, method: str, set_name: str, raw: dict, time_limit: float
     elif status == "solved":
         outcome = "solved" if accepted else "uncertified"
     elif status in NO_SOLUTION:
-        proved = farkas_certificate(problem.M, problem.q) is not None
+        proved = isinstance(problem, LCP) and farkas_certificate(problem.M, problem.q) is not None
         outcome = "infeasible" if proved else "unproved_infeasible"
     else:
         outcome = status
@@ -172,8 +185,11 @@ def run_bench(
     try:
         for set_name, problems in sets.items():
             for problem in problems:
-                if isinstance(problem, MLCP):
-                    problem = problem.to_lcp()
+                if isinstance(problem, Unreadable):
+                    results.append(judge(problem, "-", set_name, {}, time_limit, tol))
+                    if progress is not None:
+                        progress(results[-1])
+                    continue
                 for method in methods:
                     runner = siconos if method in SICONOS_METHODS else local
                     raw = runner.solve(problem, method, time_limit)

@@ -35,18 +35,18 @@ and ``*.dat`` files (Siconos's numerics test-suite format, rigidlcp.lcp.io.sicon
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import shutil
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from rigidlcp import lcp
-from rigidlcp.lcp import LCP, MLCP
-from rigidlcp.lcp.io.siconos import read_siconos_lcp
+from rigidlcp.lcp import LCP
 
 P_KINDS = ("positive-definite", "diagonally-dominant", "triangular", "scaled")
 
@@ -351,19 +351,35 @@ def get_set(spec: str, *, seed: int = 0, cache_dir: str | os.PathLike | None = N
                      "directory")
 
 
-def load_folder(folder: str | os.PathLike) -> list[LCP]:
-    """Every *.npz (lcp.load; an MLCP is reduced to its LCP) and *.dat (Siconos format) file
-    of a folder, sorted by name. A file that cannot be read raises, naming it."""
+@dataclass(frozen=True)
+class Unreadable:
+    """A file of a folder set that could not be read: the bench reports it as a row with
+    status "unreadable" and the reason, and goes on."""
+
+    name: str
+    reason: str
+    meta: dict = field(default_factory=dict)
+    n: int = 0
+
+
+def load_folder(folder: str | os.PathLike) -> list:
+    """Every *.npz and *.dat file of a folder (lcp.load: npz, or Siconos's LCP, MLCP or 2D
+    friction-contact text), sorted by name; the problems keep their kind (an MLCP is not
+    reduced here). A file that cannot be read, or whose problem rigidlcp does not take (e.g. a
+    rectangular MLCP), is an `Unreadable` with the reason (its error message)."""
     folder = Path(folder)
     files = sorted([*folder.glob("*.npz"), *folder.glob("*.dat")])
     if not files:
         raise ValueError(f"{folder} holds no *.npz or *.dat problem files")
-    out = []
+    out: list = []
     for f in files:
-        p = read_siconos_lcp(f) if f.suffix == ".dat" else lcp.load(f)
-        if isinstance(p, MLCP):
-            p = p.to_lcp()
+        name = f"{folder.name}/{f.stem}"
+        try:
+            p = lcp.load(f)
+        except (ValueError, OSError) as exc:  # InvalidProblem, NotApplicable, bad zip, ...
+            out.append(Unreadable(name, str(exc), {"set": folder.name, "file": str(f)}))
+            continue
         meta = {**p.meta, "set": folder.name, "class": "folder", "file": str(f)}
         meta.setdefault("expected", "unknown")
-        out.append(LCP(p.M, p.q, name=f"{folder.name}/{f.stem}", meta=meta))
+        out.append(dataclasses.replace(p, name=name, meta=meta))
     return out

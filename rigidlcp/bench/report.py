@@ -10,7 +10,13 @@ Metrics per set and method (qpbenchmark's conventions, stated in the report):
   pivoting and enumerate's bases, sweeps for pgs, interior-point or ADMM iterations for the QP
   methods, Siconos's SICONOS_IPARAM_ITER_DONE): comparable within a method, not across;
 * worst residual: the largest scaled complementarity residual (verify.certify's measure,
-  max_i |min(z_i / z_s, w_i / w_s)|) over the answers the method claimed were solutions.
+  max_i |min(z_i / z_s, w_i / w_s)|; friction contact: the relative natural-map residual) over
+  the answers the method claimed were solutions;
+* refused: problems the method declined (NotApplicable: outside its class or size limit),
+  reported apart from its failures (a refusal still counts at the time limit in the SGM);
+* SGM over the common problems: the same mean over only the problems that *every* compared
+  method accepts (none refused them), a fair comparison of methods with different domains.
+Unreadable files (method "-") are listed with their reason, outside every method's numbers.
 
 Performance profile (Dolan & More, Math. Program. 91, 201, 2002): with t_ps the time of method
 s on problem p (infinite when it failed), r_ps = t_ps / min_s t_ps, and
@@ -54,6 +60,9 @@ class Summary:
     median_iterations: float
     worst_residual: float
     failures: Counter
+    refused: int = 0
+    sgm_common: float = math.nan
+    common: int = 0
 
     @property
     def rate(self) -> float:
@@ -63,10 +72,13 @@ class Summary:
 def summarize(results: Sequence[Result], time_limit: float, set_name: str | None = None
               ) -> list[Summary]:
     """One Summary per method over the results of `set_name` (None: every set, "all")."""
-    rows = [r for r in results if set_name is None or r.set == set_name]
+    rows = [r for r in results if (set_name is None or r.set == set_name) and r.method != "-"]
+    refused_somewhere = {(r.set, r.problem) for r in rows if r.outcome == "not_applicable"}
     out = []
     for method in dict.fromkeys(r.method for r in rows):
         mine = [r for r in rows if r.method == method]
+        common = [r.time if r.success else time_limit for r in mine
+                  if (r.set, r.problem) not in refused_somewhere]
         ok = [r for r in mine if r.success]
         times = [r.time if r.success else time_limit for r in mine]
         its = [r.iterations for r in ok if r.iterations is not None]
@@ -77,7 +89,10 @@ def summarize(results: Sequence[Result], time_limit: float, set_name: str | None
             sgm_time=shifted_geometric_mean(times),
             median_iterations=float(np.median(its)) if its else math.nan,
             worst_residual=max(claimed) if claimed else math.nan,
-            failures=Counter(r.outcome for r in mine if not r.success)))
+            failures=Counter(r.outcome for r in mine
+                             if not r.success and r.outcome != "not_applicable"),
+            refused=sum(r.outcome == "not_applicable" for r in mine),
+            sgm_common=shifted_geometric_mean(common), common=len(common)))
     return out
 
 
@@ -85,7 +100,7 @@ def profile_data(results: Sequence[Result], set_name: str | None = None
                  ) -> tuple[list[str], np.ndarray]:
     """(methods, ratios): ratios[p, s] = t_ps / min_s t_ps (inf for a failure; all inf when
     every method failed on p). Times are floored at 1 microsecond."""
-    rows = [r for r in results if set_name is None or r.set == set_name]
+    rows = [r for r in results if (set_name is None or r.set == set_name) and r.method != "-"]
     methods = list(dict.fromkeys(r.method for r in rows))
     problems = list(dict.fromkeys((r.set, r.problem) for r in rows))
     T = np.full((len(problems), len(methods)), np.inf)
@@ -142,14 +157,17 @@ def _fmt(v: float, spec: str) -> str:
 
 def summary_table(summaries: Sequence[Summary]) -> list[str]:
     """Markdown table lines of summaries."""
-    lines = ["| method | success | SGM time | median iterations | worst residual | failures |",
-             "|---|---:|---:|---:|---:|---|"]
+    common = summaries[0].common if summaries else 0
+    lines = ["| method | success | refused | SGM time | SGM time, common "
+             f"({common}) | median iterations | worst residual | failures |",
+             "|---|---:|---:|---:|---:|---:|---:|---|"]
     for s in summaries:
         fails = ", ".join(f"{k} {v}" for k, v in sorted(s.failures.items())) or "-"
         lines.append(
-            f"| {s.method} | {s.successes}/{s.problems} ({100 * s.rate:.0f}%) | "
-            f"{_fmt_time(s.sgm_time)} | {_fmt(s.median_iterations, '.0f')} | "
-            f"{_fmt(s.worst_residual, '.1e')} | {fails} |")
+            f"| {s.method} | {s.successes}/{s.problems} ({100 * s.rate:.0f}%) | {s.refused} | "
+            f"{_fmt_time(s.sgm_time)} | {_fmt_time(s.sgm_common)} | "
+            f"{_fmt(s.median_iterations, '.0f')} | {_fmt(s.worst_residual, '.1e')} | "
+            f"{fails} |")
     return lines
 
 
@@ -180,6 +198,10 @@ def write_report(results: Sequence[Result], out: str | os.PathLike, *, time_limi
         "rho_s(tau) = fraction of problems solved within a factor tau of the fastest method.",
     ]
     lines += ["", *(f"- {n}" for n in notes)] if notes else []
+    unreadable = [r for r in results if r.outcome == "unreadable"]
+    if unreadable:
+        lines += ["", f"Unreadable files ({len(unreadable)}), not run:", ""]
+        lines += [f"- `{r.problem}`: {r.message}" for r in unreadable]
     lines += ["", "## All sets", ""]
     lines += summary_table(summarize(results, time_limit))
     png = plot_profile(results, out / "profile_all.png", "all sets")

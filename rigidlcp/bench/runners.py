@@ -1,5 +1,8 @@
-"""Runners of the benchmark harness (rigidlcp.bench.harness): rigidlcp's methods in a forked worker
-process that is killed on a timeout, and Siconos's LCP solvers in a /usr/bin/python3 subprocess.
+"""Runners of the benchmark harness (rigidlcp.bench.harness): rigidlcp's methods in a worker process
+(started by "forkserver" or "spawn", never forked from this possibly multi-threaded process)
+that is killed on a timeout, and Siconos's LCP solvers in a /usr/bin/python3 subprocess.
+A method registered at run time (not built in) is sent to the worker with the problem, by
+reference (pickle): it must be a module-level function.
 
 A runner's ``solve(problem, method, time_limit)`` returns a raw answer, a dict with "kind":
 "answer" (with z, status, iterations, time, message), "timeout", "not_applicable" or "error";
@@ -29,6 +32,8 @@ HELPER = Path(__file__).with_name("_siconos_bench_helper.py")
 #: Siconos methods: name -> (helper solver, largest n it is given: None = any).
 SICONOS_METHODS = {"siconos-lemke": ("lemke", None), "siconos-enum": ("enum", 20),
                    "siconos-pgs": ("pgs", None)}
+#: Seconds a new worker may take to start (imports), outside every time limit.
+STARTUP = 300.0
 #: Seconds allowed beyond the time limit for passing the problem and the answer around.
 GRACE = 2.0
 
@@ -43,19 +48,24 @@ def _worker_main(conn) -> None:
         threadpool_limits(1)
     except Exception:  # noqa: BLE001 - no threadpoolctl: leave BLAS alone
         pass
+    lcp.methods()  # import every method module before the first (timed) solve
+    conn.send("ready")
     while True:
         try:
-            M, q, method = conn.recv()
+            problem, method, info = conn.recv()
         except (EOFError, OSError):
             return
-        conn.send(_solve_here(LCP(M, q), method))
+        if info is not None and method not in {m.name for m in lcp.methods()}:
+            lcp.register(info.name, accepts=info.accepts, description=info.description,
+                         max_n=info.max_n, native=info.native)(info.func)
+        conn.send(_solve_here(problem, method))
 
 
 #: A small P-matrix LCP solved once, untimed, by each method in a fresh worker (imports, caches).
 WARM_UP = LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), name="warm-up")
 
 
-def _solve_here(problem: LCP, method: str) -> dict:
+def _solve_here(problem, method: str) -> dict:
     t0 = time.perf_counter()
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -68,29 +78,64 @@ def _solve_here(problem: LCP, method: str) -> dict:
                 "time": time.perf_counter() - t0}
     elapsed = time.perf_counter() - t0
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
-            "iterations": int(sol.iterations), "message": sol.message, "time": elapsed}
+            "iterations": int(sol.iterations), "message": sol.message, "time": elapsed,
+            "u": None if sol.u is None else np.asarray(sol.u, dtype=float)}
+
+
+def start_method() -> str:
+    """"forkserver" where available (POSIX), else "spawn": a worker is never forked from this
+    process, which may run threads (BLAS, HiGHS, the Siconos pump)."""
+    methods = mp.get_all_start_methods()
+    return "forkserver" if "forkserver" in methods else "spawn"
+
+
+def _picklable_info(method: str):
+    """The method's MethodInfo when it pickles (by reference: a module-level function), so
+    that a worker can register a method registered here at run time; else None (the worker
+    knows the built-in methods by itself)."""
+    import pickle
+
+    from rigidlcp.lcp import api
+
+    if method not in _PICKLED:
+        info = api.get_method(method)
+        try:
+            pickle.dumps(info)
+        except Exception:  # noqa: BLE001 - a closure or local function
+            info = None
+        _PICKLED[method] = info
+    return _PICKLED[method]
+
+
+_PICKLED: dict = {}
 
 
 class LocalRunner:
-    """rigidlcp's methods in a worker process (fork), killed and replaced on a timeout.
+    """rigidlcp's methods in a worker process (forkserver / spawn), killed and replaced on a
+    timeout.
     With isolate=False the solve runs in this process and the limit is checked afterwards."""
 
     def __init__(self, isolate: bool = True, grace: float = GRACE):
-        self.isolate = isolate and "fork" in mp.get_all_start_methods()
+        self.isolate = isolate
         self.grace = grace
         self.proc = None
         self.conn = None
         self.warm: set[str] = set()  # methods already run once by the current worker
 
     def _start(self) -> None:
-        ctx = mp.get_context("fork")
+        ctx = mp.get_context(start_method())
+        if ctx.get_start_method() == "forkserver":
+            ctx.set_forkserver_preload(["numpy", "scipy.sparse", "rigidlcp.lcp"])
         parent, child = ctx.Pipe()
         self.proc = ctx.Process(target=_worker_main, args=(child,), daemon=True)
         self.proc.start()
         child.close()
         self.conn = parent
+        # the worker's start (imports) is not part of any solve's time limit
+        if not (parent.poll(STARTUP) and parent.recv() == "ready"):
+            raise RuntimeError(f"the bench worker did not start within {STARTUP:g} s")
 
-    def solve(self, problem: LCP, method: str, time_limit: float) -> dict:
+    def solve(self, problem, method: str, time_limit: float) -> dict:
         if method not in self.warm:
             self.warm.add(method)
             self.solve(WARM_UP, method, time_limit)
@@ -98,7 +143,7 @@ class LocalRunner:
             return _solve_here(problem, method)
         if self.proc is None or not self.proc.is_alive():
             self._start()
-        self.conn.send((problem.M, problem.q, method))
+        self.conn.send((problem, method, _picklable_info(method)))
         if self.conn.poll(time_limit + self.grace):
             try:
                 return self.conn.recv()
@@ -160,8 +205,18 @@ class SiconosRunner:
         self.version = _debian_version("python3-siconos") or ready.get("version", "?")
         return True
 
-    def solve(self, problem: LCP, method: str, time_limit: float) -> dict:
+    def solve(self, problem, method: str, time_limit: float) -> dict:
         solver, max_n = SICONOS_METHODS[method]
+        if isinstance(problem, lcp.MLCP):
+            try:
+                problem = problem.to_lcp()
+            except lcp.NotApplicable as exc:
+                return {"kind": "not_applicable", "time": 0.0,
+                        "message": f"{method} is given LCPs (an MLCP after its Schur "
+                        f"reduction): {exc}"}
+        if not isinstance(problem, LCP):
+            return {"kind": "not_applicable", "time": 0.0,
+                    "message": f"{method} is given LCPs and MLCPs only"}
         if max_n is not None and problem.n > max_n:
             return {"kind": "not_applicable", "time": 0.0,
                     "message": f"{method} is given n <= {max_n} only (exhaustive)"}

@@ -29,26 +29,30 @@ from rigidlcp.lcp.api import _REGISTRY
 SMALL = dict(sizes=(3, 6), per_size=2)
 
 
+# Test doubles: module-level functions, so that the bench's worker (started by forkserver or
+# spawn, not forked) can receive them by reference.
+def wrong(M, q):
+    z = np.ones(q.size)
+    return lcp.Solution(z=z, w=M @ z + q, status="solved", method="test-wrong")
+
+
+def liar(M, q):
+    return lcp.Solution(z=np.zeros(q.size), w=q.copy(), status="infeasible",
+                        method="test-liar")
+
+
+def slow(M, q):
+    if q.size > 2:  # the 2 x 2 warm-up problem is answered at once
+        time.sleep(60)
+    return lcp.solve(lcp.LCP(M, q), method="lemke")
+
+
 @pytest.fixture
 def doubles():
     """Test doubles registered with lcp.register (and removed afterwards)."""
-
-    @lcp.register("test-wrong", accepts="any", description="claims z = 1 solves everything")
-    def wrong(M, q):
-        z = np.ones(q.size)
-        return lcp.Solution(z=z, w=M @ z + q, status="solved", method="test-wrong")
-
-    @lcp.register("test-liar", accepts="any", description="claims nothing has a solution")
-    def liar(M, q):
-        return lcp.Solution(z=np.zeros(q.size), w=q.copy(), status="infeasible",
-                            method="test-liar")
-
-    @lcp.register("test-slow", accepts="any", description="sleeps, then answers rightly")
-    def slow(M, q):
-        if q.size > 2:  # the 2 x 2 warm-up problem is answered at once
-            time.sleep(60)
-        return lcp.solve(lcp.LCP(M, q), method="lemke")
-
+    lcp.register("test-wrong", accepts="any", description="claims z = 1 solves everything")(wrong)
+    lcp.register("test-liar", accepts="any", description="claims nothing has a solution")(liar)
+    lcp.register("test-slow", accepts="any", description="sleeps, then answers rightly")(slow)
     yield
     for name in ("test-wrong", "test-liar", "test-slow"):
         _REGISTRY.pop(name, None)
