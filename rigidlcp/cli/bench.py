@@ -12,7 +12,8 @@ import platform
 import shlex
 import sys
 
-DEFAULT_METHODS = "lemke,pivoting,pgs,qp-clarabel,qp-osqp,enumerate"
+DEFAULT_METHODS = ("lemke,pivoting,pgs,qp-clarabel,qp-osqp,enumerate,newton-min,newton-fb,"
+                   "enumerate-mlcp,states,nsgs")
 
 
 def register(sub) -> None:
@@ -56,7 +57,7 @@ def register(sub) -> None:
 def cmd_bench(args: argparse.Namespace) -> int:
     from rigidlcp import lcp
     from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, run_bench, write_csv
-    from rigidlcp.bench.problem_sets import SETS, get_set, list_sets
+    from rigidlcp.bench.problem_sets import SETS, Unreadable, get_set, list_sets
     from rigidlcp.bench.report import write_report
 
     siconos = None if args.no_siconos else SiconosRunner()
@@ -115,7 +116,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
                               if info else f"folder {spec}.")
         load0 = os.getloadavg()[0]
         started = datetime.datetime.now().isoformat(timespec="seconds")
-        total = sum(len(p) for p in sets.values()) * len(methods)
+        total = sum(1 if isinstance(p, Unreadable) else len(methods)
+                    for problems in sets.values() for p in problems)
         done = [0]
 
         def progress(r) -> None:
