@@ -222,3 +222,28 @@ def test_bench_command_lists_and_rejects(capsys):
     assert "events-rect" in listed and "siconos-lemke" in listed
     assert cli_main(["bench", "--set", "random-p", "--no-siconos"]) == 2  # no --out
     assert cli_main(["bench", "--set", "nope", "--out", "/tmp/x", "--no-siconos"]) == 2
+
+
+def test_a_folder_of_every_kind_with_an_unreadable_file(tmp_path):
+    import shutil
+    from pathlib import Path
+
+    data = Path(__file__).resolve().parents[1] / "data" / "siconos"
+    for name in ("lcp_CPS_1.dat", "diodeBridge_mlcp.dat", "FrictionContactProblem00031.dat",
+                 "Rectangular_mlcp.dat"):
+        shutil.copy(data / name, tmp_path / name)
+    (tmp_path / "broken.dat").write_text("2\n0\n2\n2\n2\t2\n1 2\n")
+    sets = {"mixed": get_set(str(tmp_path))}
+    results = run_bench(sets, ["newton-min", "states"], time_limit=30)
+    rows = {(r.problem.split("/")[1], r.method): r for r in results}
+    bad = rows[("broken", "-")]
+    assert bad.outcome == "unreadable" and "line 6" in bad.message
+    assert rows[("Rectangular_mlcp", "-")].outcome == "unreadable"
+    assert "rectangular" in rows[("Rectangular_mlcp", "-")].message
+    assert rows[("diodeBridge_mlcp", "newton-min")].outcome == "solved"  # singular A
+    assert rows[("FrictionContactProblem00031", "states")].outcome == "solved"
+    assert rows[("lcp_CPS_1", "states")].outcome == "not_applicable"
+    s = {x.method: x for x in summarize(results, 30)}
+    assert set(s) == {"newton-min", "states"}  # the unreadable rows are no method's
+    assert s["states"].refused == 2 and "not_applicable" not in s["states"].failures
+    assert s["states"].common == 1  # only the friction problem is accepted by both
