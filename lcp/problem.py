@@ -224,7 +224,7 @@ def load(path: str | os.PathLike):
     with open(path, "rb") as fh:
         magic = fh.read(4)
     if magic[:2] != b"PK" and path.suffix != ".npz":  # not an .npz: a Siconos text file
-        from verify.siconos_format import read_siconos  # TODO(rebase): .io.siconos
+        from .io.siconos import read_siconos
 
         return read_siconos(path)
     with np.load(path, allow_pickle=False) as data:

@@ -1,7 +1,7 @@
 """Contact-state pivoting for 2D friction contact (method ``states``).
 
 The paper's contact-state iteration (Sec. II C) on a FrictionContact2D: the implementation is
-the event solver of the disk arrays, models.sparse_pivoting.solve_states (block principal
+the event solver of the disk arrays, lcp.state_pivoting.solve_states (block principal
 pivoting on contact states, sparse LU with row updates, a local Lemke rescue), applied with
 every contact a non-sliding candidate. Its states are, per contact, T/NT (r_n basic or
 u_n basic) and NS/+/- (u_t = 0, or r_t = -mu r_n / +mu r_n), i.e. the complementary bases of
@@ -9,11 +9,8 @@ the Glocker LCP (lcp.friction). It is deterministic: the same problem gives the 
 the same iteration count on every run (refactoring is triggered by counts, not by time).
 
 Start: T wherever q_n <= 0 (the free motion closes the contact), and sliding the way q_t drives
-it (models.sparse_evolution.cold_start). Status: "solved", "max_iter" or "failed" (with the
+it (as models.engine.sparse's cold start). Status: "solved", "max_iter" or "failed" (with the
 number of still violated states).
-
-Note: the pivoting code still lives in models/ (the event loop's backend); this module imports
-it when the method is called, so `lcp` does not import `models` at import time.
 """
 
 from __future__ import annotations
@@ -29,12 +26,12 @@ from .solution import Solution
 def solve_states_fc2d(problem: FrictionContact2D, *, tol: float = 1e-10,
                       max_iter: int | None = None, max_updates: int = 400) -> Solution:
     """Contact-state pivoting (module doc). tol: the sign tests' relative tolerance
-    (models.sparse_pivoting.violations); max_iter: state changes (default max(1000, 20 c));
+    (lcp.state_pivoting.violations); max_iter: state changes (default max(1000, 20 c));
     max_updates: row replacements before a fresh sparse LU."""
     if not (0 < tol < 1):
         raise InvalidProblem(f"tol must be in (0, 1), got {tol!r}")
-    from models.sparse_event import NS, ActiveSystem, StateFactor  # noqa: F401
-    from models.sparse_pivoting import solve_states
+    from .state_factor import ActiveSystem, StateFactor
+    from .state_pivoting import solve_states
 
     c, mu = problem.c, problem.mu
     Wb, qb = problem.blocks()

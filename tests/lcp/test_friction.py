@@ -10,10 +10,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import lcp
-import verify
-from lcp.enumeration import enumerate_solutions
-from lcp.friction import natural_residual, project_cone
+from rigidlcp import lcp, verify
+from rigidlcp.lcp.enumeration import enumerate_solutions
+from rigidlcp.lcp.friction import natural_residual, project_cone
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "siconos"
 FC_METHODS = ["lemke", "pivoting", "enumerate", "states", "nsgs", "newton-min", "newton-fb"]

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import lcp
-from verify.strategies import lcps, mlcps, p_matrices
+from rigidlcp import lcp
+from rigidlcp.verify.strategies import lcps, mlcps, p_matrices
 
 SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 

@@ -10,11 +10,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-import lcp
-from lcp.io.siconos_fc2d import read_siconos_fc2d, write_siconos_fc2d
-from lcp.io.siconos_mlcp import read_siconos_mlcp, write_siconos_mlcp
-from lcp.io.text import FileFormatError, UnsupportedProblem, WrongKind
-from verify.siconos_format import read_siconos, read_siconos_lcp, write_siconos_lcp
+from rigidlcp import lcp
+from rigidlcp.lcp.io.siconos import read_siconos, read_siconos_lcp, write_siconos_lcp
+from rigidlcp.lcp.io.siconos_fc2d import read_siconos_fc2d, write_siconos_fc2d
+from rigidlcp.lcp.io.siconos_mlcp import read_siconos_mlcp, write_siconos_mlcp
+from rigidlcp.lcp.io.text import FileFormatError, UnsupportedProblem, WrongKind
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "siconos"
 SYSTEM_PYTHON = "/usr/bin/python3"

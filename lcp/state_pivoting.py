@@ -1,0 +1,353 @@
+"""Pivoting on contact states (issue 6; promoted to lcp by issue 12: method ``states`` of
+lcp.states, and the sparse event engine's solver, models.engine.sparse).
+
+`solve_states` is lcp.pivoting's iteration written on contact states (the paper's Sec. II C):
+block principal pivoting on every violated state while their number drops (Judice & Pires),
+else single flips (the most violated state first; Murty's least index after a cycle), the next
+violated indices when a flip makes the active system singular, with a cycle test, a local
+Lemke rescue and an iteration limit. Indices: the
+normal state of contact alpha is alpha, its tangential state c + alpha. The sign tests and
+their relative scales follow lcp.pivoting (see `violations`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from .state_factor import NS, ActiveSystem, SingularSystem, StateFactor, factorize
+
+
+@dataclass
+class StateSolution:
+    """The result of `solve_states`: forces, accelerations a = W lambda + q, the states."""
+
+    R: np.ndarray
+    S: np.ndarray
+    a: np.ndarray
+    normal: np.ndarray
+    tang: np.ndarray
+    status: str
+    iterations: int
+    residual: float  # max|min(z, w)| of the event LCP (z = [R, tau, a_minus])
+    message: str = ""
+    info: dict = field(default_factory=dict)
+
+
+def violations(lam: np.ndarray, a: np.ndarray, asys: ActiveSystem, normal: np.ndarray,
+               tang: np.ndarray, cand: np.ndarray, tol: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(indices, new tangential codes, sizes): violated inequalities, normal alpha as alpha
+    and tangential alpha as c + alpha, in increasing order, and how much each is violated
+    relative to its scale (the tests and scales follow lcp.pivoting: forces against
+    max(|lambda|, |q| / |W|), accelerations against |q_i| + (|W| |lambda|)_i floored at 1e-4
+    of its largest value)."""
+    c, mu, W, q = asys.c, asys.mu, asys.W, asys.q
+    R, S = lam[:c], lam[c:]
+    wmax = float(np.abs(W.data).max(initial=0.0)) or 1.0
+    fscale = max(float(np.abs(lam).max(initial=0.0)), float(np.abs(q).max(initial=0.0)) / wmax)
+    ascale = np.abs(q) + asys.absW @ np.abs(lam)
+    ascale = np.maximum(ascale, 1e-4 * float(ascale.max(initial=0.0)))
+    an, at = a[:c], a[c:]
+    bad_n = np.where(normal, R < -tol * fscale, an < -tol * ascale[:c])
+    lo = S < -mu * R - tol * fscale
+    hi = S > mu * R + tol * fscale
+    new_t = tang.copy()
+    bad_t = np.zeros(c, dtype=bool)
+    is_ns = cand & (tang == NS)
+    bad_t |= is_ns & (lo | hi)
+    new_t[is_ns & lo] = 1
+    new_t[is_ns & hi & ~lo] = -1
+    plus = cand & (tang == 1) & (at < -tol * ascale[c:])
+    minus = cand & (tang == -1) & (at > tol * ascale[c:])
+    bad_t |= plus | minus
+    new_t[plus | minus] = NS
+    size_n = np.where(normal, -R / fscale, -an / ascale[:c])
+    cone = np.maximum(-mu * R - S, S - mu * R) / fscale
+    size_t = np.where(tang == NS, cone, np.abs(at) / ascale[c:])
+    H = np.concatenate([np.flatnonzero(bad_n), c + np.flatnonzero(bad_t)])
+    return H, new_t, np.concatenate([size_n, size_t])[H]
+
+
+def lcp_residual(lam: np.ndarray, a: np.ndarray, mu: np.ndarray, tang: np.ndarray,
+                 cand: np.ndarray) -> float:
+    """max|min(z, w)| of the event LCP for z = [R, tau, a_minus] recovered from the states."""
+    c = mu.size
+    R, S, an, at = lam[:c], lam[c:], a[:c], a[c:]
+    tau = (mu * R + S)[cand]
+    a_minus = np.where(tang == -1, -at, 0.0)[cand]
+    z = np.concatenate([R, tau, a_minus])
+    w = np.concatenate([an, (at + np.where(tang == -1, -at, 0.0))[cand], 2 * mu[cand] *
+                        R[cand] - tau])
+    return float(np.max(np.abs(np.minimum(z, w)), initial=0.0))
+
+
+def solve_states(factor: StateFactor, cand: np.ndarray, normal: np.ndarray, tang: np.ndarray,
+                 *, tol: float = 1e-10, max_iter: int | None = None, block_tries: int = 3,
+                 max_rescues: int = 8, single: str = "largest") -> StateSolution:
+    """Pivot on contact states from (normal, tang) to a solution of the event LCP.
+
+    cand: mask of the non-sliding candidates (their tangential state may change); the other
+    contacts keep their code in `tang` (sliding sign, or 0 when frictionless). The factor is
+    updated in place and keeps the final states (the warm start of the next event).
+
+    A block step onto a singular system is retried on the first half, quarter, ... of the
+    violated indices. Single flips take the most violated state first (single="largest"),
+    which on these non-P problems needs far fewer steps than Murty's least index (at 20x20
+    near the steady state: 232 instead of 3122 flips at the worst event); after a cycle the
+    event continues with the least-index rule (single="least" from the start), whose
+    finiteness on P-matrices is the textbook guarantee. When the iteration cycles (a state
+    recurs) or no flip of a violated state gives a nonsingular system, a *local rescue*
+    solves the event LCP restricted to the violated contacts and their neighbours (the other
+    states fixed: their principal pivot transform, a dense LCP of a few hundred unknowns) by
+    lexicographic Lemke, and the iteration resumes from its states; up to `max_rescues`
+    times, on a growing neighbourhood.
+    Status: "solved", "max_iter", or "failed"; info counts the steps of each kind.
+    """
+    asys = factor.sys
+    c = asys.c
+    max_iter = max(1000, 20 * c) if max_iter is None else max_iter
+    info = {"block_steps": 0, "independent": 0, "partial_blocks": 0, "single_flips": 0,
+            "fallback_flips": 0, "rescues": 0, "warm_start_rejected": 0}
+    try:
+        factor.set_states(normal, tang)
+    except SingularSystem:
+        info["warm_start_rejected"] += 1  # keep the factor's (previous) states where allowed
+        n2, t2 = factor.normal.copy(), factor.tang.copy()
+        t2[~cand] = tang[~cand]
+        t2[cand & ~np.isin(t2, (1, -1, NS))] = NS
+        try:
+            factor.set_states(n2, t2)
+        except SingularSystem:
+            factor.refactor(np.zeros(c, dtype=bool), np.where(cand, 1, tang).astype(np.int8))
+    record, tries, it = np.inf, block_tries, 0
+    largest_first = single == "largest"
+    seen: dict = {}
+    fs0 = factor.stats["factorizations"]
+    zform: EventLCP | None = None
+    while True:
+        if factor.worn:
+            try:
+                factor.refactor(factor.normal, factor.tang)
+            except SingularSystem:
+                pass
+        lam = factor.solve_current()
+        a = asys.W @ lam + asys.q
+        H, new_t, size = violations(lam, a, asys, factor.normal, factor.tang, cand, tol)
+        info["factorizations"] = factor.stats["factorizations"] - fs0
+        out = (factor, lam, a, cand, it, info)
+        if H.size == 0:
+            return _result(*out, "solved")
+        if it >= max_iter:
+            return _result(*out, "max_iter", f"{H.size} inequalities still fail after {it} "
+                           "changes")
+        key = (factor.normal.tobytes(), factor.tang.tobytes(), record, tries)
+        stuck = key in seen
+        seen[key] = it
+        it += 1
+        if stuck and largest_first:  # a cycle: Murty's least-index rule from here on
+            largest_first, seen, stuck = False, {key: it}, False
+        if not stuck:
+            if H.size < record:
+                record, tries = H.size, block_tries
+                if _block_step(factor, new_t, H, c, info):
+                    continue
+                tries = 0
+            elif tries > 0 and INDEPENDENT:
+                tries -= 1
+                Hi = _independent(H, c, asys.adjacency)
+                if Hi.size > 1 and _block_step(factor, new_t, Hi, c, info, "independent"):
+                    continue
+            elif tries > 0:
+                tries -= 1
+                if _block_step(factor, new_t, H, c, info):
+                    continue
+                tries = 0
+            order = H[np.argsort(-size, kind="stable")] if largest_first else H
+            if _single_flip(factor, new_t, order, c, info):
+                continue
+        # a cycle, or no usable flip: the local rescue
+        if info["rescues"] >= max_rescues:
+            why = "the pivoting cycles" if stuck else "no flip gives a nonsingular system"
+            return _result(*out, "failed", f"{why}; {info['rescues']} local rescues did not "
+                           f"help ({H.size} violated states)")
+        if zform is None:
+            zform = EventLCP(asys, factor.tang, cand)
+        grow = 2 ** info["rescues"]
+        info["rescues"] += 1
+        if local_rescue(factor, zform, H, min_contacts=24 * grow, radius=1 + info["rescues"]):
+            record, tries, seen = np.inf, block_tries, {}
+
+
+INDEPENDENT = True
+
+
+def _independent(H: np.ndarray, c: int, adjacency: sp.csr_matrix) -> np.ndarray:
+    """A subset of H whose contacts are pairwise not adjacent (greedy, least index first):
+    flips that barely interact, each close to a single principal pivot."""
+    taken = np.zeros(c, dtype=bool)
+    blocked = np.zeros(c, dtype=bool)
+    keep = []
+    for pos, h in enumerate(H.tolist()):
+        a = h % c
+        if taken[a]:
+            keep.append(pos)  # both states of one contact
+            continue
+        if blocked[a]:
+            continue
+        taken[a] = True
+        blocked[adjacency.indices[adjacency.indptr[a]:adjacency.indptr[a + 1]]] = True
+        keep.append(pos)
+    return H[keep]
+
+
+def _block_step(factor: StateFactor, new_t, H, c, info, kind: str = "block_steps") -> bool:
+    """Flip all of H; when that system is singular, the first half, quarter, ... of H."""
+    size = H.size
+    while size >= 2 or size == H.size:
+        n2, t2 = _flip(factor.normal, factor.tang, new_t, H[:size], c)
+        try:
+            factor.set_states(n2, t2)
+        except SingularSystem:
+            size //= 2
+            if size < 2:
+                return False
+            continue
+        info[kind if size == H.size else "partial_blocks"] += 1
+        return True
+    return False
+
+
+def _single_flip(factor: StateFactor, new_t, H, c, info) -> bool:
+    """Murty's least index; the next violated indices when a flip is singular."""
+    for pos in range(H.size):
+        n2, t2 = _flip(factor.normal, factor.tang, new_t, H[pos:pos + 1], c)
+        try:
+            factor.set_states(n2, t2)
+        except SingularSystem:
+            continue
+        info["single_flips" if pos == 0 else "fallback_flips"] += 1
+        return True
+    return False
+
+
+def _result(factor, lam, a, cand, it, info, status, message="") -> StateSolution:
+    c = factor.sys.c
+    return StateSolution(lam[:c].copy(), lam[c:].copy(), a, factor.normal.copy(),
+                         factor.tang.copy(), status, it,
+                         lcp_residual(lam, a, factor.sys.mu, factor.tang, cand), message, info)
+
+
+def _flip(normal, tang, new_t, H, c):
+    n2, t2 = normal.copy(), tang.copy()
+    hn = H[H < c]
+    n2[hn] = ~n2[hn]
+    ht = H[H >= c] - c
+    t2[ht] = new_t[ht]
+    return n2, t2
+
+
+# --------------------------------------------------------------------------------------------
+# the local rescue: the event LCP (z-form) around the violated contacts, by dense Lemke
+# --------------------------------------------------------------------------------------------
+
+class EventLCP:
+    """The event LCP w = M z + q, z = [R (c), tau (k), a_minus (k)] (models.event's layout),
+    with a sparse M = B + rows of W G, built from the active system's W, q and the event's
+    sliding signs and candidates."""
+
+    def __init__(self, asys: ActiveSystem, tang: np.ndarray, cand: np.ndarray):
+        c, mu = asys.c, asys.mu
+        self.c, self.cand = c, cand
+        cj = np.flatnonzero(cand)
+        k = cj.size
+        self.cj, self.k, self.n = cj, k, c + 2 * k
+        idx, kk = np.arange(c), np.arange(k)
+        s = np.where(cand, 0, np.where(np.isin(tang, (1, -1)), tang, 0)).astype(float)
+        slope = np.where(cand, -mu, -s * mu)
+        G = sp.csr_matrix((np.concatenate([np.ones(c), slope, np.ones(k)]),
+                           (np.concatenate([idx, c + idx, c + cj]),
+                            np.concatenate([idx, idx, c + kk]))), shape=(2 * c, self.n))
+        WG = (asys.W @ G).tocsr()
+        B = sp.csr_matrix((np.concatenate([np.ones(k), 2.0 * mu[cj], -np.ones(k)]),
+                           (np.concatenate([c + kk, c + k + kk, c + k + kk]),
+                            np.concatenate([c + k + kk, cj, c + kk]))), shape=(self.n, self.n))
+        top = sp.vstack([WG[:c], WG[c + cj], sp.csr_matrix((k, self.n))])
+        self.M = (top + B).tocsr()
+        self.q = np.concatenate([asys.q[:c], asys.q[c + cj], np.zeros(k)])
+        self.pos = -np.ones(c, dtype=int)  # candidate position of each contact
+        self.pos[cj] = kk
+        self.adjacency = asys.adjacency
+
+    def basis(self, normal: np.ndarray, tang: np.ndarray) -> np.ndarray:
+        """The z-basis (mask) of a vector of states: R basic on T; tau on NS and "-";
+        a_minus on "-"."""
+        t = tang[self.cj]
+        return np.concatenate([normal, (t == NS) | (t == -1), t == -1])
+
+    def z_indices(self, contacts: np.ndarray) -> np.ndarray:
+        p = self.pos[contacts]
+        p = p[p >= 0]
+        return np.concatenate([contacts, self.c + p, self.c + self.k + p])
+
+
+def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contacts: int = 24,
+                 radius: int = 2, max_n: int = 1500) -> bool:
+    """Re-solve the states of the contacts of H and their neighbours (rings of the contact
+    graph, at least `radius` rings and `min_contacts` contacts, at most max_n LCP unknowns),
+    the other states fixed: the LCP of those unknowns is the principal pivot transform
+    M_FF - M_Fa M_aa^-1 M_aF, q_F - M_Fa M_aa^-1 q_a (a: the basic unknowns outside F),
+    solved by dense lexicographic Lemke. Sets the factor's states; False when it cannot."""
+    from .api import solve
+    from .problem import LCP
+
+    c = ev.c
+    F = np.unique(H % c)
+    ring = 0
+    while ring < radius or F.size < min_contacts:
+        grown = np.unique(np.concatenate([F, ev.adjacency[F].indices]))
+        ring += 1
+        if grown.size == F.size or ev.z_indices(grown).size > max_n:
+            break
+        F = grown
+    zF = ev.z_indices(F)
+    inF = np.zeros(ev.n, dtype=bool)
+    inF[zF] = True
+    basic = ev.basis(factor.normal, factor.tang)
+    aX = np.flatnonzero(basic & ~inF)
+    M = ev.M
+    MFF = M[zF][:, zF].toarray()
+    qF = ev.q[zF].copy()
+    if aX.size:
+        try:
+            lu = factorize(M[aX][:, aX])
+        except RuntimeError:
+            return False
+        d = np.abs(lu.U.diagonal())
+        if d.min() <= 1e-13 * d.max():
+            return False
+        rhs = np.column_stack([M[aX][:, zF].toarray(), ev.q[aX]])
+        sol = lu.solve(rhs)
+        MFa = M[zF][:, aX]
+        MFF -= MFa @ sol[:, :-1]
+        qF -= MFa @ sol[:, -1]
+    res = solve(LCP(MFF, qF), method="lemke")
+    if res.status != "solved":
+        return False
+    zb = np.zeros(zF.size, dtype=bool)
+    zb[np.asarray(res.basis, dtype=int)] = True
+    normal, tang = factor.normal.copy(), factor.tang.copy()
+    nR = np.isin(zF, F)  # the R unknowns come first in z_indices
+    normal[F] = zb[: F.size] if nR[: F.size].all() else normal[F]
+    p = ev.pos[F]
+    candF = F[p >= 0]
+    kf = candF.size
+    tau_b, am_b = zb[F.size:F.size + kf], zb[F.size + kf:]
+    tang[candF] = np.where(tau_b & ~am_b, NS, np.where(am_b & tau_b, -1, 1))
+    try:
+        factor.set_states(normal, tang)
+    except SingularSystem:
+        return False
+    return True
