@@ -28,7 +28,7 @@ from rigidlcp import lcp
 from rigidlcp.lcp import LCP
 
 SYSTEM_PYTHON = "/usr/bin/python3"
-HELPER = Path(__file__).with_name("_siconos_bench_helper.py")
+HELPER = Path(__file__).with_name("_siconos_helper.py")
 #: Siconos methods: name -> (helper solver, largest n it is given: None = any).
 SICONOS_METHODS = {"siconos-lemke": ("lemke", None), "siconos-enum": ("enum", 20),
                    "siconos-pgs": ("pgs", None)}
