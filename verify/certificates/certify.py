@@ -41,6 +41,7 @@ from rigidlcp.lcp import (
     enumerate_solutions,
 )
 
+from .friction import forces_map, friction_certificate
 from .uniqueness import Search, milp_search, p_matrix_test, scales, sign_pattern
 
 #: "auto" enumerates the complementary bases up to this n (2^n bases; singular ones need LPs).
@@ -135,7 +136,7 @@ def certify(
     obs: dict[str, np.ndarray] = {}
     fc_residual = None
     if isinstance(problem, lcp.FrictionContact2D):
-        fc_cert = _friction(problem, solution, tol, uniqueness)
+        fc_cert = friction_certificate(problem, solution, tol, uniqueness, Certificate)
         if fc_cert is not None:
             fc_cert.seconds = time.perf_counter() - t0
             return fc_cert
@@ -143,7 +144,7 @@ def certify(
         problem = fc.to_lcp()
         r = np.asarray(solution.z if isinstance(solution, Solution) else solution, dtype=float)
         solution = fc.lcp_from_r(r)
-        obs["forces"] = _forces_map(fc)
+        obs["forces"] = forces_map(fc)
         fc_residual = lcp.natural_residual(fc, r)
     if hasattr(problem, "lcp") and hasattr(problem, "G") and hasattr(problem, "dyn"):
         ep = problem
@@ -266,45 +267,6 @@ def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: fl
         if verdict.verdict != UNIQUE or verdict.scope:
             cert.notes.append(f"{name}: {verdict.verdict} [{verdict.stage}] {verdict.reason}"
                               + (f" (scope: {verdict.scope})" if verdict.scope else ""))
-
-
-#: Friction contact: uniqueness is asked on the dense Glocker LCP up to this many contacts.
-FC_UNIQUENESS_MAX_C = 200
-
-
-def _forces_map(fc: lcp.FrictionContact2D) -> np.ndarray:
-    """L with r = L z for the Glocker LCP's z = [R, tau, a_minus] (Siconos's layout)."""
-    c = fc.c
-    L = np.zeros((2 * c, 3 * c))
-    idx = np.arange(c)
-    L[2 * idx, idx] = 1.0
-    L[2 * idx + 1, c + idx] = 1.0
-    L[2 * idx + 1, idx] = -fc.mu
-    return L
-
-
-def _friction(fc: lcp.FrictionContact2D, solution, tol: float, uniqueness: str):
-    """A FrictionContact2D answer r: the relative natural-map residual (lcp.friction) must be
-    <= tol. Returns the certificate when no uniqueness question is asked (uniqueness "none",
-    or more than FC_UNIQUENESS_MAX_C contacts); else None, and certify goes on with the
-    Glocker LCP (z = fc.lcp_from_r(r), the forces r = L z as an observable)."""
-    r = np.asarray(solution.z if isinstance(solution, Solution) else solution, dtype=float)
-    r = r.reshape(-1)
-    if r.size != fc.n:
-        raise ValueError(f"the solution has {r.size} entries, the problem {fc.n} unknowns")
-    res = lcp.natural_residual(fc, r)
-    note = f"friction contact: relative natural-map residual {res:.3e}"
-    if uniqueness != "none" and fc.c <= FC_UNIQUENESS_MAX_C and res <= tol:
-        return None
-    u = fc.u(r)
-    cert = Certificate(accepted=bool(res <= tol), tol=tol, residual=res, scaled_residual=res,
-                       notes=[note])
-    if uniqueness != "none" and fc.c > FC_UNIQUENESS_MAX_C:
-        cert.notes.append(f"{fc.c} contacts > {FC_UNIQUENESS_MAX_C}: uniqueness not assessed")
-    cert.degenerate = np.flatnonzero((np.abs(r[0::2]) <= 1e-12 * max(np.abs(r).max(
-        initial=0.0), 1e-300)) & (np.abs(u[0::2]) <= 1e-12 * max(np.abs(u).max(initial=0.0),
-                                                                 1e-300)))
-    return cert
 
 
 def _norm_inf(A: np.ndarray) -> float:
