@@ -28,6 +28,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidlcp.lcp import LCP, MLCP
+from rigidlcp.lcp.friction import FrictionContact2D
 
 from .dynamics import Dynamics
 from .system import System
@@ -110,6 +111,36 @@ class EventProblem:
     def forces(self, z: np.ndarray) -> np.ndarray:
         """lambda = [R; S] of a solution z."""
         return self.G @ z
+
+    def friction_contact(self) -> FrictionContact2D:
+        """This event as a 2D friction-contact problem (lcp.FrictionContact2D, Siconos's layout:
+        normal and tangent of contact alpha at 2 alpha, 2 alpha + 1) at acceleration level.
+
+        A non-sliding candidate is a contact of the problem with its own mu (Eqs. 2.5, 2.7 are
+        the problem's Signorini-Coulomb law). A sliding contact's friction S = -s mu R
+        (Eq. 2.10) is folded into the column of its R, which makes W non-symmetric, and its
+        tangent unknown is a dummy with mu = 0 and a zero column (so r_t = 0 and u_t is free),
+        as is a frictionless contact's. `forces_of` maps the problem's r back to [R; S]."""
+        c, mu = self.system.c, self.system.mu
+        W, q = self.dyn.W.copy(), self.dyn.q
+        sliding = (self.s != 0) & (mu > 0)
+        slope = np.where(sliding, -self.s * mu, 0.0)
+        W[:, :c] += W[:, c:] * slope
+        W[:, c:][:, sliding] = 0.0
+        order = np.arange(2 * c).reshape(2, c).T.reshape(-1)  # [n0, t0, n1, t1, ...]
+        mu_fc = np.zeros(c)
+        mu_fc[self.candidates] = mu[self.candidates]
+        return FrictionContact2D(W[np.ix_(order, order)], q[order], mu_fc, name="event",
+                                 meta={"t": self.t})
+
+    def forces_of(self, r: np.ndarray) -> np.ndarray:
+        """lambda = [R; S] of a solution r of `friction_contact` (Siconos's layout)."""
+        mu = self.system.mu
+        r = np.asarray(r, dtype=float).reshape(-1)
+        R = r[0::2]
+        S = np.where((self.s != 0) & (mu > 0), -self.s * mu * R, 0.0)
+        S[self.candidates] = r[1::2][self.candidates]
+        return np.concatenate([R, S])
 
     def unpack(self, z: np.ndarray, tol: float | None = None) -> EventSolution:
         """Forces, accelerations and contact states of an LCP solution z."""

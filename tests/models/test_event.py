@@ -119,3 +119,35 @@ def test_contact_matrix_rejects_bad_states():
         contact_matrix(system, np.ones(3, bool), np.zeros(3, int))
     with pytest.raises(ValueError, match="tangential states"):
         contact_matrix(system, np.ones(system.c, bool), np.full(system.c, 2))
+
+
+# -- the event as a friction-contact problem (lcp.FrictionContact2D) ---------------------------
+
+
+@pytest.mark.parametrize("method", ["lemke", "states", "nsgs", "newton-fb"])
+def test_event_as_friction_contact_problem_obeys_the_contact_laws(method):
+    """Every event of a run, cast as a FrictionContact2D and solved by a friction-contact
+    method, gives forces that satisfy the contact laws checked from the forces alone
+    (verify.certificates.laws, independent of both formulations)."""
+    from rigidlcp.verify.certificates.laws import contact_law_residuals
+
+    system = models.System(models.rectangular(4, 2), mu_pp=0.3, mu_plane=0.5, mu_wall=0.2,
+                           gamma=0.1)
+    run = models.simulate(system, seed=3, max_events=6)
+    assert run.n_events >= 3
+    for k in range(run.n_events):
+        state = run.state_at(k)
+        ep = models.event_problem(system, state)
+        fc = ep.friction_contact()
+        assert fc.c == system.c and np.all(fc.mu[ep.s != 0] == 0)
+        sol = lcp.solve(fc, method=method)
+        assert sol.status == "solved", (k, sol)
+        lam = ep.forces_of(sol.z)
+        R, S = lam[: system.c], lam[system.c:]
+        scale = max(1.0, float(np.abs(lam).max()))
+        worst = max(contact_law_residuals(system, state, R, S).values())
+        assert worst <= 1e-7 * scale, (k, contact_law_residuals(system, state, R, S))
+        # the same forces give the same relative accelerations in both layouts
+        a = ep.dyn.relative_accelerations(lam)
+        u = fc.u(sol.z)
+        assert np.allclose(u[0::2], a[: system.c], atol=1e-8 * scale)
