@@ -1,8 +1,10 @@
-"""`rigidlcp methods` and `rigidlcp solve` (over rigidlcp.lcp).
+"""`rigidlcp methods`, `rigidlcp solve` and `rigidlcp certify` (over rigidlcp.lcp and verify).
 
-Exit codes of ``solve``: 0 solved, 1 the method did not solve it (any other status: infeasible,
-ray, max_iter, not_converged, failed), 2 bad input (unreadable file, invalid problem, unknown
-method or option, a method that refuses the problem).
+A problem file is any that `lcp.load` reads: the toolkit's .npz (LCP, MLCP) or Siconos's text
+files (LCP, MLCP, 2D friction contact). Exit codes of ``certify``: 0 accepted, 1 rejected (or not
+solved), 2 bad input. Exit codes of ``solve``: 0 solved, 1 the method did not solve it (any
+other status: infeasible, ray, max_iter, not_converged, failed), 2 bad input (unreadable file,
+invalid problem, unknown method or option, a method that refuses the problem).
 """
 
 from __future__ import annotations
@@ -22,18 +24,38 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_methods)
 
     p = subparsers.add_parser(
-        "solve", help="solve an LCP or MLCP stored in a .npz file",
-        description="Solve the LCP (arrays M, q) or MLCP (arrays A, C, D, B, a, b) of a .npz "
-        "file. Exit code 0 when solved, 1 when the method did not solve it, 2 on bad input.",
+        "solve", help="solve a problem file (.npz, or Siconos's LCP/MLCP/FC2D text)",
+        description="Solve the problem of a file: an LCP or MLCP .npz (LCP.save / MLCP.save) "
+        "or a Siconos text file (LCP, MLCP, 2D friction contact). Exit code 0 when solved, 1 "
+        "when the method did not solve it, 2 on bad input.",
     )
-    p.add_argument("problem", help="the .npz file (written by LCP.save / MLCP.save)")
+    _add_problem_arguments(p)
+    p.add_argument("--json", action="store_true", help="print the whole solution as JSON")
+    p.set_defaults(func=cmd_solve)
+
+    p = subparsers.add_parser(
+        "certify", help="solve a problem file and certify the answer (residual, uniqueness)",
+        description="Solve the problem of a file (as `rigidlcp solve`) and certify the answer "
+        "independently of the method (verify.certify: the scaled residual, and whether the "
+        "solution is unique). Exit code 0 when accepted, 1 when not, 2 on bad input.",
+    )
+    _add_problem_arguments(p)
+    p.add_argument("--uniqueness", default="auto",
+                   choices=("auto", "staged", "p-matrix", "enumeration", "milp", "none"),
+                   help="how uniqueness is decided (default auto; docs/verification.md)")
+    p.add_argument("--time-limit", type=float, default=30.0,
+                   help="seconds per MILP of the uniqueness search (default 30)")
+    p.add_argument("--json", action="store_true", help="print the certificate as JSON")
+    p.set_defaults(func=cmd_certify)
+
+
+def _add_problem_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("problem", help="the problem file (.npz, or a Siconos .dat/.hdf text file)")
     p.add_argument("--method", default="lemke", help="a method from `rigidlcp methods` "
                    "(default: lemke)")
     p.add_argument("--option", "-o", action="append", default=[], metavar="KEY=VALUE",
                    help="a method option; VALUE is read as JSON when it parses (1e-9, 100, "
                    "true, [0, 2]), else as a string. Repeatable.")
-    p.add_argument("--json", action="store_true", help="print the whole solution as JSON")
-    p.set_defaults(func=cmd_solve)
 
 
 def cmd_methods(args: argparse.Namespace) -> int:
@@ -76,14 +98,42 @@ def _jsonable(x: Any) -> Any:
     return x
 
 
-def cmd_solve(args: argparse.Namespace) -> int:
-    """Solve the problem file; print status, residual, iterations (or JSON)."""
+def _load(path: str):
     try:
-        problem = load(args.problem)
+        return load(path)
     except (FileNotFoundError, InvalidProblem):
         raise
     except Exception as exc:  # a corrupt or foreign file: numpy/zipfile say why
-        raise InvalidProblem(f"cannot read {args.problem} as a problem file: {exc}") from None
+        raise InvalidProblem(f"cannot read {path} as a problem file: {exc}") from None
+
+
+def cmd_certify(args: argparse.Namespace) -> int:
+    """Solve the problem file, certify the answer, print the certificate (or JSON)."""
+    from rigidlcp.verify import certify
+
+    problem = _load(args.problem)
+    sol = solve(problem, method=args.method, **parse_options(args.option))
+    if sol.z is None or not sol.success:
+        print(f"{sol.method}: status {sol.status} ({sol.message or 'no message'}): "
+              "nothing to certify")
+        return 1
+    cert = certify(problem, sol, uniqueness=args.uniqueness, time_limit=args.time_limit)
+    if args.json:
+        fields = ("accepted", "tol", "residual", "scaled_residual", "eq_residual",
+                  "scaled_eq_residual", "w_unique", "z_unique", "pattern_unique", "observables",
+                  "method", "other_reason", "other_distance", "bound", "notes", "seconds")
+        out = {"solver": sol.method, "status": sol.status,
+               **{f: getattr(cert, f) for f in fields}}
+        print(json.dumps(_jsonable(out), indent=2, allow_nan=False))
+    else:
+        print(f"solved by {sol.method} ({sol.iterations} iterations)")
+        print(cert)
+    return 0 if cert.accepted else 1
+
+
+def cmd_solve(args: argparse.Namespace) -> int:
+    """Solve the problem file; print status, residual, iterations (or JSON)."""
+    problem = _load(args.problem)
     sol = solve(problem, method=args.method, **parse_options(args.option))
     if args.json:
         print(json.dumps(_jsonable(sol.to_dict()), indent=2, allow_nan=False))

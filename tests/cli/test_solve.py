@@ -103,3 +103,26 @@ def test_solve_without_a_file_is_an_argparse_error():
     with pytest.raises(SystemExit) as exc:
         main(["solve"])
     assert exc.value.code == 2
+
+
+# -- rigidlcp certify: any problem file, the certificate of the answer --------------------------
+
+DATA = __import__("pathlib").Path(__file__).resolve().parents[1] / "data" / "siconos"
+
+
+@pytest.mark.parametrize("name,method", [
+    ("FC2D_SliderCrankLagrangian00000.dat", "lemke"),   # friction contact (Glocker LCP)
+    ("m2n1_mlcp.dat", "lemke"),                          # MLCP
+    ("lcp_deudeu_block.dat", "pivoting"),                # LCP, sparse-block storage
+])
+def test_certify_accepts_answers_to_every_kind_of_file(capsys, name, method):
+    assert main(["certify", str(DATA / name), "--method", method, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["accepted"] is True and out["status"] == "solved"
+    assert out["scaled_residual"] <= 1e-8
+
+
+def test_certify_refuses_a_file_it_cannot_solve_with_one_line(capsys):
+    assert main(["certify", str(DATA / "Rectangular_mlcp.dat")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Rectangular_mlcp.dat" in err[0] and "line" in err[0]
