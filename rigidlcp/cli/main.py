@@ -19,6 +19,8 @@ from rigidlcp.lcp.errors import RigidLCPError
 COMMAND_MODULES = (
     "rigidlcp.cli.solve",  # methods, solve
     "rigidlcp.cli.simulate",  # simulate, plot
+    "rigidlcp.cli.timestep",  # timestep (Moreau-Jean)
+    "rigidlcp.cli.compare_integrators",  # compare-integrators
     "rigidlcp.cli.sweep",  # sweep, effective
     "rigidlcp.cli.nullspace",  # nullspace, verify-formulas
     "rigidlcp.cli.forces",  # forces

@@ -1,0 +1,59 @@
+"""`rigidlcp timestep`: Moreau-Jean time-stepping of an array (rigidlcp.models.timestepping),
+printed and saved like `rigidlcp simulate` (the same run format: `rigidlcp plot` reads it)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+
+def register(sub) -> None:
+    from .simulate import add_system_arguments
+
+    p = sub.add_parser("timestep", help="Moreau-Jean time-stepping of an array to its steady "
+                       "state (the second integrator)",
+                       description="Moreau-Jean (theta-method) time-stepping: each step a "
+                       "velocity-level Signorini-Coulomb LCP solved by the toolkit's solvers and "
+                       "checked (docs/integrators.md).")
+    add_system_arguments(p)
+    g = p.add_argument_group("run")
+    g.add_argument("--seed", type=int, default=1, help="seed of the initial angular velocities")
+    g.add_argument("--h", type=float, default=1e-3, help="time step")
+    g.add_argument("--theta", type=float, default=1.0, help="theta in [0.5, 1]")
+    g.add_argument("--method", default="lemke", help="LCP method of a step")
+    g.add_argument("--t-max", type=float, default=np.inf)
+    g.add_argument("--max-steps", type=int, default=2_000_000)
+    g.add_argument("--record-every", type=int, default=100,
+                   help="also record every N steps (besides state changes; 0: only those)")
+    g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json); refuses "
+                   "to overwrite")
+    g.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(func=cmd_timestep)
+
+
+def cmd_timestep(args) -> int:
+    from rigidlcp.lcp.errors import OutputExists
+    from rigidlcp.models.runio import run_paths, save_run
+    from rigidlcp.models.timestepping import moreau_jean
+
+    from .simulate import system_from_args
+
+    system = system_from_args(args)
+    if args.out:
+        for path in run_paths(args.out):
+            if path.exists():
+                raise OutputExists(f"--out: {path} exists (not overwritten)")
+    run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta, method=args.method,
+                      t_max=args.t_max, max_steps=args.max_steps,
+                      record_every=args.record_every)
+    summary = run.summary()
+    if args.out:
+        summary["saved"] = str(save_run(run, args.out))
+    if args.json:
+        print(json.dumps(summary, indent=2, default=float))
+    else:
+        width = max(len(k) for k in summary)
+        for k, v in summary.items():
+            print(f"  {k:<{width}}  {v}")
+    return 0 if run.status in ("steady", "time_limit", "event_limit") else 1
