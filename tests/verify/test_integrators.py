@@ -59,3 +59,29 @@ def test_cli_compare_prints_the_table(capsys):
     out = capsys.readouterr().out
     assert code == 0
     assert "observed order of sup|domega|" in out and out.count(" time_lim ") == 3
+
+
+def test_2x2_event_accelerations_not_unique_by_the_laws_themselves():
+    """docs/mechanics.md example 1: the MILP's second solution of the event at t = 8.52281
+    keeps every contact closed (a_n = 0) and satisfies the laws contact by contact
+    (event_check, which does not use the event LCP), with other angular accelerations."""
+    import lcp
+    from models.evolution import EventRecord
+    from verify.certify import certify
+
+    system = models.System(models.rectangular(2, 2), mu_pp=0.1, mu_plane=0.2, gamma=0.1)
+    run = models.simulate(system, seed=1, select="none")
+    assert abs(run.records[6].t - 8.52281) < 1e-5
+    state = run.state_at(6)
+    ep = models.event_problem(system, state)
+    sol = lcp.solve(ep.lcp, "lemke")
+    cert = certify(ep, sol, uniqueness="milp")
+    assert cert.observables["accelerations"] is False and cert.observables["forces"] is False
+    ours, other = ep.unpack(sol.z), ep.unpack(cert.other)
+    assert np.abs(other.a_n).max() < 1e-12
+    assert np.abs(other.omega_dot - ours.omega_dot).max() > 1.0
+    rec = EventRecord(t=state.t, V=state.V, omega=state.omega, omega_dot=other.omega_dot,
+                      R=other.R, S=other.S, s=other.s, s_in=state.s, vt=None, at=other.a_t,
+                      mu_g=0.0, dissipation=0.0, iterations=0, residual=0.0, n_lcp=0,
+                      method="milp")
+    assert event_check(system, rec).valid
