@@ -256,5 +256,65 @@ def format_comparison(cmp: Comparison) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["LawCheck", "event_check", "step_check", "StepRow", "Comparison",
+@dataclass
+class SteadyPair:
+    """Two steady states of one system (event-driven `ed`, time-stepping `ts`) examined as
+    solutions of one event problem (see `examine_steady_states`)."""
+
+    d_mu_g: float
+    d_alpha: float
+    differing: list[int]  # contacts whose T/NT or NS/S+/S- differ
+    ts_in_event: LawCheck
+    ed_in_step: LawCheck
+    sum_R: tuple[float, float]  # (ed, ts)
+    norm2: tuple[float, float]  # |lambda|^2 (ed, ts)
+    raw_vs_ts: float  # max |dalpha| between lemke's own solution at ts's state and ts
+    selected_vs_ed: float  # max |dalpha| between face-min-norm at ts's state and ed
+    selected_mu_g: float
+    ed_from_ts: Run  # the event-driven run restarted from ts's steady state
+    ts_from_ed: Run  # the time-stepper restarted from ed's final state (t_max + 5)
+
+
+def examine_steady_states(system: models.System, ed: Run, ts: Run, h: float) -> SteadyPair:
+    """Is the disagreement of two steady states a matter of selection? At the time-stepper's
+    steady configuration and states, the event LCP is solved by lemke (the solver's own
+    vertex, select="none") and moved by the event-driven rule (`lcp.face.face_minimum_norm`:
+    least sum R, then least |lambda|); each integrator is also restarted from the other's
+    steady state."""
+    from rigidlcp import lcp
+    from rigidlcp.lcp.face import face_minimum_norm
+    from rigidlcp.models.observables import global_friction_coefficient
+
+    E, T = ed.last, ts.last
+    c = system.c
+    state = State(T.t, np.asarray(T.omega, float).copy(), T.V,
+                  np.where(system.mu > 0, np.asarray(T.s, int), 0))
+    ep = event_problem(system, state)
+    sol = lcp.solve(ep.lcp, "lemke")
+    if sol.status != "solved":
+        raise ValueError(f"lemke failed at the time-stepper's steady state: {sol.message}")
+    least = np.zeros(ep.lcp.n)
+    least[:c] = 1.0
+    side = np.zeros(ep.lcp.n, bool)
+    side[:c + ep.k] = True
+    face = face_minimum_norm(ep.lcp, sol.z, ep.G, c=least, z_side=side)
+    raw, sel = ep.unpack(sol.z), ep.unpack(face.z)
+    ed_from_ts = models.simulate(system, state.copy(), t_max=T.t + 40.0)
+    fin = ed.final if ed.final is not None else State(E.t, E.omega, E.V, E.s)
+    ts_from_ed = moreau_jean(system, State(fin.t, fin.omega.copy(), fin.V, fin.s.copy()), h=h,
+                             t_max=fin.t + 5.0)
+    return SteadyPair(
+        d_mu_g=abs(E.mu_g - T.mu_g), d_alpha=float(np.abs(E.omega_dot - T.omega_dot).max()),
+        differing=np.flatnonzero(state_labels(system, E) != state_labels(system, T)).tolist(),
+        ts_in_event=event_check(system, T), ed_in_step=step_check(system, E, h),
+        sum_R=(float(E.R.sum()), float(T.R.sum())),
+        norm2=(float(np.sum(E.R**2 + E.S**2)), float(np.sum(T.R**2 + T.S**2))),
+        raw_vs_ts=float(np.abs(raw.omega_dot - T.omega_dot).max()),
+        selected_vs_ed=float(np.abs(sel.omega_dot - E.omega_dot).max()),
+        selected_mu_g=global_friction_coefficient(system, sel.S),
+        ed_from_ts=ed_from_ts, ts_from_ed=ts_from_ed)
+
+
+__all__ = ["LawCheck", "event_check", "step_check", "StepRow", "Comparison", "SteadyPair",
+           "examine_steady_states",
            "compare_integrators", "format_comparison", "omega_at", "state_labels"]

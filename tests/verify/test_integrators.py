@@ -65,9 +65,9 @@ def test_2x2_event_accelerations_not_unique_by_the_laws_themselves():
     """docs/mechanics.md example 1: the MILP's second solution of the event at t = 8.52281
     keeps every contact closed (a_n = 0) and satisfies the laws contact by contact
     (event_check, which does not use the event LCP), with other angular accelerations."""
-    import lcp
-    from models.evolution import EventRecord
-    from verify.certify import certify
+    from rigidlcp import lcp
+    from rigidlcp.models.engine.records import EventRecord
+    from rigidlcp.verify.certificates.certify import certify
 
     system = models.System(models.rectangular(2, 2), mu_pp=0.1, mu_plane=0.2, gamma=0.1)
     run = models.simulate(system, seed=1, select="none")
@@ -85,3 +85,25 @@ def test_2x2_event_accelerations_not_unique_by_the_laws_themselves():
                       mu_g=0.0, dissipation=0.0, iterations=0, residual=0.0, n_lcp=0,
                       method="milp")
     assert event_check(system, rec).valid
+
+
+@pytest.mark.slow
+def test_two_valid_steady_states_selected_by_the_rule():
+    """rect 5x3, gamma 0.3: the two integrators end with the same contact states and mu_g but
+    angular accelerations 4e-3 apart; both satisfy the other's laws, lemke's own vertex at the
+    time-stepper's state is the time-stepper's steady state, and the least-sum-R face walk
+    moves it to the event-driven one (docs/integrators.md)."""
+    from rigidlcp.models.timestepping import moreau_jean
+    from rigidlcp.verify.integrators import examine_steady_states
+
+    system = models.System(models.rectangular(5, 3), mu_pp=0.1, mu_plane=0.2, gamma=0.3)
+    ed = models.simulate(system, seed=1)
+    ts = moreau_jean(system, seed=1, h=4e-3)
+    x = examine_steady_states(system, ed, ts, 4e-3)
+    assert x.differing == [] and x.d_alpha > 1e-3
+    assert x.ts_in_event.valid and x.ts_in_event.steady and x.ed_in_step.valid
+    assert x.raw_vs_ts < 1e-10 and x.selected_vs_ed < 1e-10
+    assert x.sum_R[0] < x.sum_R[1]  # the event-driven rule: least sum R
+    assert x.ed_from_ts.status == "steady"
+    assert np.allclose(x.ed_from_ts.last.omega_dot, ed.last.omega_dot, atol=1e-10)
+    assert np.allclose(x.ts_from_ed.last.omega_dot, ts.last.omega_dot, atol=1e-10)
