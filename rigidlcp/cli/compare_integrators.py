@@ -27,6 +27,9 @@ def register(sub) -> None:
     g.add_argument("--T", type=float, default=None,
                    help="time at which the angular velocities are compared (default: half "
                    "the event-driven run's last event time)")
+    g.add_argument("--phases", type=int, default=1,
+                   help="average the sup error over N grids shifted by j h / N (shows the "
+                   "order cleanly; N times the cost)")
     p.set_defaults(func=cmd_compare_integrators)
 
 
@@ -45,7 +48,7 @@ def cmd_compare_integrators(args) -> int:
     StepOptions(h=args.h, theta=args.theta)  # bad h / theta: one line, exit status 2
     hs = tuple(args.h / 2**k for k in range(args.levels))
     cmp = compare_integrators(system, seed=args.seed, hs=hs, T=args.T, t_max=args.t_max,
-                              step_options={"theta": args.theta})
+                              step_options={"theta": args.theta}, phases=args.phases)
     print(format_comparison(cmp))
     bad = [r.h for r in cmp.rows if r.run.status not in ("steady", "time_limit")]
     return 1 if bad else 0
