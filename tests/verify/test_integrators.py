@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from rigidlcp import models
-from rigidlcp.cli.main import main
 from rigidlcp.verify.integrators import compare_integrators, event_check, step_check
 
 
@@ -44,21 +43,6 @@ def test_first_order_in_h(row3):
     cmp = compare_integrators(row3, seed=1, hs=(8e-3, 4e-3, 2e-3), t_max=1.7, phases=6)
     orders = cmp.orders("d_omega_max")
     assert all(0.75 <= o <= 1.25 for o in orders), orders
-
-
-def test_cli_bad_input(capsys):
-    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--h", "0"]) == 2
-    assert "h must be" in capsys.readouterr().err
-    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--levels", "2"]) == 2
-    assert main(["timestep", "--lx", "1", "--ly", "1", "--theta", "2"]) == 2
-
-
-def test_cli_compare_prints_the_table(capsys):
-    code = main(["compare-integrators", "--lx", "3", "--ly", "1", "--gamma", "0.05",
-                 "--h", "8e-3", "--t-max", "1.0"])
-    out = capsys.readouterr().out
-    assert code == 0
-    assert "observed order of sup|domega|" in out and out.count(" time_lim ") == 3
 
 
 def test_2x2_event_accelerations_not_unique_by_the_laws_themselves():

@@ -1,0 +1,29 @@
+"""`rigidlcp timestep` and `rigidlcp compare-integrators`: bad input, the table, the run file."""
+
+from rigidlcp.cli.main import main
+
+
+def test_cli_bad_input(capsys):
+    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--h", "0"]) == 2
+    assert "h must be" in capsys.readouterr().err
+    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--levels", "2"]) == 2
+    assert main(["timestep", "--lx", "1", "--ly", "1", "--theta", "2"]) == 2
+
+
+def test_cli_compare_prints_the_table(capsys):
+    code = main(["compare-integrators", "--lx", "3", "--ly", "1", "--gamma", "0.05",
+                 "--h", "8e-3", "--t-max", "1.0"])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "observed order of sup|domega|" in out and out.count(" time_lim ") == 3
+
+
+def test_cli_timestep_saves_a_run_and_refuses_to_overwrite(tmp_path, capsys):
+    out = tmp_path / "disk"
+    args = ["timestep", "--lx", "1", "--ly", "1", "--mu-plane", "0.3", "--gamma", "0.16",
+            "--h", "1e-3", "--out", str(out)]
+    assert main(args) == 0
+    assert "steady" in capsys.readouterr().out
+    assert main(["plot", str(out) + ".npz", "--out", str(tmp_path / "png")]) == 0
+    assert main(args) == 2
+    assert "exists" in capsys.readouterr().err
