@@ -25,9 +25,11 @@ measured in the worker around `lcp.solve` (validation, the method, w = M z + q);
 first solves a 2 x 2 problem, untimed, in every fresh worker (imports, caches). The worker
 uses one BLAS thread (threadpoolctl): solves never run in parallel.
 
-Siconos's Lemke, enumeration and PGS ("siconos-lemke", "siconos-enum", "siconos-pgs") run in
-a long-lived /usr/bin/python3 subprocess (verify/_siconos_bench_helper.py, problems passed as
-.npy files, only the driver call timed) when that interpreter can import siconos.numerics.
+Siconos's solvers (runners.SICONOS_METHODS: Lemke, enumeration and PGS on LCPs; enumeration,
+direct enumeration and Fischer-Burmeister on MLCPs; NSGS, Lemke and enumeration on 2D friction
+contact) run in a long-lived /usr/bin/python3 subprocess (rigidlcp/bench/_siconos_helper.py,
+problems passed as .npy files, only the driver call timed) when that interpreter can import
+siconos.numerics; their answers are certified here like every other.
 """
 
 from __future__ import annotations
@@ -49,8 +51,9 @@ from rigidlcp.verify.certificates.certify import certify
 from .problem_sets import Unreadable
 from .runners import GRACE, SICONOS_METHODS, LocalRunner, SiconosRunner
 
-__all__ = ["Result", "judge", "run_bench", "farkas_certificate", "write_csv", "read_csv",
-           "available_methods", "LocalRunner", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
+__all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate", "write_csv",
+           "read_csv", "available_methods", "LocalRunner", "SiconosRunner", "SICONOS_METHODS",
+           "GRACE"]
 
 #: Claims that no solution exists.
 NO_SOLUTION = ("infeasible", "ray")
@@ -76,6 +79,19 @@ class Result:
     scaled_residual: float  # verify.certify's acceptance measure (nan: no point)
     expected: str
     message: str = ""
+    kind: str = ""  # the kind of problem: "LCP", "MLCP", "FC2D" ("-" unreadable, "" unknown)
+
+
+def problem_kind(problem) -> str:
+    """"LCP", "MLCP" or "FC2D" (the report's common SGM is per kind); "-" for an unreadable
+    file."""
+    if isinstance(problem, Unreadable):
+        return "-"
+    if isinstance(problem, MLCP):
+        return "MLCP"
+    if isinstance(problem, lcp.FrictionContact2D):
+        return "FC2D"
+    return "LCP"
 
 
 CSV_FIELDS = [f.name for f in fields(Result)]
@@ -118,10 +134,10 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         return Result(set=set_name, problem=problem.name, n=0, method="-",
                       outcome="unreadable", success=False, status="unreadable", time=0.0,
                       iterations=None, residual=math.nan, scaled_residual=math.nan,
-                      expected="-", message=problem.reason)
+                      expected="-", message=problem.reason, kind="-")
     expected = str(problem.meta.get("expected", "unknown"))
     base = dict(set=set_name, problem=problem.name, n=problem.n, method=method,
-                expected=expected, message=raw.get("message", ""))
+                expected=expected, message=raw.get("message", ""), kind=problem_kind(problem))
     kind = raw["kind"]
     if kind != "answer":
         t = time_limit if kind == "timeout" else float(raw.get("time", 0.0))
@@ -155,7 +171,7 @@ def available_methods(siconos: SiconosRunner | None) -> list[str]:
     """rigidlcp's registered methods, and Siconos's when its runner is available."""
     names = [m.name for m in lcp.methods()]
     if siconos is not None and siconos.available:
-        names += list(SICONOS_METHODS)
+        names += [m for m in SICONOS_METHODS if siconos.offers(m)]
     return names
 
 
@@ -180,6 +196,9 @@ def run_bench(
         if m in SICONOS_METHODS and (siconos is None or not siconos.available):
             raise ValueError(f"{m} needs Siconos: "
                              f"{siconos.reason if siconos else 'no Siconos runner given'}")
+        if m in SICONOS_METHODS and not siconos.offers(m):
+            raise ValueError(f"{m} needs Siconos's {SICONOS_METHODS[m].kind} solvers, which "
+                             f"Siconos {siconos.version} at {siconos.python} does not have")
     local = LocalRunner(isolate, grace)
     results: list[Result] = []
     try:
@@ -232,5 +251,5 @@ def read_csv(path: str | os.PathLike) -> list[Result]:
                 residual=float(row["residual"]) if row["residual"] else math.nan,
                 scaled_residual=(float(row["scaled_residual"]) if row["scaled_residual"]
                                  else math.nan),
-                expected=row["expected"], message=row["message"]))
+                expected=row["expected"], message=row["message"], kind=row.get("kind", "")))
     return out

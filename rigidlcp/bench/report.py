@@ -14,8 +14,11 @@ Metrics per set and method (qpbenchmark's conventions, stated in the report):
   the answers the method claimed were solutions;
 * refused: problems the method declined (NotApplicable: outside its class or size limit),
   reported apart from its failures (a refusal still counts at the time limit in the SGM);
-* SGM over the common problems: the same mean over only the problems that *every* compared
-  method accepts (none refused them), a fair comparison of methods with different domains.
+* SGM over the common problems, per kind of problem (LCP, MLCP, FC2D): for each kind, the
+  methods compared on it are those that accept at least one problem of that kind, and the
+  common problems are the problems of that kind that every one of them accepts (none refused
+  it); the same mean over only those, a fair comparison of methods with different domains
+  ("-" for a method that refuses every problem of the kind).
 Unreadable files (method "-") are listed with their reason, outside every method's numbers.
 
 Performance profile (Dolan & More, Math. Program. 91, 201, 2002): with t_ps the time of method
@@ -30,7 +33,7 @@ import math
 import os
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -61,8 +64,10 @@ class Summary:
     worst_residual: float
     failures: Counter
     refused: int = 0
-    sgm_common: float = math.nan
-    common: int = 0
+    #: {kind: SGM over the common problems of that kind} (kinds the method is compared on)
+    sgm_common: dict = field(default_factory=dict)
+    #: {kind: number of common problems of that kind} (the same for every method)
+    common: dict = field(default_factory=dict)
 
     @property
     def rate(self) -> float:
@@ -73,12 +78,16 @@ def summarize(results: Sequence[Result], time_limit: float, set_name: str | None
               ) -> list[Summary]:
     """One Summary per method over the results of `set_name` (None: every set, "all")."""
     rows = [r for r in results if (set_name is None or r.set == set_name) and r.method != "-"]
-    refused_somewhere = {(r.set, r.problem) for r in rows if r.outcome == "not_applicable"}
+    common_sets = common_problems(rows)
     out = []
     for method in dict.fromkeys(r.method for r in rows):
         mine = [r for r in rows if r.method == method]
-        common = [r.time if r.success else time_limit for r in mine
-                  if (r.set, r.problem) not in refused_somewhere]
+        sgm_common = {}
+        for kind, (compared, problems) in common_sets.items():
+            if method in compared:
+                sgm_common[kind] = shifted_geometric_mean(
+                    [r.time if r.success else time_limit for r in mine
+                     if r.kind == kind and (r.set, r.problem) in problems])
         ok = [r for r in mine if r.success]
         times = [r.time if r.success else time_limit for r in mine]
         its = [r.iterations for r in ok if r.iterations is not None]
@@ -92,7 +101,22 @@ def summarize(results: Sequence[Result], time_limit: float, set_name: str | None
             failures=Counter(r.outcome for r in mine
                              if not r.success and r.outcome != "not_applicable"),
             refused=sum(r.outcome == "not_applicable" for r in mine),
-            sgm_common=shifted_geometric_mean(common), common=len(common)))
+            sgm_common=sgm_common, common={k: len(p) for k, (_, p) in common_sets.items()}))
+    return out
+
+
+def common_problems(rows: Sequence[Result]) -> dict[str, tuple[set, set]]:
+    """{kind: (compared methods, common problems)} over `rows` (one set's or all results):
+    the methods compared on a kind accept (do not refuse) at least one of its problems; its
+    common problems, (set, problem) pairs, are those that none of these methods refused."""
+    out = {}
+    order = {"LCP": 0, "MLCP": 1, "FC2D": 2}
+    for kind in sorted(dict.fromkeys(r.kind for r in rows), key=lambda k: order.get(k, 3)):
+        mine = [r for r in rows if r.kind == kind]
+        compared = {r.method for r in mine if r.outcome != "not_applicable"}
+        refused = {(r.set, r.problem) for r in mine
+                   if r.method in compared and r.outcome == "not_applicable"}
+        out[kind] = (compared, {(r.set, r.problem) for r in mine} - refused)
     return out
 
 
@@ -156,16 +180,19 @@ def _fmt(v: float, spec: str) -> str:
 
 
 def summary_table(summaries: Sequence[Summary]) -> list[str]:
-    """Markdown table lines of summaries."""
-    common = summaries[0].common if summaries else 0
-    lines = ["| method | success | refused | SGM time | SGM time, common "
-             f"({common}) | median iterations | worst residual | failures |",
-             "|---|---:|---:|---:|---:|---:|---:|---|"]
+    """Markdown table lines of summaries: one "SGM time, common" column per kind of problem
+    (the number of common problems of that kind in its header)."""
+    common = summaries[0].common if summaries else {}
+    heads = "".join(f" SGM time, common {k or 'problems'} ({n}) |" for k, n in common.items())
+    lines = [f"| method | success | refused | SGM time |{heads} median iterations | "
+             "worst residual | failures |",
+             "|---|---:|---:|---:|" + "---:|" * len(common) + "---:|---:|---|"]
     for s in summaries:
         fails = ", ".join(f"{k} {v}" for k, v in sorted(s.failures.items())) or "-"
+        cells = "".join(f" {_fmt_time(s.sgm_common.get(k, math.nan))} |" for k in common)
         lines.append(
             f"| {s.method} | {s.successes}/{s.problems} ({100 * s.rate:.0f}%) | {s.refused} | "
-            f"{_fmt_time(s.sgm_time)} | {_fmt_time(s.sgm_common)} | "
+            f"{_fmt_time(s.sgm_time)} |{cells} "
             f"{_fmt(s.median_iterations, '.0f')} | {_fmt(s.worst_residual, '.1e')} | "
             f"{fails} |")
     return lines
@@ -192,6 +219,9 @@ def write_report(results: Sequence[Result], out: str | os.PathLike, *, time_limi
         "",
         "Columns: success = certified answers / problems; SGM time = shifted geometric mean "
         f"of the solve time, shift {1e3 * SHIFT:g} ms, failures counted at the time limit; "
+        "SGM time, common KIND = the same mean over only the problems of that kind (LCP, MLCP, "
+        "FC2D) that every method accepting any problem of the kind accepts ('-': the method "
+        "refuses every problem of the kind); "
         "median iterations over the successes (each method's own count: pivots, sweeps or "
         "solver iterations); worst residual = largest scaled residual max|min(z/z_s, w/w_s)| "
         "over the answers claimed as solutions; failures by kind. Profiles: Dolan-More, "

@@ -23,16 +23,16 @@ def register(sub) -> None:
         "solve, certify each answer with verify (an uncertified answer is a failure), and "
         "write OUT/results.csv, OUT/report.md (success rate, shifted geometric mean of the "
         "solve time, iterations, worst residual per set and method) and Dolan-More "
-        "performance profiles OUT/profile_*.png. Siconos's Lemke, enumeration and PGS are "
-        "added when /usr/bin/python3 can import siconos.numerics.",
+        "performance profiles OUT/profile_*.png. Siconos's LCP, MLCP and 2D "
+        "friction-contact solvers are added when /usr/bin/python3 can import siconos.numerics.",
         epilog="Sets: see --list; a directory of *.npz / *.dat (Siconos format) files is a "
-        "set too. Methods: rigidlcp's (`rigidlcp methods`) and siconos-lemke, siconos-enum, "
-        "siconos-pgs. Exit status 0 when the run completed (whatever the success rates).")
+        "set too. Methods: rigidlcp's (`rigidlcp methods`) and Siconos's (siconos-*, see "
+        "--list). Exit status 0 when the run completed (whatever the success rates).")
     p.add_argument("--set", dest="sets", metavar="NAME[,NAME]",
                    help="problem sets (names or directories), comma-separated")
     p.add_argument("--methods", default=None, metavar="M[,M]",
                    help=f"methods, comma-separated (default: {DEFAULT_METHODS}, plus "
-                   "siconos-lemke,siconos-enum,siconos-pgs when Siconos is available)")
+                   "every siconos-* method of --list when Siconos is available)")
     p.add_argument("--out", metavar="DIR", help="output directory")
     p.add_argument("--time-limit", type=float, default=10.0, metavar="S",
                    help="seconds per solve; a longer solve is killed and fails (default 10)")
@@ -71,10 +71,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
             print("methods:")
             for m in lcp.methods():
                 print(f"  {m.name}")
-            for m in SICONOS_METHODS:
-                state = ("available" if siconos is not None and siconos.available
-                         else f"unavailable: {siconos.reason if siconos else '--no-siconos'}")
-                print(f"  {m:<13} ({state})")
+            for m, spec in SICONOS_METHODS.items():
+                if siconos is None or not siconos.available:
+                    state = f"unavailable: {siconos.reason if siconos else '--no-siconos'}"
+                else:
+                    state = "available" if siconos.offers(m) else (
+                        f"unavailable: no {spec.kind} solvers in this Siconos")
+                print(f"  {m:<24} {spec.kind} problems ({state})")
             return 0
         if not args.sets or not args.out:
             raise ValueError("--set and --out are required (or --list)")
@@ -85,10 +88,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if args.methods:
             methods = [m.strip() for m in args.methods.split(",") if m.strip()]
         else:
-            methods = DEFAULT_METHODS.split(",") + (list(SICONOS_METHODS) if siconos_ok else [])
-        absent = [m for m in methods if m in SICONOS_METHODS and not siconos_ok]
+            methods = DEFAULT_METHODS.split(",") + [m for m in SICONOS_METHODS
+                                                    if siconos_ok and siconos.offers(m)]
+        absent = [m for m in methods if m in SICONOS_METHODS
+                  and not (siconos_ok and siconos.offers(m))]
         if absent:
-            why = siconos.reason if siconos is not None else "--no-siconos"
+            why = (siconos.reason or f"this Siconos ({siconos.version}) lacks them"
+                   if siconos is not None else "--no-siconos")
             notes.append(f"skipped {', '.join(absent)}: Siconos unavailable ({why})")
             methods = [m for m in methods if m not in absent]
         elif not siconos_ok and not args.methods:
@@ -98,8 +104,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
             notes.append(f"Siconos: python3-siconos {siconos.version} in a {siconos.python} "
                          "subprocess; only its driver call is timed; siconos-lemke is given "
                          "max_iter = 1000 + 100 n (as rigidlcp's lemke), siconos-pgs tol "
-                         "1e-10 and 10000 sweeps (as rigidlcp's pgs), siconos-enum n <= 20; "
-                         "a nonzero Siconos info is a failure (it proves nothing)")
+                         "1e-10 and 10000 sweeps (as rigidlcp's pgs), siconos-fc2d-nsgs tol "
+                         "1e-12 and 10000 sweeps (as rigidlcp's nsgs); the enumerations are "
+                         "given n <= 20 (LCP), m <= 16 (MLCP), c <= 5 contacts (fc2d); the "
+                         "MLCP and fc2d solvers have Siconos's other defaults; a nonzero "
+                         "Siconos info is a failure (it proves nothing)")
         params = {}
         if args.sizes:
             params["sizes"] = tuple(int(s) for s in args.sizes.split(","))
