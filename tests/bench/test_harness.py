@@ -246,4 +246,7 @@ def test_a_folder_of_every_kind_with_an_unreadable_file(tmp_path):
     s = {x.method: x for x in summarize(results, 30)}
     assert set(s) == {"newton-min", "states"}  # the unreadable rows are no method's
     assert s["states"].refused == 2 and "not_applicable" not in s["states"].failures
-    assert s["states"].common == 1  # only the friction problem is accepted by both
+    # the common problems per kind: states is compared on friction contact only
+    assert s["states"].common == {"LCP": 1, "MLCP": 1, "FC2D": 1}
+    assert set(s["states"].sgm_common) == {"FC2D"}
+    assert set(s["newton-min"].sgm_common) == {"LCP", "MLCP", "FC2D"}
