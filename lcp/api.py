@@ -135,14 +135,21 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
     return sol
 
 
+_LOADED = False
+
+
 def _load_builtin_methods() -> None:
     # Importing the method modules registers them (done lazily to keep import cheap).
     # `from . import methods` would find the *function* lcp.methods and import nothing, and
     # importing the submodule rebinds the package attribute `methods` to it: undo that.
+    global _LOADED
+    if _LOADED:
+        return
     import importlib
     import sys
 
     importlib.import_module(f"{__package__}.methods")
+    _LOADED = True
     package = sys.modules[__package__]
     if getattr(package, "methods", None) is not methods:
         package.methods = methods

@@ -1,0 +1,87 @@
+"""The hot loop of Lemke's method -- ratio test, lexicographic tie-break, pivot -- compiled.
+
+`pivot_loop(T, basic, nonbasic, row_of, slot_of, tol, max_iter)` runs Lemke's pivots on the
+dictionary of `lcp.lemke._Lemke` (docs/lemke.md, "The dictionary") in C (lcp/_lemke_c.c,
+built by setup.py as an optional extension) and returns (code, pivots, s, entering):
+code 0 = z0 left (solved), 1 = a basis repeated (numerical cycling), 2 = pivot limit,
+3 = secondary ray (slot s of the unblocked entering variable). The arrays are updated in place.
+The C loop applies the same rules in the same order as the numpy loop of `_Lemke.run`
+(the fallback when the extension is not built), so both take the same pivots
+(tests/lcp/test_lemke_kernel.py compares the sequences).
+
+Set the environment variable RIGIDLCP_NO_KERNEL=1 (or call `use_compiled(False)`) to run the
+numpy loop even when the extension is built.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+try:
+    from . import _lemke_c
+except ImportError:  # not built (no C compiler at install): the numpy loop runs instead
+    _lemke_c = None
+
+#: Is the compiled loop built?
+COMPILED = _lemke_c is not None
+_use = COMPILED and os.environ.get("RIGIDLCP_NO_KERNEL", "") in ("", "0")
+
+SOLVED, CYCLING, MAX_ITER, RAY = 0, 1, 2, 3
+
+
+def enabled() -> bool:
+    """Will `lcp.lemke` use the compiled loop?"""
+    return _use
+
+
+def use_compiled(flag: bool) -> bool:
+    """Switch the compiled loop on or off (on only when built); returns the previous setting."""
+    global _use
+    previous, _use = _use, bool(flag) and COMPILED
+    return previous
+
+
+_rounding_matched = False
+
+
+def _match_blas_rounding() -> None:
+    """Make the C update round like the BLAS `dger` of the numpy loop: with one fused
+    multiply-add per entry (OpenBLAS's Haswell+ kernels) or with a product and a sum."""
+    global _rounding_matched
+    from scipy.linalg.blas import dger
+
+    rng = np.random.default_rng(0)
+    A = np.asfortranarray(rng.standard_normal((67, 5)))
+    x, y = rng.standard_normal(67), rng.standard_normal(5)
+    plain = A + np.outer(x, y)
+    dger(1.0, x, y, 1, 1, A, 1, 1, 1)
+    _lemke_c.set_fma(not np.array_equal(A, plain))
+    _rounding_matched = True
+
+
+def pivot_loop(T: np.ndarray, basic: np.ndarray, nonbasic: np.ndarray, row_of: np.ndarray,
+               slot_of: np.ndarray, tol: float, max_iter: int,
+               trace: np.ndarray | None = None) -> tuple[int, int, int, int]:
+    """Run the pivots (compiled); `trace` (int64, length 2 k) receives (row, slot) of the first
+    k pivots."""
+    if not _rounding_matched:
+        _match_blas_rounding()
+    return _lemke_c.run(T, basic, nonbasic, row_of, slot_of, float(tol), int(max_iter), trace)
+
+
+def setup(T: np.ndarray, M: np.ndarray, q: np.ndarray, d: np.ndarray) -> tuple[float, float, float]:
+    """Fill the dictionary T = [M / mu, d / delta, q / nu] (compiled); returns (mu, nu, delta)."""
+    return _lemke_c.setup(T, np.ascontiguousarray(M), q, d)
+
+
+def plain_finite(M, q) -> tuple[bool, float]:
+    """(True, min q) when M (n x n) and q (n) are C-contiguous float64 arrays with finite entries
+    (then they need no conversion); (False, nan) otherwise (the caller validates them)."""
+    if (_use and type(M) is np.ndarray and type(q) is np.ndarray and M.dtype == np.float64
+            and q.dtype == np.float64 and q.ndim == 1 and q.size > 0
+            and M.shape == (q.size, q.size) and M.flags.c_contiguous
+            and q.flags.c_contiguous):
+        return _lemke_c.check(M, q)
+    return False, float("nan")
