@@ -98,14 +98,23 @@ def test_real_event_cycles_in_both_loops():
 
 
 def test_switch():
+    previous = kernel.use_compiled(True)
     assert kernel.enabled()
-    previous = kernel.use_compiled(False)
+    kernel.use_compiled(False)
     assert not kernel.enabled()
     kernel.use_compiled(previous)
     assert kernel.enabled() == previous
 
 
 def test_plain_finite_refuses_what_needs_validation():
+    previous = kernel.use_compiled(True)
+    try:
+        check_plain_finite()
+    finally:
+        kernel.use_compiled(previous)
+
+
+def check_plain_finite():
     M, q = np.eye(2), np.array([-1.0, 1.0])
     assert kernel.plain_finite(M, q) == (True, -1.0)
     assert not kernel.plain_finite(M.tolist(), q)[0]
