@@ -30,6 +30,9 @@ def main() -> int:
         if not line.strip():
             continue
         req = json.loads(line)
+        if "Ms" in req:
+            print(json.dumps(_batch(np, sn, req)), flush=True)
+            continue
         M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
         q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
         n = q.size
@@ -50,6 +53,32 @@ def main() -> int:
         }
         print(json.dumps(out), flush=True)
     return 0
+
+
+def _batch(np, sn, req: dict) -> dict:
+    """A loop of lcp_lexicolemke over stacked problems {"Ms": path (k, n, n), "qs": path}:
+    "loop" = wall seconds of the whole loop (problem objects, options, solve), "calls" = the sum
+    of the solver calls only; the pivots and the worst residual."""
+    Ms, qs = np.load(req["Ms"]), np.load(req["qs"])
+    k, n = qs.shape
+    Ms = [np.ascontiguousarray(Ms[i]) for i in range(k)]
+    qs = [np.ascontiguousarray(qs[i]) for i in range(k)]
+    Z, W = np.zeros((k, n)), np.zeros((k, n))
+    infos, pivots, calls = [], [], 0.0
+    max_iter = int(req.get("max_iter", 10000))
+    t0 = time.perf_counter()
+    for i in range(k):
+        problem = sn.LCP(Ms[i], qs[i])
+        options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+        options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+        c0 = time.perf_counter()
+        infos.append(sn.lcp_lexicolemke(problem, Z[i], W[i], options))
+        calls += time.perf_counter() - c0
+        pivots.append(int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
+    loop = time.perf_counter() - t0
+    res = max(float(np.max(np.abs(np.minimum(Z[i], Ms[i] @ Z[i] + qs[i])))) for i in range(k))
+    return {"loop": loop, "calls": calls, "pivots": pivots,
+            "failures": sum(1 for x in infos if x), "residual": res}
 
 
 if __name__ == "__main__":

@@ -1,14 +1,15 @@
 """rigidlcp's pure mathematics: LCP/MLCP problems, solvers, residuals. Knows nothing of disks."""
 
 from .api import MethodInfo, get_method, methods, register, solve
+from .batch import solve_many
 from .friction import FrictionContact2D, natural_residual
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable, load
 from .solution import STATUSES, Solution, complementarity_residual
 
 __all__ = [
     "LCP", "MLCP", "InvalidProblem", "NotApplicable", "load", "Solution", "STATUSES",
-    "complementarity_residual", "solve", "methods", "get_method", "register", "MethodInfo",
-    "enumerate_solutions", "FrictionContact2D", "natural_residual",
+    "complementarity_residual", "solve", "solve_many", "methods", "get_method", "register",
+    "MethodInfo", "enumerate_solutions", "FrictionContact2D", "natural_residual",
 ]
 
 

@@ -450,6 +450,31 @@ fail1:
     return NULL;
 }
 
+static void fill(idx n, double *T, const double *M, const double *q, const double *d,
+                 double *out_mu, double *out_nu, double *out_delta)
+{
+    double mu = 0.0, nu = 0.0, delta = -1.0 / 0.0;
+    for (idx k = 0; k < n * n; k++) {
+        double a = M[k] < 0 ? -M[k] : M[k];
+        if (a > mu) mu = a;
+    }
+    if (mu == 0.0) mu = 1.0;
+    for (idx i = 0; i < n; i++) {
+        double a = q[i] < 0 ? -q[i] : q[i];
+        if (a > nu) nu = a;
+        if (d[i] > delta) delta = d[i];
+    }
+    for (idx i = 0; i < n; i++)
+        for (idx j = 0; j < n; j++) T[i + n * j] = M[i * n + j] / mu;
+    for (idx i = 0; i < n; i++) {
+        T[i + n * n] = d[i] / delta;
+        T[i + n * (n + 1)] = q[i] / nu;
+    }
+    *out_mu = mu;
+    *out_nu = nu;
+    *out_delta = delta;
+}
+
 /* setup(T, M, q, d) -> (mu, nu, delta): T[:, :n] = M / mu, T[:, n] = d / delta,
  * T[:, n + 1] = q / nu with mu = max|M| (1 if M = 0), nu = max|q|, delta = max d; as numpy's
  * true divisions in `_Lemke.__init__`. M is read C-contiguous, T written column-major. */
@@ -468,25 +493,9 @@ static PyObject *py_setup(PyObject *self, PyObject *args)
     if (get_buffer(od, &vd, "d", 'd', n, 0) < 0) goto f1;
     if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto f2;
     if (get_buffer(oT, &vT, "T", 'd', n * (n + 2), 1) < 0) goto f3;
-    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf,
-                 *d = (const double *)vd.buf;
-    double *T = (double *)vT.buf, mu = 0.0, nu = 0.0, delta = -1.0 / 0.0;
-    for (idx k = 0; k < n * n; k++) {
-        double a = M[k] < 0 ? -M[k] : M[k];
-        if (a > mu) mu = a;
-    }
-    if (mu == 0.0) mu = 1.0;
-    for (idx i = 0; i < n; i++) {
-        double a = q[i] < 0 ? -q[i] : q[i];
-        if (a > nu) nu = a;
-        if (d[i] > delta) delta = d[i];
-    }
-    for (idx i = 0; i < n; i++)
-        for (idx j = 0; j < n; j++) T[i + n * j] = M[i * n + j] / mu;
-    for (idx i = 0; i < n; i++) {
-        T[i + n * n] = d[i] / delta;
-        T[i + n * (n + 1)] = q[i] / nu;
-    }
+    double mu, nu, delta;
+    fill(n, (double *)vT.buf, (const double *)vM.buf, (const double *)vq.buf,
+         (const double *)vd.buf, &mu, &nu, &delta);
     PyBuffer_Release(&vT);
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vd);
@@ -541,7 +550,148 @@ static PyObject *py_set_fma(PyObject *self, PyObject *arg)
     return PyBool_FromLong(use_fma);
 }
 
+/* solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k problems of size n
+ * (Ms: k n n C-contiguous, qs: k n; the data must be finite) by the same steps as lemke()
+ * (q >= 0: z = 0 and no pivot; else setup + run). Writes z (k n, the original units, as
+ * `_Lemke.point`), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
+ * (solved) leaves a usable z: the caller solves the others again by lemke() for their
+ * evidence (ray, restart after cycling). */
+static PyObject *py_solve_batch(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc, &op))
+        return NULL;
+    Py_buffer vd, vc, vp, vM, vq, vZ, vB;
+    idx n = PyObject_Length(od), k = PyObject_Length(oc);
+    if (n < 1 || k < 0) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "d: empty");
+        return NULL;
+    }
+    if (get_buffer(od, &vd, "d", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oc, &vc, "codes", 'q', k, 0) < 0) goto b1;
+    if (get_buffer(op, &vp, "pivots", 'q', k, 0) < 0) goto b2;
+    if (get_buffer(oM, &vM, "Ms", 'd', k * n * n, 0) < 0) goto b3;
+    if (get_buffer(oq, &vq, "qs", 'd', k * n, 0) < 0) goto b4;
+    if (get_buffer(oZ, &vZ, "Z", 'd', k * n, 0) < 0) goto b5;
+    if (PyObject_GetBuffer(oB, &vB, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) goto b6;
+    if (vB.len != k * n || vB.itemsize != 1) {
+        PyErr_SetString(PyExc_ValueError, "basic_z: expected k n int8 values");
+        goto b7;
+    }
+    Lemke L;
+    int64_t *ints = (int64_t *)malloc((6 * n + 3) * sizeof(int64_t));
+    double *T = (double *)malloc((size_t)n * (n + 2) * sizeof(double));
+    L.rows = (idx *)malloc(4 * n * sizeof(idx));
+    L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
+    L.V = (double *)malloc((size_t)n * n * sizeof(double));
+    int failed = !(ints && T && L.rows && L.alpha && L.V);
+    if (!failed) {
+        const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
+                     *d = (const double *)vd.buf;
+        double *Z = (double *)vZ.buf;
+        int8_t *B = (int8_t *)vB.buf;
+        int64_t *codes = (int64_t *)vc.buf, *piv = (int64_t *)vp.buf;
+        L.n = n;
+        L.T = T;
+        L.tol = tol;
+        L.basic = ints;
+        L.nonbasic = ints + n;
+        L.row_of = ints + 2 * n + 1;
+        L.slot_of = ints + 4 * n + 2;
+        L.cand = L.rows + n;
+        L.wj = L.rows + 2 * n;
+        L.pos = L.rows + 3 * n;
+        L.theta = L.alpha + n;
+        L.col = L.alpha + 2 * n;
+        L.row = L.alpha + 3 * n;
+        Py_BEGIN_ALLOW_THREADS
+        for (idx p = 0; p < k && !failed; p++) {
+            const double *q = qs + p * n;
+            double *z = Z + p * n;
+            int8_t *bz = B + p * n;
+            memset(z, 0, n * sizeof(double));
+            memset(bz, 0, n);
+            double qmin = q[0];
+            for (idx i = 1; i < n; i++)
+                if (q[i] < qmin) qmin = q[i];
+            if (qmin >= 0) {
+                codes[p] = 0;
+                piv[p] = 0;
+                continue;
+            }
+            double mu, nu, delta;
+            fill(n, T, Ms + p * n * n, q, d, &mu, &nu, &delta);
+            for (idx i = 0; i < n; i++) {
+                L.basic[i] = i;
+                L.row_of[i] = i;
+                L.slot_of[i] = -1;
+            }
+            for (idx j = 0; j <= n; j++) {
+                L.nonbasic[j] = n + j;
+                L.row_of[n + j] = -1;
+                L.slot_of[n + j] = j;
+            }
+            long long pivots = 0;
+            idx s;
+            int64_t entering;
+            int code = run(&L, max_iter, NULL, 0, &pivots, &s, &entering);
+            if (code < 0) {
+                failed = 1;
+                break;
+            }
+            codes[p] = code;
+            piv[p] = pivots;
+            if (code == 0) {
+                const double *beta = T + n * (n + 1);
+                double scale = nu / mu;
+                for (idx i = 0; i < n; i++) {
+                    int64_t b = L.basic[i];
+                    if (b >= n && b < 2 * n) {
+                        z[b - n] = beta[i] * scale;
+                        bz[b - n] = 1;
+                    }
+                }
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    free(ints);
+    free(T);
+    free(L.rows);
+    free(L.alpha);
+    free(L.V);
+    PyBuffer_Release(&vB);
+    PyBuffer_Release(&vZ);
+    PyBuffer_Release(&vq);
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vp);
+    PyBuffer_Release(&vc);
+    PyBuffer_Release(&vd);
+    if (failed) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+b7:
+    PyBuffer_Release(&vB);
+b6:
+    PyBuffer_Release(&vZ);
+b5:
+    PyBuffer_Release(&vq);
+b4:
+    PyBuffer_Release(&vM);
+b3:
+    PyBuffer_Release(&vp);
+b2:
+    PyBuffer_Release(&vc);
+b1:
+    PyBuffer_Release(&vd);
+    return NULL;
+}
+
 static PyMethodDef methods[] = {
+    {"solve_batch", py_solve_batch, METH_VARARGS,
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k LCPs by Lemke."},
     {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
     {"setup", py_setup, METH_VARARGS,

@@ -85,3 +85,13 @@ def plain_finite(M, q) -> tuple[bool, float]:
             and q.flags.c_contiguous):
         return _lemke_c.check(M, q)
     return False, float("nan")
+
+
+def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_iter: int,
+                Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray) -> None:
+    """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
+    z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
+    leaves a z; the others are to be solved again one by one for their evidence."""
+    if not _rounding_matched:
+        _match_blas_rounding()
+    _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots)
