@@ -81,10 +81,11 @@ static int hs_add(HashSet *h, int64_t key)
 
 /* ------------------------------------------------------------------ the rank-one update */
 /* T[:, c] += col * row[c] for every c with row[c] != 0. OpenBLAS's optimized ?ger kernels
- * (Haswell and later) compute each entry as one fused multiply-add; the numpy loop of
- * lemke.py calls them. `use_fma` (set from Python after probing what dger does) picks the
- * same rounding, so that both loops see the same numbers and take the same pivots. */
-static int use_fma = 0;
+ * (Haswell and later: chosen at run time on CPUs with AVX2 and FMA) compute each entry as one
+ * fused multiply-add; the numpy loop of lemke.py calls them. `use_fma` (on when the CPU has
+ * AVX2 and FMA, see fma_available; set_fma overrides it) picks the same rounding, so that
+ * both loops see the same numbers and take the same pivots (a test checks it against dger). */
+static int use_fma = -1; /* -1: not decided yet */
 
 static void update_plain(double *T, const double *col, const double *row, idx n, idx m)
 {
@@ -126,8 +127,8 @@ static void update_fma(double *T, const double *col, const double *row, idx n, i
 static int fma_available(void)
 {
 #if HAVE_FMA_TARGET && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("fma");
+    __builtin_cpu_init(); /* OpenBLAS's FMA kernels (Haswell, Zen, SkylakeX) need AVX2 too */
+    return __builtin_cpu_supports("fma") && __builtin_cpu_supports("avx2");
 #elif HAVE_FMA_TARGET
     return 1;
 #else
@@ -150,6 +151,7 @@ static int64_t pivot(Lemke *L, idx r, idx s)
     memset(Ts, 0, n * sizeof(double));
     col[r] = 1.0;
 #if HAVE_FMA_TARGET
+    if (use_fma < 0) use_fma = fma_available();
     if (use_fma)
         update_fma(T, col, row, n, m);
     else
@@ -540,10 +542,14 @@ static PyObject *py_check(PyObject *self, PyObject *args)
 }
 
 /* set_fma(flag) -> bool: use fused multiply-adds in the update (only if the CPU has them);
- * returns the setting in force. */
+ * returns the setting in force (set_fma(None) only asks). */
 static PyObject *py_set_fma(PyObject *self, PyObject *arg)
 {
     (void)self;
+    if (arg == Py_None) { /* query only */
+        if (use_fma < 0) use_fma = fma_available();
+        return PyBool_FromLong(use_fma);
+    }
     int flag = PyObject_IsTrue(arg);
     if (flag < 0) return NULL;
     use_fma = flag && fma_available();

@@ -43,13 +43,10 @@ def use_compiled(flag: bool) -> bool:
     return previous
 
 
-_rounding_matched = False
-
-
-def _match_blas_rounding() -> None:
-    """Make the C update round like the BLAS `dger` of the numpy loop: with one fused
-    multiply-add per entry (OpenBLAS's Haswell+ kernels) or with a product and a sum."""
-    global _rounding_matched
+def blas_uses_fma() -> bool:
+    """Does scipy's BLAS `dger` (the numpy loop's update) round each entry once, as a fused
+    multiply-add? The C update does so when the CPU has AVX2 and FMA, as OpenBLAS's kernels do;
+    tests/lcp/test_lemke_kernel.py checks the two agree on the machine at hand."""
     from scipy.linalg.blas import dger
 
     rng = np.random.default_rng(0)
@@ -57,8 +54,13 @@ def _match_blas_rounding() -> None:
     x, y = rng.standard_normal(67), rng.standard_normal(5)
     plain = A + np.outer(x, y)
     dger(1.0, x, y, 1, 1, A, 1, 1, 1)
-    _lemke_c.set_fma(not np.array_equal(A, plain))
-    _rounding_matched = True
+    return not np.array_equal(A, plain)
+
+
+def set_fma(flag: bool | None) -> bool:
+    """Round the C update with fused multiply-adds (only if the CPU has them); returns the
+    setting in force (None: only ask)."""
+    return _lemke_c.set_fma(flag)
 
 
 def pivot_loop(T: np.ndarray, basic: np.ndarray, nonbasic: np.ndarray, row_of: np.ndarray,
@@ -66,8 +68,6 @@ def pivot_loop(T: np.ndarray, basic: np.ndarray, nonbasic: np.ndarray, row_of: n
                trace: np.ndarray | None = None) -> tuple[int, int, int, int]:
     """Run the pivots (compiled); `trace` (int64, length 2 k) receives (row, slot) of the first
     k pivots."""
-    if not _rounding_matched:
-        _match_blas_rounding()
     return _lemke_c.run(T, basic, nonbasic, row_of, slot_of, float(tol), int(max_iter), trace)
 
 
@@ -92,6 +92,4 @@ def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_i
     """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
     z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
     leaves a z; the others are to be solved again one by one for their evidence."""
-    if not _rounding_matched:
-        _match_blas_rounding()
     _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots)

@@ -65,14 +65,27 @@ def register(name: str, *, accepts: str, description: str, max_n: int | None = N
     return deco
 
 
+#: The built-in methods and the module that registers each (`get_method` imports only that one,
+#: so that e.g. lemke never loads the QP solvers).
+_BUILTIN = {"enumerate": "enumeration", "lemke": "lemke", "pgs": "pgs", "pivoting": "pivoting",
+            "qp-clarabel": "qp", "qp-osqp": "qp"}
+
+
 def methods() -> list[MethodInfo]:
-    """The registered methods, with what each accepts."""
+    """The registered methods, with what each accepts (built-in ones first, by name)."""
     _load_builtin_methods()
-    return list(_REGISTRY.values())
+    infos = list(_REGISTRY.values())
+    return sorted(infos, key=lambda m: (0, m.name) if m.name in _BUILTIN else (1, ""))
 
 
 def get_method(name: str) -> MethodInfo:
-    _load_builtin_methods()
+    if name not in _REGISTRY:
+        if name in _BUILTIN:
+            import importlib
+
+            importlib.import_module(f"{__package__}.{_BUILTIN[name]}")
+        else:
+            _load_builtin_methods()
     try:
         return _REGISTRY[name]
     except KeyError:

@@ -20,7 +20,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import _lemke_kernel as _kernel
+import rigidlcp.lcp._lemke_kernel as _kernel
+
 from .api import get_method, solve
 from .problem import LCP, MLCP, InvalidProblem
 from .solution import Solution

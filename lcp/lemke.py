@@ -23,9 +23,9 @@ docs/lemke.md.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.blas import dger
 
-from . import _lemke_kernel as _kernel
+import rigidlcp.lcp._lemke_kernel as _kernel
+
 from .api import register
 from .problem import InvalidProblem, as_matrix, as_vector
 from .solution import Solution
@@ -168,6 +168,9 @@ class _Lemke:
     def chunks(self) -> list[tuple[np.ndarray, np.ndarray]]:
         """Column blocks of T (and of the pivot row buffer) for `dger` (numpy loop only)."""
         if not hasattr(self, "_chunks"):
+            from scipy.linalg.blas import dger  # here: the compiled loop needs no scipy.linalg
+
+            self.dger = dger
             n, T = self.n, self.T
             self.row = np.empty(n + 2)  # the pivot row buffer
             step = max(1, _GER_CHUNK // n)
@@ -195,6 +198,7 @@ class _Lemke:
         T[r, :] = 0.0
         colview.fill(0.0)
         col[r] = 1.0
+        dger = self.dger
         for rv, tv in chunks:
             dger(1.0, col, rv, 1, 1, tv, 1, 1, 1)  # tv += col rv^T, in place
         entering = self.nonbasic[s]

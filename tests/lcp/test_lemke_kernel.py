@@ -89,6 +89,16 @@ def test_same_pivot_limit():
     assert sol.status == "max_iter" and sol.iterations == 50
 
 
+def test_update_rounds_like_the_blas_of_the_numpy_loop():
+    """The C update uses a fused multiply-add exactly when scipy's dger does (probed)."""
+    from rigidlcp.lcp import _lemke_c
+
+    assert _lemke_c.set_fma(None) == kernel.blas_uses_fma()
+    A = np.asfortranarray(np.random.default_rng(1).standard_normal((9, 9)))
+    M, q = A @ A.T, -np.ones(9)
+    assert_same(M, q)
+
+
 def test_real_event_cycles_in_both_loops():
     """The event of test_lemke.py whose basis repeats at tol = 1e-10 after 766 pivots: the
     compiled loop finds the same repeat (its rounding matches the BLAS of the numpy loop)."""
