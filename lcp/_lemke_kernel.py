@@ -93,3 +93,18 @@ def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_i
     z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
     leaves a z; the others are to be solved again one by one for their evidence."""
     _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots)
+
+
+def solve_one(M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float, max_iter: int):
+    """One LCP by the compiled loop, start to end: (z, basis, pivots) when it is solved, None
+    otherwise (the caller reruns `_Lemke` for the evidence of a ray, a limit or a cycle).
+    M, q: C-contiguous float64 and finite (see `plain_finite`); q not >= 0."""
+    n = q.size
+    Z = np.empty((1, n))
+    basic = np.empty((1, n), dtype=np.int8)
+    codes = np.empty(1, dtype=np.int64)
+    pivots = np.empty(1, dtype=np.int64)
+    _lemke_c.solve_batch(M, q, d, float(tol), int(max_iter), Z, basic, codes, pivots)
+    if codes[0] != SOLVED:
+        return None
+    return Z[0], basic[0].nonzero()[0], int(pivots[0])

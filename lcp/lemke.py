@@ -88,7 +88,13 @@ def lemke(
             z=np.zeros(n), w=q.copy(), status="solved", method="lemke", iterations=0,
             basis=np.zeros(0, dtype=int), message="q >= 0: z = 0 solves the LCP",
         )
-    sol = _Lemke(M, q, d, tol).run(max_iter)
+    if plain and _kernel.enabled():  # the whole run in C (same pivots, same z)
+        fast = _kernel.solve_one(M, q, np.ascontiguousarray(d), tol, max_iter)
+        if fast is not None:
+            z, basis, pivots = fast
+            return Solution(z=z, w=M @ z + q, status="solved", method="lemke",
+                            iterations=pivots, basis=basis)
+    sol = _Lemke(M, q, d, tol).run(max_iter)  # also reruns what the fast path did not solve
     # Rounding can defeat the lexicographic rule on near-ties (tol too fine for the data):
     # then restart with ties decided more coarsely, and say so.
     retry = tol
