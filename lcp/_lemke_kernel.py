@@ -63,6 +63,30 @@ def set_fma(flag: bool | None) -> bool:
     return _lemke_c.set_fma(flag)
 
 
+def run(lemke_run, max_iter: int):
+    """`_Lemke.run` in C: the pivots on `lemke_run`'s dictionary, then its outcome (solution,
+    ray, pivot limit, cycling) built by its own methods. Its bookkeeping becomes int64 arrays,
+    updated in place (the outcome methods read them as they read the lists)."""
+    L = lemke_run
+    n = L.n
+    L.row_of, L.nonbasic = np.array(L.row_of), np.arange(n, 2 * n + 1)
+    L.basic, L.slot_of = L.basic_np, L.slot_np
+    trace = None if L.trace is None else np.full(2 * (max_iter + 1), -1, dtype=np.int64)
+    code, pivots, s, entering = pivot_loop(L.T, L.basic_np, L.nonbasic, L.row_of, L.slot_np,
+                                           L.tol, max_iter, trace)
+    if trace is not None:
+        L.trace.extend(map(tuple, trace[: 2 * pivots].reshape(-1, 2).tolist()))
+    if code == SOLVED:
+        return L.solution(pivots)
+    if code == RAY:
+        return L.ray(pivots, s, entering)
+    sol = L.stopped(pivots)
+    if code == CYCLING:
+        sol.message = f"numerical cycling: a basis repeated after {pivots} pivots"
+        sol.info["cycling"] = True
+    return sol
+
+
 def pivot_loop(T: np.ndarray, basic: np.ndarray, nonbasic: np.ndarray, row_of: np.ndarray,
                slot_of: np.ndarray, tol: float, max_iter: int,
                trace: np.ndarray | None = None) -> tuple[int, int, int, int]:

@@ -278,7 +278,7 @@ class _Lemke:
     # -- the run --------------------------------------------------------------------------
     def run(self, max_iter: int) -> Solution:
         if _kernel.enabled():
-            return self.run_compiled(max_iter)
+            return _kernel.run(self, max_iter)  # the same loop in C
         n, tol, T, slot_of = self.n, self.tol, self.T, self.slot_of
         beta = T[:, n + 1]
         z0 = 2 * n
@@ -332,28 +332,6 @@ class _Lemke:
                 r = int(rows[k])
             else:
                 r = self.choose(rows, alpha, theta, amax)
-
-    def run_compiled(self, max_iter: int) -> Solution:
-        """The same loop as `run`, in C (lcp/_lemke_kernel.py): same rules, same pivots."""
-        n = self.n
-        # The bookkeeping as int64 arrays, updated in place by the kernel (read by the outcomes).
-        self.row_of, self.nonbasic = np.array(self.row_of), np.arange(n, 2 * n + 1)
-        self.basic, self.slot_of = self.basic_np, self.slot_np
-        trace = None if self.trace is None else np.full(2 * (max_iter + 1), -1, dtype=np.int64)
-        code, pivots, s, entering = _kernel.pivot_loop(
-            self.T, self.basic_np, self.nonbasic, self.row_of, self.slot_np, self.tol, max_iter,
-            trace)
-        if trace is not None:
-            self.trace.extend(map(tuple, trace[: 2 * pivots].reshape(-1, 2).tolist()))
-        if code == _kernel.SOLVED:
-            return self.solution(pivots)
-        if code == _kernel.RAY:
-            return self.ray(pivots, s, entering)
-        sol = self.stopped(pivots)
-        if code == _kernel.CYCLING:
-            sol.message = f"numerical cycling: a basis repeated after {pivots} pivots"
-            sol.info["cycling"] = True
-        return sol
 
     # -- outcomes -------------------------------------------------------------------------
     def point(self) -> tuple[np.ndarray, np.ndarray, float]:
