@@ -2,7 +2,6 @@
 
 from .api import MethodInfo, get_method, methods, register, solve
 from .batch import solve_many
-from .friction import FrictionContact2D, natural_residual
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable, load
 from .solution import STATUSES, Solution, complementarity_residual
 
@@ -14,8 +13,13 @@ __all__ = [
 
 
 def __getattr__(name: str):
+    # Loaded on first use: enumeration needs scipy.optimize, friction scipy.sparse.
     if name == "enumerate_solutions":
         from .enumeration import enumerate_solutions
 
         return enumerate_solutions
+    if name in ("FrictionContact2D", "natural_residual"):
+        from . import friction
+
+        return getattr(friction, name)
     raise AttributeError(f"module 'lcp' has no attribute {name!r}")

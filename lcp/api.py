@@ -67,15 +67,19 @@ def register(name: str, *, accepts: str, description: str, max_n: int | None = N
 
 #: The built-in methods and the module that registers each (`get_method` imports only that one,
 #: so that e.g. lemke never loads the QP solvers).
-_BUILTIN = {"enumerate": "enumeration", "lemke": "lemke", "pgs": "pgs", "pivoting": "pivoting",
-            "qp-clarabel": "qp", "qp-osqp": "qp"}
+#: In the order lcp/methods.py registers them (the order `methods()` lists them in).
+_BUILTIN = {"enumerate": "enumeration", "lemke": "lemke", "enumerate-mlcp": "mlcp_full",
+            "newton-min": "newton", "newton-fb": "newton", "nsgs": "nsgs", "pgs": "pgs",
+            "pivoting": "pivoting", "qp-clarabel": "qp", "qp-osqp": "qp", "states": "states"}
 
 
 def methods() -> list[MethodInfo]:
-    """The registered methods, with what each accepts (built-in ones first, by name)."""
+    """The registered methods, with what each accepts (built-in ones first, in a fixed order,
+    whichever were loaded first by `get_method`)."""
     _load_builtin_methods()
+    order = {name: i for i, name in enumerate(_BUILTIN)}
     infos = list(_REGISTRY.values())
-    return sorted(infos, key=lambda m: (0, m.name) if m.name in _BUILTIN else (1, ""))
+    return sorted(infos, key=lambda m: order.get(m.name, len(order)))
 
 
 def get_method(name: str) -> MethodInfo:

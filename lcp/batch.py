@@ -34,9 +34,10 @@ def solve_many(
 ) -> list[Solution]:
     """Solve a list of LCPs (w = M z + q, 0 <= z perp w >= 0) by one method.
 
-    problems: a sequence of `lcp.LCP` / `lcp.MLCP`, or a pair (Ms, qs) of stacked arrays of
-    shapes (k, n, n) and (k, n). options: the method's options, the same for every problem.
-    Returns one Solution per problem, in order, each as `lcp.solve` would return it.
+    problems: a sequence of `lcp.LCP` (stacked by size: the fast path), `lcp.MLCP` or
+    `lcp.FrictionContact2D` (solved one by one by `lcp.solve`), or a pair (Ms, qs) of stacked
+    arrays of shapes (k, n, n) and (k, n). options: the method's options, the same for every
+    problem. Returns one Solution per problem, in order, each as `lcp.solve` would return it.
     """
     info = get_method(method)
     unknown = set(options) - set(info.options)
@@ -49,15 +50,17 @@ def solve_many(
             problems[0], (LCP, MLCP)):
         Ms, qs = _stacked(*problems)
         return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]))
+    from .friction import FrictionContact2D
+
     problems = list(problems)
     for i, p in enumerate(problems):
-        if not isinstance(p, (LCP, MLCP)):
-            raise InvalidProblem(f"problems[{i}] must be an lcp.LCP or lcp.MLCP, "
-                                 f"got {type(p).__name__}")
+        if not isinstance(p, (LCP, MLCP, FrictionContact2D)):
+            raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
+                                 f"lcp.FrictionContact2D, got {type(p).__name__}")
     out: list[Solution | None] = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
-        if isinstance(p, MLCP):  # the Schur reduction and u are per problem: one by one
+        if not isinstance(p, LCP):  # MLCP (u, reductions) or friction problem: one by one
             out[i] = solve(p, method, **options)
         else:
             groups.setdefault(p.n, []).append(i)

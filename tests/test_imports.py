@@ -38,3 +38,13 @@ def test_cli_parser_loads_no_scipy():
                         "importlib.import_module('rigidlcp.cli.main').build_parser()")
     assert not {m for m in mods if m.startswith("scipy")}
     assert "rigidlcp.models.engine.dense" not in mods
+
+
+def test_the_lazy_method_table_lists_every_builtin_method_in_order():
+    """lcp.api._BUILTIN (which module registers which method) must follow lcp/methods.py."""
+    out = subprocess.run(
+        [sys.executable, "-c", "import importlib\nfrom rigidlcp.lcp import api\n"
+         "importlib.import_module('rigidlcp.lcp.methods')\n"
+         "print(list(api._REGISTRY) == list(api._BUILTIN))"],
+        capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"
