@@ -104,13 +104,15 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
-    from .friction import FrictionContact2D
+    friction = not isinstance(problem, (LCP, MLCP))
+    if friction:  # imported only then: lcp.friction loads scipy.sparse
+        from .friction import FrictionContact2D
 
-    if not isinstance(problem, (LCP, MLCP, FrictionContact2D)):
-        raise InvalidProblem(
-            f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
-            f"{type(problem).__name__}"
-        )
+        if not isinstance(problem, FrictionContact2D):
+            raise InvalidProblem(
+                f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
+                f"{type(problem).__name__}"
+            )
     info = get_method(method)
     unknown = set(options) - set(info.options)
     if unknown:
@@ -118,7 +120,7 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
             f"method {method!r} does not accept option(s) {sorted(unknown)}; "
             f"it accepts {list(info.options) or 'none'}"
         )
-    if isinstance(problem, FrictionContact2D):
+    if friction:
         from .friction import solve_friction
 
         return solve_friction(problem, info, dict(options))

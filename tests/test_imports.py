@@ -26,7 +26,9 @@ def test_lemke_solve_loads_only_lemke():
                         "lcp.solve(lcp.LCP(np.eye(2), -np.ones(2)), 'lemke')")
     assert "rigidlcp.lcp.lemke" in mods
     assert not {m for m in mods if m.startswith(HEAVY)}
-    assert not {"rigidlcp.lcp.qp", "rigidlcp.lcp.pgs", "rigidlcp.lcp.enumeration"} & mods
+    assert not {"rigidlcp.lcp.qp", "rigidlcp.lcp.pgs", "rigidlcp.lcp.enumeration",
+                "rigidlcp.lcp.friction"} & mods
+    assert "scipy.sparse" not in mods
     from rigidlcp.lcp import _lemke_kernel
 
     if _lemke_kernel.enabled():  # the compiled loop needs no scipy.linalg (dger)
