@@ -4,7 +4,8 @@ on LCPs passed as .npy files.
 
 Protocol (one JSON object per line): the helper first prints {"ready": true, "numpy": ...} or
 {"ready": false, "error": ...}; then for every request {"M": path, "q": path, "max_iter": k} it
-solves once and prints {"time": wall seconds of the solve call only, "cpu": its CPU seconds
+solves once (or "inner" times in a row, reporting the mean) and prints {"time": wall seconds
+of the solve call only, "cpu": its CPU seconds
 (process time), "iterations": Siconos's pivot
 count, "info": return code, "residual": max|min(z, M z + q)|}. End of input ends it.
 
@@ -30,6 +31,9 @@ def main() -> int:
         if not line.strip():
             continue
         req = json.loads(line)
+        if "Ms" in req:
+            print(json.dumps(_batch(np, sn, req)), flush=True)
+            continue
         M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
         q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
         n = q.size
@@ -37,9 +41,12 @@ def main() -> int:
         options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
         options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(req.get("max_iter", 10000))
         z, w = np.zeros(n), np.zeros(n)
+        inner = int(req.get("inner", 1))  # consecutive calls timed together (warm caches)
         c0, t0 = time.process_time(), time.perf_counter()
-        info = sn.lcp_lexicolemke(problem, z, w, options)
-        elapsed, cpu = time.perf_counter() - t0, time.process_time() - c0
+        for _ in range(inner):
+            info = sn.lcp_lexicolemke(problem, z, w, options)
+        elapsed = (time.perf_counter() - t0) / inner
+        cpu = (time.process_time() - c0) / inner
         residual = float(np.max(np.abs(np.minimum(z, M @ z + q))))
         out = {
             "time": elapsed,
@@ -50,6 +57,32 @@ def main() -> int:
         }
         print(json.dumps(out), flush=True)
     return 0
+
+
+def _batch(np, sn, req: dict) -> dict:
+    """A loop of lcp_lexicolemke over stacked problems {"Ms": path (k, n, n), "qs": path}:
+    "loop" = wall seconds of the whole loop (problem objects, options, solve), "calls" = the sum
+    of the solver calls only; the pivots and the worst residual."""
+    Ms, qs = np.load(req["Ms"]), np.load(req["qs"])
+    k, n = qs.shape
+    Ms = [np.ascontiguousarray(Ms[i]) for i in range(k)]
+    qs = [np.ascontiguousarray(qs[i]) for i in range(k)]
+    Z, W = np.zeros((k, n)), np.zeros((k, n))
+    infos, pivots, calls = [], [], 0.0
+    max_iter = int(req.get("max_iter", 10000))
+    t0 = time.perf_counter()
+    for i in range(k):
+        problem = sn.LCP(Ms[i], qs[i])
+        options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+        options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+        c0 = time.perf_counter()
+        infos.append(sn.lcp_lexicolemke(problem, Z[i], W[i], options))
+        calls += time.perf_counter() - c0
+        pivots.append(int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
+    loop = time.perf_counter() - t0
+    res = max(float(np.max(np.abs(np.minimum(Z[i], Ms[i] @ Z[i] + qs[i])))) for i in range(k))
+    return {"loop": loop, "calls": calls, "pivots": pivots,
+            "failures": sum(1 for x in infos if x), "residual": res}
 
 
 if __name__ == "__main__":

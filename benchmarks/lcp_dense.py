@@ -14,6 +14,7 @@ timed), interleaved run by run with rigidlcp's `lemke` so that both see the same
 and a second table gives the time ratio rigidlcp/Siconos and both pivot counts.
 
     python benchmarks/lcp_dense.py [--sizes 10,50,100,200,500,1000] [--repeats 5] [--seed 0]
+                                   [--methods lemke,...] [--inner 1|N|auto]
 """
 
 from __future__ import annotations
@@ -70,9 +71,9 @@ class Siconos:
     def available(self) -> bool:
         return self.proc is not None
 
-    def solve(self, M_path: Path, q_path: Path, max_iter: int) -> dict:
+    def solve(self, M_path: Path, q_path: Path, max_iter: int, inner: int = 1) -> dict:
         assert self.proc is not None
-        req = {"M": str(M_path), "q": str(q_path), "max_iter": max_iter}
+        req = {"M": str(M_path), "q": str(q_path), "max_iter": max_iter, "inner": inner}
         self.proc.stdin.write(json.dumps(req) + "\n")
         self.proc.stdin.flush()
         return json.loads(self.proc.stdout.readline())
@@ -92,21 +93,31 @@ def _debian_version(package: str) -> str:
     return out.stdout.strip() or "?"
 
 
-def _time_solve(problem: lcp.LCP, method: str) -> tuple[float, float, lcp.Solution]:
-    """Wall and CPU (process) seconds of one lcp.solve call."""
+def _time_solve(problem: lcp.LCP, method: str, inner: int = 1
+                ) -> tuple[float, float, lcp.Solution]:
+    """Wall and CPU (process) seconds of one lcp.solve call (the mean of `inner` calls in a
+    row: warm caches, as in a loop over problems)."""
     c0, t0 = time.process_time(), time.perf_counter()
-    sol = lcp.solve(problem, method=method)
-    return time.perf_counter() - t0, time.process_time() - c0, sol
+    for _ in range(inner):
+        sol = lcp.solve(problem, method=method)
+    return (time.perf_counter() - t0) / inner, (time.process_time() - c0) / inner, sol
+
+
+def inner_calls(n: int, inner: str) -> int:
+    """Calls per timed sample: --inner N, or "auto": about 20000 / n^2 (200 at n = 10, 1 from
+    n = 142 on), so that a sample is not one cold call of a few microseconds."""
+    return max(1, round(20000 / n**2)) if inner == "auto" else int(inner)
 
 
 def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[str] | None,
-        use_siconos: bool) -> None:
+        use_siconos: bool, inner: str = "1") -> None:
     infos = [m for m in lcp.methods() if methods is None or m.name in methods]
     siconos = Siconos() if use_siconos else None
     print("Dense LCP benchmark: M = A A^T + 0.1 I, q ~ N(0, 1), A standard normal, "
           f"seed ({seed}, n); median of {repeats} runs of lcp.solve")
     print(f"python {platform.python_version()}, numpy {np.__version__}, {os.cpu_count()} CPUs, "
-          f"load average at start {os.getloadavg()[0]:.2f}")
+          f"load average at start {os.getloadavg()[0]:.2f}; lemke timed as the mean of --inner "
+          f"{inner} calls in a row (Siconos likewise)")
     print()
     header = (f"{'n':>5}  {'method':<12} {'status':<13} {'iters':>7} {'median [ms]':>12} "
               f"{'residual':>9}")
@@ -148,12 +159,13 @@ def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[
                     too_slow[name] = n
                 else:
                     times = []
+                    k = inner_calls(n, inner) if name == "lemke" else 1
                     for _ in range(repeats):
-                        t, c, sol = _time_solve(problem, name)
+                        t, c, sol = _time_solve(problem, name, k)
                         times.append(t)
                         cpus.append(c)
                         if name == "lemke" and siconos is not None and siconos.available:
-                            sic.append(siconos.solve(M_path, q_path, 1000 + 100 * n))
+                            sic.append(siconos.solve(M_path, q_path, 1000 + 100 * n, k))
                 note = "  (1 run: over budget)" if len(times) == 1 and repeats > 1 else ""
                 print(f"{n:>5}  {name:<12} {sol.status:<13} {sol.iterations:>7} "
                       f"{1e3 * np.median(times):>12.3f} {sol.residual:>9.1e}{note}")
@@ -209,12 +221,15 @@ def main(argv: list[str] | None = None) -> int:
                         help="seconds per solve above which a method is not run at larger n")
     parser.add_argument("--methods", default=None, help="comma-separated subset of methods")
     parser.add_argument("--no-siconos", action="store_true", help="do not run Siconos")
+    parser.add_argument("--inner", default="1",
+                        help="lemke (and Siconos) calls per timed sample, their mean reported: "
+                        "an integer or 'auto' (about 20000 / n^2); default 1")
     args = parser.parse_args(argv)
     sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
     if not sizes or min(sizes) < 1 or args.repeats < 1:
         parser.error("--sizes must be positive integers and --repeats >= 1")
     methods = args.methods.split(",") if args.methods else None
-    run(sizes, args.repeats, args.seed, args.budget, methods, not args.no_siconos)
+    run(sizes, args.repeats, args.seed, args.budget, methods, not args.no_siconos, args.inner)
     return 0
 
 

@@ -65,14 +65,31 @@ def register(name: str, *, accepts: str, description: str, max_n: int | None = N
     return deco
 
 
+#: The built-in methods and the module that registers each (`get_method` imports only that one,
+#: so that e.g. lemke never loads the QP solvers).
+#: In the order lcp/methods.py registers them (the order `methods()` lists them in).
+_BUILTIN = {"enumerate": "enumeration", "lemke": "lemke", "enumerate-mlcp": "mlcp_full",
+            "newton-min": "newton", "newton-fb": "newton", "nsgs": "nsgs", "pgs": "pgs",
+            "pivoting": "pivoting", "qp-clarabel": "qp", "qp-osqp": "qp", "states": "states"}
+
+
 def methods() -> list[MethodInfo]:
-    """The registered methods, with what each accepts."""
+    """The registered methods, with what each accepts (built-in ones first, in a fixed order,
+    whichever were loaded first by `get_method`)."""
     _load_builtin_methods()
-    return list(_REGISTRY.values())
+    order = {name: i for i, name in enumerate(_BUILTIN)}
+    infos = list(_REGISTRY.values())
+    return sorted(infos, key=lambda m: order.get(m.name, len(order)))
 
 
 def get_method(name: str) -> MethodInfo:
-    _load_builtin_methods()
+    if name not in _REGISTRY:
+        if name in _BUILTIN:
+            import importlib
+
+            importlib.import_module(f"{__package__}.{_BUILTIN[name]}")
+        else:
+            _load_builtin_methods()
     try:
         return _REGISTRY[name]
     except KeyError:
@@ -87,13 +104,15 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
-    from .friction import FrictionContact2D
+    friction = not isinstance(problem, (LCP, MLCP))
+    if friction:  # imported only then: lcp.friction loads scipy.sparse
+        from .friction import FrictionContact2D
 
-    if not isinstance(problem, (LCP, MLCP, FrictionContact2D)):
-        raise InvalidProblem(
-            f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
-            f"{type(problem).__name__}"
-        )
+        if not isinstance(problem, FrictionContact2D):
+            raise InvalidProblem(
+                f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
+                f"{type(problem).__name__}"
+            )
     info = get_method(method)
     unknown = set(options) - set(info.options)
     if unknown:
@@ -101,7 +120,7 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
             f"method {method!r} does not accept option(s) {sorted(unknown)}; "
             f"it accepts {list(info.options) or 'none'}"
         )
-    if isinstance(problem, FrictionContact2D):
+    if friction:
         from .friction import solve_friction
 
         return solve_friction(problem, info, dict(options))
@@ -135,14 +154,21 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
     return sol
 
 
+_LOADED = False
+
+
 def _load_builtin_methods() -> None:
     # Importing the method modules registers them (done lazily to keep import cheap).
     # `from . import methods` would find the *function* lcp.methods and import nothing, and
     # importing the submodule rebinds the package attribute `methods` to it: undo that.
+    global _LOADED
+    if _LOADED:
+        return
     import importlib
     import sys
 
     importlib.import_module(f"{__package__}.methods")
+    _LOADED = True
     package = sys.modules[__package__]
     if getattr(package, "methods", None) is not methods:
         package.methods = methods

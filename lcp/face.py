@@ -114,6 +114,54 @@ def face_minimum_norm(
     return FaceResult(z0, face.nullity, 0.0, f"failed: inaccurate face point ({status})")
 
 
+@dataclass
+class PointCheck:
+    point: bool  # proved: the face is {z}, so face_minimum_norm would return z unchanged
+    isolated: bool  # proved too: z is an isolated solution of the LCP (strict complementarity)
+    A: np.ndarray  # the face's support (as face_minimum_norm takes it)
+    sigma_min: float  # least singular value of M_AA (inf when A is empty)
+    threshold: float  # what sigma_min had to exceed
+
+
+def face_is_point(problem: LCP, z: np.ndarray, *, z_side: np.ndarray | None = None,
+                  tol: float | None = None, margin: float = 10.0) -> PointCheck:
+    """A cheap proof that the face of z is the single point z, i.e. that `face_minimum_norm`
+    (same z, z_side, tol) has nothing to select: it would return z itself (status "unique").
+
+    Proof. Take A as face_minimum_norm does: {i : w_i <= tol} with z_side, the indices
+    {i : w_i <= tol and (z_i > tol or z_side_i)}. Every y of the face satisfies y_Ac = 0 and
+    (M y + q)_A = 0, i.e. M_AA y_A = -q_A. If M_AA is nonsingular, y_A = -M_AA^-1 q_A: the face
+    holds at most one point, and z (to tol) is in it, so F(z) = {z}. face_minimum_norm then finds
+    no lower c'y on F(z) (its walk stops at once) and its `_Face` has nullity 0: it returns z.
+    Nonsingular is decided as `_Face` decides rank -- the singular values of M_AA against
+    rank_tol = 1e3 max(|A|) eps max(sigma_max, 1) -- with a margin: sigma_min > margin x
+    rank_tol (default 10), so that rounding in the two SVDs cannot make them disagree (the
+    singular values are computed to about eps sigma_max, far below rank_tol). Near the
+    threshold the answer is "not proved" and the caller runs the selection as before.
+
+    If moreover no pair is degenerate (z_i > tol or w_i > tol for every i: strict
+    complementarity), every solution near z has z's pattern, hence lies in F(z) = {z}: z is an
+    isolated solution, and so are the quantities linear in z (an event's accelerations and
+    forces) -- `isolated`. Without it, other solutions may branch off at the degenerate pairs
+    (another face); the face selection does not look there either, so `point` suffices for it.
+    """
+    M, q = problem.M, problem.q
+    z = np.asarray(z, dtype=float)
+    w = M @ z + q
+    scale = max(np.abs(q).max(initial=0.0), np.abs(z).max(initial=0.0), 1e-300)
+    tol = 1e-9 * scale if tol is None else tol
+    zero_w = w <= tol
+    in_A = zero_w if z_side is None else zero_w & ((z > tol) | np.asarray(z_side, bool))
+    A = np.flatnonzero(in_A)
+    strict = not np.any(zero_w & (z <= tol))
+    if A.size == 0:
+        return PointCheck(True, strict, A, np.inf, 0.0)
+    sig = np.linalg.svd(M[np.ix_(A, A)], compute_uv=False)
+    rank_tol = A.size * np.finfo(float).eps * max(float(sig.max(initial=0.0)), 1.0) * 1e3
+    point = bool(sig.min() > margin * rank_tol)
+    return PointCheck(point, point and strict, A, float(sig.min()), margin * rank_tol)
+
+
 def _residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
 

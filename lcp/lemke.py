@@ -23,7 +23,8 @@ docs/lemke.md.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg.blas import dger
+
+import rigidlcp.lcp._lemke_kernel as _kernel
 
 from .api import register
 from .problem import InvalidProblem, as_matrix, as_vector
@@ -71,20 +72,29 @@ def lemke(
     the case, by Lemke's theorem, when M is copositive-plus, tested as M + M^T PSD) or
     ``max_iter``.
     """
-    M = as_matrix("M", M, (None, None))
-    if M.shape[0] != M.shape[1]:
-        raise InvalidProblem(f"M must be square, got shape {M.shape}")
+    plain, qmin = _kernel.plain_finite(M, q)  # valid as they are (e.g. from an LCP)?
+    if not plain:
+        M = as_matrix("M", M, (None, None))
+        if M.shape[0] != M.shape[1]:
+            raise InvalidProblem(f"M must be square, got shape {M.shape}")
+        q = as_vector("q", q, M.shape[0])
+        qmin = float(q.min())
     n = M.shape[0]
-    q = as_vector("q", q, n)
     d = _covering_vector(d, n)
     max_iter = _check_max_iter(max_iter, n)
     tol = _check_tol(tol)
-    if np.all(q >= 0):
+    if qmin >= 0:
         return Solution(
             z=np.zeros(n), w=q.copy(), status="solved", method="lemke", iterations=0,
             basis=np.zeros(0, dtype=int), message="q >= 0: z = 0 solves the LCP",
         )
-    sol = _Lemke(M, q, d, tol).run(max_iter)
+    if plain and _kernel.enabled():  # the whole run in C (same pivots, same z)
+        fast = _kernel.solve_one(M, q, np.ascontiguousarray(d), tol, max_iter)
+        if fast is not None:
+            z, basis, pivots = fast
+            return Solution(z=z, w=M @ z + q, status="solved", method="lemke",
+                            iterations=pivots, basis=basis)
+    sol = _Lemke(M, q, d, tol).run(max_iter)  # also reruns what the fast path did not solve
     # Rounding can defeat the lexicographic rule on near-ties (tol too fine for the data):
     # then restart with ties decided more coarsely, and say so.
     retry = tol
@@ -140,18 +150,18 @@ class _Lemke:
     def __init__(self, M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float):
         n = q.size
         self.n, self.M, self.q, self.d, self.tol = n, M, q, d, tol
-        self.mu = float(np.abs(M).max()) or 1.0
-        self.nu = float(np.abs(q).max())
-        self.delta = float(d.max())
         T = np.empty((n, n + 2), order="F")
-        np.divide(M, self.mu, out=T[:, :n])
-        np.divide(d, self.delta, out=T[:, n])
-        np.divide(q, self.nu, out=T[:, n + 1])
+        if _kernel.enabled():
+            self.mu, self.nu, self.delta = _kernel.setup(T, M, q, d)
+        else:
+            self.mu = float(np.abs(M).max()) or 1.0
+            self.nu = float(np.abs(q).max())
+            self.delta = float(d.max())
+            np.divide(M, self.mu, out=T[:, :n])
+            np.divide(d, self.delta, out=T[:, n])
+            np.divide(q, self.nu, out=T[:, n + 1])
         self.T = T
-        self.row = np.empty(n + 2)  # the pivot row buffer
-        step = max(1, _GER_CHUNK // n)
-        assert T.flags.f_contiguous  # dger updates the column chunks in place
-        self.chunks = [(self.row[j:j + step], T[:, j:j + step]) for j in range(0, n + 2, step)]
+        self.trace: list[tuple[int, int]] | None = None  # (row, slot) of each pivot, if a list
         # Bookkeeping as Python lists (scalar access is several times faster than numpy's).
         self.basic = list(range(n))  # row -> variable
         self.nonbasic = list(range(n, 2 * n + 1))  # slot -> variable
@@ -160,6 +170,21 @@ class _Lemke:
         self.basic_np, self.slot_np = np.array(self.basic), np.array(self.slot_of)  # mirrors
 
     # -- the pivot -------------------------------------------------------------------------
+    @property
+    def chunks(self) -> list[tuple[np.ndarray, np.ndarray]]:
+        """Column blocks of T (and of the pivot row buffer) for `dger` (numpy loop only)."""
+        if not hasattr(self, "_chunks"):
+            from scipy.linalg.blas import dger  # here: the compiled loop needs no scipy.linalg
+
+            self.dger = dger
+            n, T = self.n, self.T
+            self.row = np.empty(n + 2)  # the pivot row buffer
+            step = max(1, _GER_CHUNK // n)
+            assert T.flags.f_contiguous  # dger updates the column chunks in place
+            self._chunks = [(self.row[j:j + step], T[:, j:j + step])
+                            for j in range(0, n + 2, step)]
+        return self._chunks
+
     def pivot(self, r: int, s: int) -> int:
         """Exchange basic row r with nonbasic slot s; return the variable that left.
 
@@ -167,7 +192,9 @@ class _Lemke:
         row i gets T[i, c] + T[i, s] * newrow[c] (c != s) and T[i, s] / p in slot s: one
         rank-one update after zeroing row r and column s (with the column's entry at r = 1).
         """
-        T = self.T
+        T, chunks = self.T, self.chunks
+        if self.trace is not None:
+            self.trace.append((r, s))
         colview = T[:, s]
         col = colview.copy()
         p = col[r]
@@ -177,7 +204,8 @@ class _Lemke:
         T[r, :] = 0.0
         colview.fill(0.0)
         col[r] = 1.0
-        for rv, tv in self.chunks:
+        dger = self.dger
+        for rv, tv in chunks:
             dger(1.0, col, rv, 1, 1, tv, 1, 1, 1)  # tv += col rv^T, in place
         entering = self.nonbasic[s]
         leaving = self.basic[r]
@@ -249,6 +277,8 @@ class _Lemke:
 
     # -- the run --------------------------------------------------------------------------
     def run(self, max_iter: int) -> Solution:
+        if _kernel.enabled():
+            return _kernel.run(self, max_iter)  # the same loop in C
         n, tol, T, slot_of = self.n, self.tol, self.T, self.slot_of
         beta = T[:, n + 1]
         z0 = 2 * n
@@ -306,15 +336,11 @@ class _Lemke:
     # -- outcomes -------------------------------------------------------------------------
     def point(self) -> tuple[np.ndarray, np.ndarray, float]:
         """Current (z, w, z0) in the original units."""
-        n, beta, basic = self.n, self.T[:, self.n + 1], self.basic_np
-        z, w = np.zeros(n), np.zeros(n)
-        zr = np.flatnonzero((basic >= n) & (basic < 2 * n))
-        wr = np.flatnonzero(basic < n)
-        z[basic[zr] - n] = beta[zr] * (self.nu / self.mu)
-        w[basic[wr]] = beta[wr] * self.nu
-        z0_row = self.row_of[2 * n]
-        z0 = float(beta[z0_row]) * self.nu / self.delta if z0_row >= 0 else 0.0
-        return z, w, z0
+        n = self.n
+        x = np.zeros(2 * n + 1)  # every variable: beta in its row if basic, else 0
+        x[self.basic_np] = self.T[:, n + 1]
+        z0 = float(x[2 * n]) * self.nu / self.delta
+        return x[n:2 * n] * (self.nu / self.mu), x[:n] * self.nu, z0
 
     def basis(self) -> np.ndarray:
         b = self.basic_np

@@ -1,32 +1,40 @@
 """Mechanics: lattices of rigid disks, contacts, the MLCP of an event, event-driven evolution.
 
 Dependencies point lcp <- models <- verify: this package imports `lcp`, never `verify`.
+The names below load on first use (PEP 562), so that a command loads only the modules it uses
+(e.g. `rigidlcp sweep --help` reads models.sweep's defaults without scipy.sparse).
 """
 
-from .dynamics import Dynamics
-from .engine import Run, simulate
-from .event import (
-    EventProblem,
-    EventSolution,
-    State,
-    contact_matrix,
-    event_problem,
-    initial_state,
-)
-from .lattice import (
-    LEFT_WALL,
-    PLANE,
-    RIGHT_WALL,
-    InvalidSystem,
-    Lattice,
-    make_lattice,
-    rectangular,
-    triangular,
-)
-from .system import System, make_system
+from __future__ import annotations
+
+import importlib
+
+#: Public name -> the submodule that defines it.
+_WHERE = {
+    "Dynamics": "dynamics",
+    "Run": "engine", "simulate": "engine",
+    "EventProblem": "event", "EventSolution": "event", "State": "event",
+    "contact_matrix": "event", "event_problem": "event", "initial_state": "event",
+    "LEFT_WALL": "lattice", "PLANE": "lattice", "RIGHT_WALL": "lattice",
+    "InvalidSystem": "lattice", "Lattice": "lattice", "make_lattice": "lattice",
+    "rectangular": "lattice", "triangular": "lattice",
+    "System": "system", "make_system": "system",
+}
 
 __all__ = [
     "Dynamics", "EventProblem", "EventSolution", "State", "contact_matrix", "event_problem",
     "initial_state", "Run", "simulate", "Lattice", "InvalidSystem", "rectangular",
     "triangular", "make_lattice", "System", "make_system", "LEFT_WALL", "RIGHT_WALL", "PLANE",
 ]
+
+
+def __getattr__(name: str):
+    if name in _WHERE:
+        value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -11,13 +11,12 @@ import os
 import tempfile
 from dataclasses import fields
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rigidlcp.models.engine.records import EventRecord, Run
-
-from .event import State
-from .system import make_system
+if TYPE_CHECKING:  # loaded by load_run only: models.sweep needs _json_default, not the engine
+    from rigidlcp.models.engine.records import Run
 
 FORMAT = "rigidlcp-run/1"
 _SCALARS = ("t", "V", "mu_g", "dissipation", "iterations", "residual", "n_lcp", "fallback")
@@ -76,6 +75,10 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
 
 def load_run(path: str | os.PathLike) -> Run:
     """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
+    from rigidlcp.models.engine.records import EventRecord, Run
+    from rigidlcp.models.event import State
+    from rigidlcp.models.system import make_system
+
     data_path, _ = run_paths(path)
     if not data_path.exists():
         raise FileNotFoundError(f"no run file at {data_path}")

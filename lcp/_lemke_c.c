@@ -1,0 +1,714 @@
+/* The pivot loop of Lemke's method (lcp/lemke.py) in C: the ratio test with the lexicographic
+ * tie-break and the rank-one update of the dictionary, exactly as `_Lemke.run` does them in
+ * numpy (same rules, same order of floating-point operations up to BLAS's choice of fused
+ * multiply-adds), so that both take the same pivots. Built by setuptools as an optional
+ * extension (setup.py); lcp/_lemke_kernel.py falls back to the numpy loop when it is missing.
+ *
+ * Layout (docs/lemke.md, "The dictionary"): T is the n x (n + 2) dictionary, column-major, slots
+ * 0..n hold the nonbasic columns and slot n + 1 holds beta. Variables: w_i = i, z_i = n + i,
+ * z0 = 2n. basic[row] -> variable, nonbasic[slot] -> variable, row_of[var] -> row or -1,
+ * slot_of[var] -> slot or -1 (int64 arrays, updated in place).
+ *
+ * run(T, basic, nonbasic, row_of, slot_of, tol, max_iter, trace) -> (code, pivots, s, entering)
+ *   code 0: z0 left (a solution); 1: a basis repeated (numerical cycling); 2: max_iter pivots;
+ *   3: secondary ray (slot s of the unblocked entering variable). trace: None or an int64
+ *   buffer of length 2 k; the (row, slot) of the first k pivots are written there.
+ *
+ * Only the buffer protocol is used (no numpy headers), so the build needs a C compiler only.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef Py_ssize_t idx;
+
+typedef struct {
+    idx n;
+    double *T;
+    int64_t *basic, *nonbasic, *row_of, *slot_of;
+    double tol;
+    /* scratch */
+    idx *rows, *cand, *wj, *pos;
+    double *alpha, *theta, *row, *col, *V;
+} Lemke;
+
+/* ------------------------------------------------------------------ basis hash (Zobrist) */
+typedef struct {
+    int64_t *slot;
+    size_t cap, count;
+} HashSet;
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+
+static int hs_init(HashSet *h, size_t cap)
+{
+    h->cap = cap;
+    h->count = 0;
+    h->slot = (int64_t *)malloc(cap * sizeof(int64_t));
+    if (!h->slot) return -1;
+    memset(h->slot, 0xFF, cap * sizeof(int64_t)); /* -1: empty (keys are >= 0) */
+    return 0;
+}
+
+/* 1 if key was present, 0 if inserted, -1 on allocation failure. */
+static int hs_add(HashSet *h, int64_t key)
+{
+    if (2 * (h->count + 1) > h->cap) {
+        HashSet g;
+        if (hs_init(&g, 2 * h->cap) < 0) return -1;
+        for (size_t i = 0; i < h->cap; i++)
+            if (h->slot[i] >= 0) hs_add(&g, h->slot[i]);
+        free(h->slot);
+        *h = g;
+    }
+    size_t mask = h->cap - 1, i = (size_t)((uint64_t)key * 0x9E3779B97F4A7C15ULL >> 7) & mask;
+    while (h->slot[i] >= 0) {
+        if (h->slot[i] == key) return 1;
+        i = (i + 1) & mask;
+    }
+    h->slot[i] = key;
+    h->count++;
+    return 0;
+}
+
+/* ------------------------------------------------------------------ the rank-one update */
+/* T[:, c] += col * row[c] for every c with row[c] != 0. OpenBLAS's optimized ?ger kernels
+ * (Haswell and later: chosen at run time on CPUs with AVX2 and FMA) compute each entry as one
+ * fused multiply-add; the numpy loop of lemke.py calls them. `use_fma` (on when the CPU has
+ * AVX2 and FMA, see fma_available; set_fma overrides it) picks the same rounding, so that
+ * both loops see the same numbers and take the same pivots (a test checks it against dger). */
+static int use_fma = -1; /* -1: not decided yet */
+
+static void update_plain(double *T, const double *col, const double *row, idx n, idx m)
+{
+    for (idx c = 0; c < m; c++) {
+        double rc = row[c];
+        if (rc == 0.0) continue; /* adds 0 * col: changes nothing but the sign of a zero */
+        double *Tc = T + n * c;
+        for (idx i = 0; i < n; i++) Tc[i] += col[i] * rc;
+    }
+}
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define HAVE_FMA_TARGET 1
+__attribute__((target("fma"))) static void update_fma(double *T, const double *col,
+                                                      const double *row, idx n, idx m)
+{
+    for (idx c = 0; c < m; c++) {
+        double rc = row[c];
+        if (rc == 0.0) continue;
+        double *Tc = T + n * c;
+        for (idx i = 0; i < n; i++) Tc[i] = __builtin_fma(col[i], rc, Tc[i]);
+    }
+}
+#elif defined(__FP_FAST_FMA) || defined(__aarch64__)
+#define HAVE_FMA_TARGET 1
+static void update_fma(double *T, const double *col, const double *row, idx n, idx m)
+{
+    for (idx c = 0; c < m; c++) {
+        double rc = row[c];
+        if (rc == 0.0) continue;
+        double *Tc = T + n * c;
+        for (idx i = 0; i < n; i++) Tc[i] = __builtin_fma(col[i], rc, Tc[i]);
+    }
+}
+#else
+#define HAVE_FMA_TARGET 0
+#endif
+
+static int fma_available(void)
+{
+#if HAVE_FMA_TARGET && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+    __builtin_cpu_init(); /* OpenBLAS's FMA kernels (Haswell, Zen, SkylakeX) need AVX2 too */
+    return __builtin_cpu_supports("fma") && __builtin_cpu_supports("avx2");
+#elif HAVE_FMA_TARGET
+    return 1;
+#else
+    return 0;
+#endif
+}
+
+/* ------------------------------------------------------------------ the pivot */
+static int64_t pivot(Lemke *L, idx r, idx s)
+{
+    const idx n = L->n, m = n + 2;
+    double *T = L->T, *row = L->row, *col = L->col;
+    double *Ts = T + n * s;
+    double p = Ts[r];
+    memcpy(col, Ts, n * sizeof(double));
+    double mult = -1.0 / p;
+    for (idx c = 0; c < m; c++) row[c] = T[r + n * c] * mult;
+    row[s] = 1.0 / p;
+    for (idx c = 0; c < m; c++) T[r + n * c] = 0.0;
+    memset(Ts, 0, n * sizeof(double));
+    col[r] = 1.0;
+#if HAVE_FMA_TARGET
+    if (use_fma < 0) use_fma = fma_available();
+    if (use_fma)
+        update_fma(T, col, row, n, m);
+    else
+#endif
+        update_plain(T, col, row, n, m);
+    int64_t entering = L->nonbasic[s], leaving = L->basic[r];
+    L->basic[r] = entering;
+    L->nonbasic[s] = leaving;
+    L->row_of[entering] = r;
+    L->slot_of[entering] = -1;
+    L->row_of[leaving] = -1;
+    L->slot_of[leaving] = s;
+    return leaving;
+}
+
+/* ------------------------------------------------------------------ lexicographic minimum */
+/* Row in rows[0..m) with the lexicographically smallest B^-1[i, :] / alpha_i (lemke.py's
+ * `_Lemke.lexico_min`, same sweep and tolerances). */
+static idx lexico_min(Lemke *L, const idx *rows, const double *alpha, idx m)
+{
+    const idx n = L->n;
+    const double *T = L->T;
+    idx nw = 0;
+    for (idx j = 0; j < n; j++)
+        if (L->slot_of[j] >= 0) L->wj[nw++] = j;
+    double *V = L->V; /* m x nw, column-major */
+    double vmax = 0.0, ainv = -1.0 / 0.0;
+    for (idx k = 0; k < nw; k++) {
+        const double *Tk = T + n * L->slot_of[L->wj[k]];
+        for (idx i = 0; i < m; i++) {
+            double v = -Tk[rows[i]] / alpha[i];
+            V[i + m * k] = v;
+            double av = v < 0 ? -v : v;
+            if (av > vmax) vmax = av;
+        }
+    }
+    for (idx i = 0; i < m; i++) {
+        double a = 1.0 / alpha[i];
+        if (a > ainv) ainv = a;
+        int64_t b = L->basic[rows[i]];
+        L->pos[i] = b < n ? (idx)b : n;
+    }
+    double eps = L->tol * (vmax > ainv ? vmax : ainv);
+    idx *cand = L->cand, nc = m;
+    for (idx i = 0; i < m; i++) cand[i] = i;
+    idx k = -1;
+    for (;;) {
+        /* next column where the tied rows differ (max - min > eps over all m rows) */
+        for (k = k + 1; k < nw; k++) {
+            double lo = V[m * k], hi = lo;
+            for (idx i = 1; i < m; i++) {
+                double v = V[i + m * k];
+                if (v < lo) lo = v;
+                if (v > hi) hi = v;
+            }
+            if (hi - lo > eps) break;
+        }
+        int last = k >= nw;
+        idx j = last ? n : L->wj[k];
+        idx n_early = 0;
+        for (idx t = 0; t < nc; t++)
+            if (L->pos[cand[t]] < j) n_early++;
+        if (n_early == nc) {
+            idx best = 0;
+            for (idx t = 1; t < nc; t++)
+                if (L->pos[cand[t]] > L->pos[cand[best]]) best = t;
+            cand[0] = cand[best];
+            nc = 1;
+        } else if (n_early > 0) {
+            idx u = 0;
+            for (idx t = 0; t < nc; t++)
+                if (!(L->pos[cand[t]] < j)) cand[u++] = cand[t];
+            nc = u;
+        }
+        if (nc == 1 || last) break;
+        double vmin = V[cand[0] + m * k];
+        for (idx t = 1; t < nc; t++)
+            if (V[cand[t] + m * k] < vmin) vmin = V[cand[t] + m * k];
+        double lim = vmin + eps;
+        idx u = 0;
+        for (idx t = 0; t < nc; t++)
+            if (V[cand[t] + m * k] <= lim) cand[u++] = cand[t];
+        nc = u;
+        if (nc == 1) break;
+    }
+    idx best = 0;
+    for (idx t = 1; t < nc; t++)
+        if (alpha[cand[t]] > alpha[cand[best]]) best = t;
+    return rows[cand[best]];
+}
+
+/* ------------------------------------------------------------------ the ratio test */
+/* Minimum ratio among rows[0..m) (ratios theta, pivots alpha > 0, amax = max alpha); ties
+ * within tol / amax: z0 leaves if it can, else the lexicographic minimum. Overwrites the
+ * leading entries of rows and alpha with the tied ones. */
+static idx choose(Lemke *L, idx *rows, double *alpha, const double *theta, idx m, double amax)
+{
+    idx k = 0;
+    for (idx i = 1; i < m; i++)
+        if (theta[i] < theta[k]) k = i;
+    double lim = theta[k] + L->tol / amax;
+    idx mt = 0;
+    for (idx i = 0; i < m; i++)
+        if (theta[i] <= lim) {
+            rows[mt] = rows[i];
+            alpha[mt] = alpha[i];
+            mt++;
+        }
+    if (mt == 1) return rows[0];
+    int64_t z0_row = L->row_of[2 * L->n];
+    if (z0_row >= 0)
+        for (idx i = 0; i < mt; i++)
+            if (rows[i] == z0_row) return (idx)z0_row;
+    return lexico_min(L, rows, alpha, mt);
+}
+
+/* ------------------------------------------------------------------ the run */
+static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
+               long long *out_pivots, idx *out_s, int64_t *out_entering)
+{
+    const idx n = L->n;
+    double *T = L->T, *beta = T + n * (n + 1);
+    const int64_t z0 = 2 * n;
+    uint64_t seed = 0x5EEDULL, *keys = (uint64_t *)malloc((2 * n + 1) * sizeof(uint64_t));
+    HashSet seen;
+    if (!keys) return -1;
+    if (hs_init(&seen, 1024) < 0) {
+        free(keys);
+        return -1;
+    }
+    for (idx i = 0; i < 2 * n + 1; i++) keys[i] = splitmix64(&seed) >> 1; /* >= 0 as int64 */
+    int code = -1;
+    /* step 0: z0 enters; every row blocks with pivot d_i and ratio q_i / d_i */
+    double amax = -1.0 / 0.0;
+    for (idx i = 0; i < n; i++) {
+        L->rows[i] = i;
+        L->alpha[i] = T[i + n * n];
+        L->theta[i] = beta[i] / L->alpha[i];
+        if (L->alpha[i] > amax) amax = L->alpha[i];
+    }
+    idx r = choose(L, L->rows, L->alpha, L->theta, n, amax), s = n;
+    long long pivots = 0;
+    int64_t h = 0, ent = z0, entering = -1;
+    for (;;) {
+        int64_t leaving = pivot(L, r, s);
+        if (pivots < trace_len) {
+            trace[2 * pivots] = r;
+            trace[2 * pivots + 1] = s;
+        }
+        pivots++;
+        if (leaving == z0) {
+            code = 0;
+            break;
+        }
+        h ^= (int64_t)(keys[leaving] ^ keys[ent]);
+        int added = hs_add(&seen, h);
+        if (added < 0) {
+            code = -1;
+            break;
+        }
+        if (added == 1) {
+            code = 1;
+            break;
+        }
+        if (pivots >= max_iter) {
+            code = 2;
+            break;
+        }
+        entering = leaving < n ? leaving + n : leaving - n;
+        ent = entering;
+        s = (idx)L->slot_of[entering];
+        const double *a = T + n * s;
+        double amin = a[0];
+        for (idx i = 1; i < n; i++)
+            if (a[i] < amin) amin = a[i];
+        amax = -amin;
+        double thr = amax > 1.0 ? L->tol * amax : L->tol;
+        if (amax <= thr) {
+            code = 3;
+            break;
+        }
+        idx m = 0;
+        for (idx i = 0; i < n; i++)
+            if (a[i] < -thr) L->rows[m++] = i;
+        if (m == 1) {
+            r = L->rows[0];
+            continue;
+        }
+        for (idx t = 0; t < m; t++) {
+            double al = -a[L->rows[t]], b = beta[L->rows[t]];
+            L->alpha[t] = al;
+            L->theta[t] = (b > 0.0 ? b : 0.0) / al;
+        }
+        r = choose(L, L->rows, L->alpha, L->theta, m, amax);
+    }
+    free(keys);
+    free(seen.slot);
+    *out_pivots = pivots;
+    *out_s = s;
+    *out_entering = entering;
+    return code;
+}
+
+/* ------------------------------------------------------------------ Python binding */
+static int get_buffer(PyObject *obj, Py_buffer *view, const char *name, char kind, idx size,
+                      int fortran)
+{
+    int flags = PyBUF_WRITABLE | PyBUF_FORMAT | (fortran ? PyBUF_F_CONTIGUOUS : PyBUF_C_CONTIGUOUS);
+    if (PyObject_GetBuffer(obj, view, flags) < 0) return -1;
+    const char *f = view->format ? view->format : "B";
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+    int ok = view->itemsize == 8 &&
+             (kind == 'd' ? (f[0] == 'd' && f[1] == 0)
+                          : ((f[0] == 'l' || f[0] == 'q') && f[1] == 0));
+    if (!ok || view->len / 8 != size) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd %s values", name, size,
+                     kind == 'd' ? "float64" : "int64");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *py_run(PyObject *self, PyObject *args)
+{
+    PyObject *oT, *ob, *onb, *orow, *oslot, *otrace;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOdLO", &oT, &ob, &onb, &orow, &oslot, &tol, &max_iter,
+                          &otrace))
+        return NULL;
+    Py_buffer vb, vnb, vrow, vslot, vT, vtr;
+    idx n = PyObject_Length(ob);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "basic: empty");
+        return NULL;
+    }
+    if (get_buffer(ob, &vb, "basic", 'q', n, 0) < 0) return NULL;
+    if (get_buffer(onb, &vnb, "nonbasic", 'q', n + 1, 0) < 0) goto fail1;
+    if (get_buffer(orow, &vrow, "row_of", 'q', 2 * n + 1, 0) < 0) goto fail2;
+    if (get_buffer(oslot, &vslot, "slot_of", 'q', 2 * n + 1, 0) < 0) goto fail3;
+    if (get_buffer(oT, &vT, "T", 'd', n * (n + 2), 1) < 0) goto fail4;
+    idx trace_len = 0;
+    int have_trace = otrace != Py_None;
+    if (have_trace) {
+        if (PyObject_GetBuffer(otrace, &vtr, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) goto fail5;
+        trace_len = vtr.len / 16;
+    }
+    Lemke L;
+    L.n = n;
+    L.T = (double *)vT.buf;
+    L.basic = (int64_t *)vb.buf;
+    L.nonbasic = (int64_t *)vnb.buf;
+    L.row_of = (int64_t *)vrow.buf;
+    L.slot_of = (int64_t *)vslot.buf;
+    L.tol = tol;
+    L.rows = (idx *)malloc(4 * n * sizeof(idx));
+    L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
+    L.V = (double *)malloc((size_t)n * n * sizeof(double));
+    long long pivots = 0;
+    idx s = 0;
+    int64_t entering = -1;
+    int code = -1;
+    if (L.rows && L.alpha && L.V) {
+        L.cand = L.rows + n;
+        L.wj = L.rows + 2 * n;
+        L.pos = L.rows + 3 * n;
+        L.theta = L.alpha + n;
+        L.col = L.alpha + 2 * n;
+        L.row = L.alpha + 3 * n;
+        Py_BEGIN_ALLOW_THREADS
+        code = run(&L, max_iter, have_trace ? (int64_t *)vtr.buf : NULL, trace_len, &pivots,
+                   &s, &entering);
+        Py_END_ALLOW_THREADS
+    }
+    free(L.rows);
+    free(L.alpha);
+    free(L.V);
+    if (have_trace) PyBuffer_Release(&vtr);
+    PyBuffer_Release(&vT);
+    PyBuffer_Release(&vslot);
+    PyBuffer_Release(&vrow);
+    PyBuffer_Release(&vnb);
+    PyBuffer_Release(&vb);
+    if (code < 0) return PyErr_NoMemory();
+    return Py_BuildValue("iLnL", code, pivots, s, (long long)entering);
+fail5:
+    PyBuffer_Release(&vT);
+fail4:
+    PyBuffer_Release(&vslot);
+fail3:
+    PyBuffer_Release(&vrow);
+fail2:
+    PyBuffer_Release(&vnb);
+fail1:
+    PyBuffer_Release(&vb);
+    return NULL;
+}
+
+static void fill(idx n, double *T, const double *M, const double *q, const double *d,
+                 double *out_mu, double *out_nu, double *out_delta)
+{
+    double mu = 0.0, nu = 0.0, delta = -1.0 / 0.0;
+    for (idx k = 0; k < n * n; k++) {
+        double a = M[k] < 0 ? -M[k] : M[k];
+        if (a > mu) mu = a;
+    }
+    if (mu == 0.0) mu = 1.0;
+    for (idx i = 0; i < n; i++) {
+        double a = q[i] < 0 ? -q[i] : q[i];
+        if (a > nu) nu = a;
+        if (d[i] > delta) delta = d[i];
+    }
+    for (idx i = 0; i < n; i++)
+        for (idx j = 0; j < n; j++) T[i + n * j] = M[i * n + j] / mu;
+    for (idx i = 0; i < n; i++) {
+        T[i + n * n] = d[i] / delta;
+        T[i + n * (n + 1)] = q[i] / nu;
+    }
+    *out_mu = mu;
+    *out_nu = nu;
+    *out_delta = delta;
+}
+
+/* setup(T, M, q, d) -> (mu, nu, delta): T[:, :n] = M / mu, T[:, n] = d / delta,
+ * T[:, n + 1] = q / nu with mu = max|M| (1 if M = 0), nu = max|q|, delta = max d; as numpy's
+ * true divisions in `_Lemke.__init__`. M is read C-contiguous, T written column-major. */
+static PyObject *py_setup(PyObject *self, PyObject *args)
+{
+    PyObject *oT, *oM, *oq, *od;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOO", &oT, &oM, &oq, &od)) return NULL;
+    Py_buffer vq, vd, vM, vT;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(od, &vd, "d", 'd', n, 0) < 0) goto f1;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto f2;
+    if (get_buffer(oT, &vT, "T", 'd', n * (n + 2), 1) < 0) goto f3;
+    double mu, nu, delta;
+    fill(n, (double *)vT.buf, (const double *)vM.buf, (const double *)vq.buf,
+         (const double *)vd.buf, &mu, &nu, &delta);
+    PyBuffer_Release(&vT);
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vd);
+    PyBuffer_Release(&vq);
+    return Py_BuildValue("ddd", mu, nu, delta);
+f3:
+    PyBuffer_Release(&vM);
+f2:
+    PyBuffer_Release(&vd);
+f1:
+    PyBuffer_Release(&vq);
+    return NULL;
+}
+
+/* check(M, q) -> (finite, qmin): are all entries of M and q finite, and min q. */
+static PyObject *py_check(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OO", &oM, &oq)) return NULL;
+    Py_buffer vq, vM;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) {
+        PyBuffer_Release(&vq);
+        return NULL;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    double acc = 0.0, qmin = q[0];
+    for (idx k = 0; k < n * n; k++) acc += M[k] - M[k]; /* NaN iff some entry is not finite */
+    for (idx i = 0; i < n; i++) {
+        acc += q[i] - q[i];
+        if (q[i] < qmin) qmin = q[i];
+    }
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    return Py_BuildValue("Od", acc == 0.0 ? Py_True : Py_False, qmin);
+}
+
+/* set_fma(flag) -> bool: use fused multiply-adds in the update (only if the CPU has them);
+ * returns the setting in force (set_fma(None) only asks). */
+static PyObject *py_set_fma(PyObject *self, PyObject *arg)
+{
+    (void)self;
+    if (arg == Py_None) { /* query only */
+        if (use_fma < 0) use_fma = fma_available();
+        return PyBool_FromLong(use_fma);
+    }
+    int flag = PyObject_IsTrue(arg);
+    if (flag < 0) return NULL;
+    use_fma = flag && fma_available();
+    return PyBool_FromLong(use_fma);
+}
+
+/* solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k problems of size n
+ * (Ms: k n n C-contiguous, qs: k n; the data must be finite) by the same steps as lemke()
+ * (q >= 0: z = 0 and no pivot; else setup + run). Writes z (k n, the original units, as
+ * `_Lemke.point`), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
+ * (solved) leaves a usable z: the caller solves the others again by lemke() for their
+ * evidence (ray, restart after cycling). */
+static PyObject *py_solve_batch(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc, &op))
+        return NULL;
+    Py_buffer vd, vc, vp, vM, vq, vZ, vB;
+    idx n = PyObject_Length(od), k = PyObject_Length(oc);
+    if (n < 1 || k < 0) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "d: empty");
+        return NULL;
+    }
+    if (get_buffer(od, &vd, "d", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oc, &vc, "codes", 'q', k, 0) < 0) goto b1;
+    if (get_buffer(op, &vp, "pivots", 'q', k, 0) < 0) goto b2;
+    if (get_buffer(oM, &vM, "Ms", 'd', k * n * n, 0) < 0) goto b3;
+    if (get_buffer(oq, &vq, "qs", 'd', k * n, 0) < 0) goto b4;
+    if (get_buffer(oZ, &vZ, "Z", 'd', k * n, 0) < 0) goto b5;
+    if (PyObject_GetBuffer(oB, &vB, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) goto b6;
+    if (vB.len != k * n || vB.itemsize != 1) {
+        PyErr_SetString(PyExc_ValueError, "basic_z: expected k n int8 values");
+        goto b7;
+    }
+    Lemke L;
+    int64_t *ints = (int64_t *)malloc((6 * n + 3) * sizeof(int64_t));
+    double *T = (double *)malloc((size_t)n * (n + 2) * sizeof(double));
+    L.rows = (idx *)malloc(4 * n * sizeof(idx));
+    L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
+    L.V = (double *)malloc((size_t)n * n * sizeof(double));
+    int failed = !(ints && T && L.rows && L.alpha && L.V);
+    if (!failed) {
+        const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
+                     *d = (const double *)vd.buf;
+        double *Z = (double *)vZ.buf;
+        int8_t *B = (int8_t *)vB.buf;
+        int64_t *codes = (int64_t *)vc.buf, *piv = (int64_t *)vp.buf;
+        L.n = n;
+        L.T = T;
+        L.tol = tol;
+        L.basic = ints;
+        L.nonbasic = ints + n;
+        L.row_of = ints + 2 * n + 1;
+        L.slot_of = ints + 4 * n + 2;
+        L.cand = L.rows + n;
+        L.wj = L.rows + 2 * n;
+        L.pos = L.rows + 3 * n;
+        L.theta = L.alpha + n;
+        L.col = L.alpha + 2 * n;
+        L.row = L.alpha + 3 * n;
+        Py_BEGIN_ALLOW_THREADS
+        for (idx p = 0; p < k && !failed; p++) {
+            const double *q = qs + p * n;
+            double *z = Z + p * n;
+            int8_t *bz = B + p * n;
+            memset(z, 0, n * sizeof(double));
+            memset(bz, 0, n);
+            double qmin = q[0];
+            for (idx i = 1; i < n; i++)
+                if (q[i] < qmin) qmin = q[i];
+            if (qmin >= 0) {
+                codes[p] = 0;
+                piv[p] = 0;
+                continue;
+            }
+            double mu, nu, delta;
+            fill(n, T, Ms + p * n * n, q, d, &mu, &nu, &delta);
+            for (idx i = 0; i < n; i++) {
+                L.basic[i] = i;
+                L.row_of[i] = i;
+                L.slot_of[i] = -1;
+            }
+            for (idx j = 0; j <= n; j++) {
+                L.nonbasic[j] = n + j;
+                L.row_of[n + j] = -1;
+                L.slot_of[n + j] = j;
+            }
+            long long pivots = 0;
+            idx s;
+            int64_t entering;
+            int code = run(&L, max_iter, NULL, 0, &pivots, &s, &entering);
+            if (code < 0) {
+                failed = 1;
+                break;
+            }
+            codes[p] = code;
+            piv[p] = pivots;
+            if (code == 0) {
+                const double *beta = T + n * (n + 1);
+                double scale = nu / mu;
+                for (idx i = 0; i < n; i++) {
+                    int64_t b = L.basic[i];
+                    if (b >= n && b < 2 * n) {
+                        z[b - n] = beta[i] * scale;
+                        bz[b - n] = 1;
+                    }
+                }
+            }
+        }
+        Py_END_ALLOW_THREADS
+    }
+    free(ints);
+    free(T);
+    free(L.rows);
+    free(L.alpha);
+    free(L.V);
+    PyBuffer_Release(&vB);
+    PyBuffer_Release(&vZ);
+    PyBuffer_Release(&vq);
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vp);
+    PyBuffer_Release(&vc);
+    PyBuffer_Release(&vd);
+    if (failed) return PyErr_NoMemory();
+    Py_RETURN_NONE;
+b7:
+    PyBuffer_Release(&vB);
+b6:
+    PyBuffer_Release(&vZ);
+b5:
+    PyBuffer_Release(&vq);
+b4:
+    PyBuffer_Release(&vM);
+b3:
+    PyBuffer_Release(&vp);
+b2:
+    PyBuffer_Release(&vc);
+b1:
+    PyBuffer_Release(&vd);
+    return NULL;
+}
+
+static PyMethodDef methods[] = {
+    {"solve_batch", py_solve_batch, METH_VARARGS,
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k LCPs by Lemke."},
+    {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},
+    {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
+    {"setup", py_setup, METH_VARARGS,
+     "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},
+    {"run", py_run, METH_VARARGS,
+     "run(T, basic, nonbasic, row_of, slot_of, tol, max_iter, trace) -> (code, pivots, s, "
+     "entering): Lemke's pivot loop on the dictionary T (see lcp/_lemke_kernel.py)."},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_lemke_c",
+                                    "Lemke's pivot loop in C (see lcp/_lemke_kernel.py).", -1,
+                                    methods};
+
+PyMODINIT_FUNC PyInit__lemke_c(void) { return PyModule_Create(&module); }

@@ -1,0 +1,134 @@
+"""The hot loop of Lemke's method -- ratio test, lexicographic tie-break, pivot -- compiled.
+
+`pivot_loop(T, basic, nonbasic, row_of, slot_of, tol, max_iter)` runs Lemke's pivots on the
+dictionary of `lcp.lemke._Lemke` (docs/lemke.md, "The dictionary") in C (lcp/_lemke_c.c,
+built by setup.py as an optional extension) and returns (code, pivots, s, entering):
+code 0 = z0 left (solved), 1 = a basis repeated (numerical cycling), 2 = pivot limit,
+3 = secondary ray (slot s of the unblocked entering variable). The arrays are updated in place.
+The C loop applies the same rules in the same order as the numpy loop of `_Lemke.run`
+(the fallback when the extension is not built), so both take the same pivots
+(tests/lcp/test_lemke_kernel.py compares the sequences).
+
+Set the environment variable RIGIDLCP_NO_KERNEL=1 (or call `use_compiled(False)`) to run the
+numpy loop even when the extension is built.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+try:
+    from . import _lemke_c
+except ImportError:  # not built (no C compiler at install): the numpy loop runs instead
+    _lemke_c = None
+
+#: Is the compiled loop built?
+COMPILED = _lemke_c is not None
+_use = COMPILED and os.environ.get("RIGIDLCP_NO_KERNEL", "") in ("", "0")
+
+SOLVED, CYCLING, MAX_ITER, RAY = 0, 1, 2, 3
+
+
+def enabled() -> bool:
+    """Will `lcp.lemke` use the compiled loop?"""
+    return _use
+
+
+def use_compiled(flag: bool) -> bool:
+    """Switch the compiled loop on or off (on only when built); returns the previous setting."""
+    global _use
+    previous, _use = _use, bool(flag) and COMPILED
+    return previous
+
+
+def blas_uses_fma() -> bool:
+    """Does scipy's BLAS `dger` (the numpy loop's update) round each entry once, as a fused
+    multiply-add? The C update does so when the CPU has AVX2 and FMA, as OpenBLAS's kernels do;
+    tests/lcp/test_lemke_kernel.py checks the two agree on the machine at hand."""
+    from scipy.linalg.blas import dger
+
+    rng = np.random.default_rng(0)
+    A = np.asfortranarray(rng.standard_normal((67, 5)))
+    x, y = rng.standard_normal(67), rng.standard_normal(5)
+    plain = A + np.outer(x, y)
+    dger(1.0, x, y, 1, 1, A, 1, 1, 1)
+    return not np.array_equal(A, plain)
+
+
+def set_fma(flag: bool | None) -> bool:
+    """Round the C update with fused multiply-adds (only if the CPU has them); returns the
+    setting in force (None: only ask)."""
+    return _lemke_c.set_fma(flag)
+
+
+def run(lemke_run, max_iter: int):
+    """`_Lemke.run` in C: the pivots on `lemke_run`'s dictionary, then its outcome (solution,
+    ray, pivot limit, cycling) built by its own methods. Its bookkeeping becomes int64 arrays,
+    updated in place (the outcome methods read them as they read the lists)."""
+    L = lemke_run
+    n = L.n
+    L.row_of, L.nonbasic = np.array(L.row_of), np.arange(n, 2 * n + 1)
+    L.basic, L.slot_of = L.basic_np, L.slot_np
+    trace = None if L.trace is None else np.full(2 * (max_iter + 1), -1, dtype=np.int64)
+    code, pivots, s, entering = pivot_loop(L.T, L.basic_np, L.nonbasic, L.row_of, L.slot_np,
+                                           L.tol, max_iter, trace)
+    if trace is not None:
+        L.trace.extend(map(tuple, trace[: 2 * pivots].reshape(-1, 2).tolist()))
+    if code == SOLVED:
+        return L.solution(pivots)
+    if code == RAY:
+        return L.ray(pivots, s, entering)
+    sol = L.stopped(pivots)
+    if code == CYCLING:
+        sol.message = f"numerical cycling: a basis repeated after {pivots} pivots"
+        sol.info["cycling"] = True
+    return sol
+
+
+def pivot_loop(T: np.ndarray, basic: np.ndarray, nonbasic: np.ndarray, row_of: np.ndarray,
+               slot_of: np.ndarray, tol: float, max_iter: int,
+               trace: np.ndarray | None = None) -> tuple[int, int, int, int]:
+    """Run the pivots (compiled); `trace` (int64, length 2 k) receives (row, slot) of the first
+    k pivots."""
+    return _lemke_c.run(T, basic, nonbasic, row_of, slot_of, float(tol), int(max_iter), trace)
+
+
+def setup(T: np.ndarray, M: np.ndarray, q: np.ndarray, d: np.ndarray) -> tuple[float, float, float]:
+    """Fill the dictionary T = [M / mu, d / delta, q / nu] (compiled); returns (mu, nu, delta)."""
+    return _lemke_c.setup(T, np.ascontiguousarray(M), q, d)
+
+
+def plain_finite(M, q) -> tuple[bool, float]:
+    """(True, min q) when M (n x n) and q (n) are C-contiguous float64 arrays with finite entries
+    (then they need no conversion); (False, nan) otherwise (the caller validates them)."""
+    if (_use and type(M) is np.ndarray and type(q) is np.ndarray and M.dtype == np.float64
+            and q.dtype == np.float64 and q.ndim == 1 and q.size > 0
+            and M.shape == (q.size, q.size) and M.flags.c_contiguous
+            and q.flags.c_contiguous):
+        return _lemke_c.check(M, q)
+    return False, float("nan")
+
+
+def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_iter: int,
+                Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray) -> None:
+    """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
+    z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
+    leaves a z; the others are to be solved again one by one for their evidence."""
+    _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots)
+
+
+def solve_one(M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float, max_iter: int):
+    """One LCP by the compiled loop, start to end: (z, basis, pivots) when it is solved, None
+    otherwise (the caller reruns `_Lemke` for the evidence of a ray, a limit or a cycle).
+    M, q: C-contiguous float64 and finite (see `plain_finite`); q not >= 0."""
+    n = q.size
+    Z = np.empty((1, n))
+    basic = np.empty((1, n), dtype=np.int8)
+    codes = np.empty(1, dtype=np.int64)
+    pivots = np.empty(1, dtype=np.int64)
+    _lemke_c.solve_batch(M, q, d, float(tol), int(max_iter), Z, basic, codes, pivots)
+    if codes[0] != SOLVED:
+        return None
+    return Z[0], basic[0].nonzero()[0], int(pivots[0])

@@ -1,0 +1,165 @@
+"""Many LCPs at once: `solve_many(problems, method=..., **options)` (the batch path).
+
+Comparison studies and fuzzing solve thousands of small LCPs; one `lcp.solve` call pays a fixed
+Python price (validation, method lookup, building the answer) that is most of its time at
+n = 10. `solve_many` pays the lookup and the option check once, validates a stack of same-size
+problems with one pass, and -- for ``method="lemke"`` when the compiled kernel is built
+(lcp/_lemke_kernel.py) -- runs the whole loop over the problems in C. Every answer is then
+checked the way `solve` checks one: w = M z + q is recomputed here (never taken from the
+method) and the residual max|min(z, w)| stored; a z that is not finite is a failure. A problem
+the batch loop does not solve (ray, pivot limit, numerical cycling) is solved again by
+`lcp.solve`, which gives the same status and evidence as a single call.
+
+The answers are the same as those of `[lcp.solve(p, method, **options) for p in problems]`:
+the same z, pivots and status (tests/lcp/test_batch.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+import rigidlcp.lcp._lemke_kernel as _kernel
+
+from .api import get_method, solve
+from .problem import LCP, MLCP, InvalidProblem
+from .solution import Solution
+
+
+def solve_many(
+    problems: Sequence[LCP | MLCP] | tuple[np.ndarray, np.ndarray],
+    method: str = "lemke",
+    **options,
+) -> list[Solution]:
+    """Solve a list of LCPs (w = M z + q, 0 <= z perp w >= 0) by one method.
+
+    problems: a sequence of `lcp.LCP` (stacked by size: the fast path), `lcp.MLCP` or
+    `lcp.FrictionContact2D` (solved one by one by `lcp.solve`), or a pair (Ms, qs) of stacked
+    arrays of shapes (k, n, n) and (k, n). options: the method's options, the same for every
+    problem. Returns one Solution per problem, in order, each as `lcp.solve` would return it.
+    """
+    info = get_method(method)
+    unknown = set(options) - set(info.options)
+    if unknown:
+        raise InvalidProblem(
+            f"method {method!r} does not accept option(s) {sorted(unknown)}; "
+            f"it accepts {list(info.options) or 'none'}"
+        )
+    if isinstance(problems, tuple) and len(problems) == 2 and not isinstance(
+            problems[0], (LCP, MLCP)):
+        Ms, qs = _stacked(*problems)
+        return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]))
+    from .friction import FrictionContact2D
+
+    problems = list(problems)
+    for i, p in enumerate(problems):
+        if not isinstance(p, (LCP, MLCP, FrictionContact2D)):
+            raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
+                                 f"lcp.FrictionContact2D, got {type(p).__name__}")
+    out: list[Solution | None] = [None] * len(problems)
+    groups: dict[int, list[int]] = {}
+    for i, p in enumerate(problems):
+        if not isinstance(p, LCP):  # MLCP (u, reductions) or friction problem: one by one
+            out[i] = solve(p, method, **options)
+        else:
+            groups.setdefault(p.n, []).append(i)
+    for idx in groups.values():  # LCPs are validated at construction: stack them as they are
+        Ms = np.stack([problems[i].M for i in idx])
+        qs = np.stack([problems[i].q for i in idx])
+        sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]])
+        for i, sol in zip(idx, sols):
+            out[i] = sol
+    return out  # type: ignore[return-value]
+
+
+def _stacked(Ms, qs) -> tuple[np.ndarray, np.ndarray]:
+    """Validate stacked data once: real finite arrays of shapes (k, n, n) and (k, n)."""
+    try:
+        Ms = np.ascontiguousarray(Ms, dtype=float)
+        qs = np.ascontiguousarray(qs, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblem(f"Ms and qs must be numeric arrays: {exc}") from None
+    if Ms.ndim != 3 or Ms.shape[1] != Ms.shape[2] or Ms.shape[1] < 1:
+        raise InvalidProblem(f"Ms must have shape (k, n, n) with n >= 1, got {Ms.shape}")
+    if qs.shape != Ms.shape[:2]:
+        raise InvalidProblem(f"qs must have shape {Ms.shape[:2]} (k, n), got {qs.shape}")
+    for name, arr in (("Ms", Ms), ("qs", qs)):
+        if not np.isfinite(arr).all():
+            where = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+            raise InvalidProblem(f"{name} contains NaN or Inf (first at index {where})")
+    return Ms, qs
+
+
+def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
+                 problem_of) -> list[Solution]:
+    """Solve the stacked (validated, finite) problems; problem_of(i) is problem i as an LCP
+    (built only when a problem must be solved one by one)."""
+    k, n = qs.shape
+    if method == "lemke" and _kernel.enabled() and k:
+        return _lemke_batch(Ms, qs, options, problem_of)
+    func = get_method(method).func
+    sols = []
+    for i in range(k):
+        sol = func(Ms[i], qs[i], **options)
+        sol.method = method
+        sols.append(sol)
+    Z = np.zeros((k, n))
+    bad = np.zeros(k, bool)
+    for i, sol in enumerate(sols):
+        z = np.asarray(sol.z, dtype=float)
+        if z.shape == (n,) and np.isfinite(z).all():
+            Z[i] = z
+        else:
+            bad[i] = True
+    _verify(Ms, qs, Z, sols, bad)
+    return sols
+
+
+def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, options: dict, problem_of) -> list[Solution]:
+    from .lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
+
+    k, n = qs.shape
+    d = _covering_vector(options.get("d"), n)
+    max_iter = _check_max_iter(options.get("max_iter"), n)
+    tol = _check_tol(options.get("tol", DEFAULT_TOL))
+    Z = np.empty((k, n))
+    basic = np.empty((k, n), dtype=np.int8)
+    codes = np.empty(k, dtype=np.int64)
+    pivots = np.empty(k, dtype=np.int64)
+    _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots)
+    # What `solve` does to each answer, for all at once: w = M z + q recomputed, the residual.
+    W = np.einsum("kij,kj->ki", Ms, Z) + qs
+    res = np.abs(np.minimum(Z, W)).max(axis=1).tolist()
+    rows, cols = np.nonzero(basic)
+    bases = np.split(cols, np.cumsum(np.bincount(rows, minlength=k))[:-1])
+    sols: list[Solution] = []
+    for i, (code, piv, z, w) in enumerate(zip(codes.tolist(), pivots.tolist(), Z, W)):
+        if code == _kernel.SOLVED:
+            sols.append(Solution(z=z, w=w, status="solved", method="lemke", iterations=piv,
+                                 residual=res[i], basis=bases[i],
+                                 message="" if piv else "q >= 0: z = 0 solves the LCP"))
+        else:  # a ray, a pivot limit or a cycle: the single call gives its evidence
+            sols.append(solve(problem_of(i), "lemke", **options))
+    return sols
+
+
+def _verify(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, sols: list[Solution],
+            bad: np.ndarray) -> None:
+    """What `solve` does to one answer, for all at once: w = M z + q recomputed, the residual
+    max|min(z, w)| stored, a non-finite z marks the solution failed (z replaced by zeros)."""
+    if not sols:
+        return
+    W = np.einsum("kij,kj->ki", Ms, Z) + qs
+    res = np.abs(np.minimum(Z, W)).max(axis=1)
+    for i, sol in enumerate(sols):
+        if bad[i]:
+            sol.status = "failed" if sol.status == "solved" else sol.status
+            sol.message = (sol.message + "; " if sol.message else "") + "method returned a bad z"
+            z = np.asarray(sol.z, dtype=float)
+            z = np.where(np.isfinite(z), z, 0.0) if z.shape == Z[i].shape else np.zeros_like(Z[i])
+            sol.z, sol.w = z, Ms[i] @ z + qs[i]
+            sol.residual = float(np.abs(np.minimum(sol.z, sol.w)).max())
+        else:
+            sol.z, sol.w, sol.residual = Z[i], W[i], float(res[i])
+

@@ -1,0 +1,95 @@
+"""lcp.solve_many (lcp/batch.py) against a loop of lcp.solve: the same answers (z, status,
+pivots, basis, evidence), every answer checked (w recomputed, residual stored), bad input
+refused with a typed error."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+
+from rigidlcp import lcp
+from rigidlcp.lcp import _lemke_kernel as kernel
+
+from .test_lemke import degenerate_integer_lcps, murty_matrix, murty_q
+
+
+def random_lcps(k: int, n: int, seed: int) -> list[lcp.LCP]:
+    rng = np.random.default_rng([seed, n])
+    out = []
+    for _ in range(k):
+        A = rng.standard_normal((n, n))
+        out.append(lcp.LCP(A @ A.T + 0.1 * np.eye(n), rng.standard_normal(n)))
+    return out
+
+
+def assert_same_as_loop(problems, method="lemke", **options):
+    many = lcp.solve_many(problems, method, **options)
+    assert len(many) == len(problems)
+    for p, got in zip(problems, many):
+        one = lcp.solve(p, method, **options)
+        assert (got.status, got.iterations, got.message) == (one.status, one.iterations,
+                                                               one.message)
+        assert got.method == one.method
+        np.testing.assert_array_equal(got.z, one.z)
+        scale = 1e-12 * (1 + np.abs(p.q if isinstance(p, lcp.LCP) else p.b).max())
+        np.testing.assert_allclose(got.w, one.w, rtol=0, atol=scale)
+        assert got.residual == pytest.approx(one.residual, abs=scale)
+        if one.basis is not None:
+            np.testing.assert_array_equal(got.basis, one.basis)
+        assert set(got.info) == set(one.info)
+    return many
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+@pytest.mark.parametrize("n", [1, 3, 10, 40])
+def test_lemke_batch_equals_a_loop_of_solve(n, compiled):
+    previous = kernel.use_compiled(compiled)
+    try:
+        sols = assert_same_as_loop(random_lcps(20, n, 0))
+    finally:
+        kernel.use_compiled(previous)
+    assert all(s.status == "solved" and s.residual < 1e-9 for s in sols)
+
+
+@settings(max_examples=40, deadline=None)
+@given(degenerate_integer_lcps(max_n=4))
+def test_batch_on_degenerate_problems(problem):
+    """Rays, infeasible problems, q >= 0, ties: each as a single solve answers it."""
+    M, q = problem
+    P = lcp.LCP(M, q)
+    assert_same_as_loop([P, P, lcp.LCP(M, -np.abs(q) - 1)])
+
+
+def test_mixed_sizes_statuses_and_mlcp():
+    M, q = np.array([[1.0, -1.0], [-1.0, 1.0]]), np.array([-1.0, -1.0])  # infeasible
+    mlcp = lcp.MLCP(np.eye(1), np.ones((1, 2)), np.ones((2, 1)), np.eye(2), np.zeros(1),
+                    np.array([-1.0, 2.0]))
+    problems = [*random_lcps(3, 5, 1), lcp.LCP(M, q), lcp.LCP(murty_matrix(6), murty_q(6)),
+                mlcp, *random_lcps(2, 7, 2)]
+    sols = assert_same_as_loop(problems, max_iter=40)
+    assert [s.status for s in sols[3:5]] == ["infeasible", "max_iter"]
+    assert sols[5].u is not None
+
+
+def test_other_methods_and_stacked_arrays():
+    problems = random_lcps(6, 8, 3)
+    assert_same_as_loop(problems, "pivoting")
+    Ms = np.stack([p.M for p in problems])
+    qs = np.stack([p.q for p in problems])
+    for a, b in zip(lcp.solve_many((Ms, qs)), lcp.solve_many(problems)):
+        np.testing.assert_array_equal(a.z, b.z)
+
+
+def test_bad_input_is_refused():
+    with pytest.raises(lcp.InvalidProblem, match="option"):
+        lcp.solve_many(random_lcps(2, 3, 0), "lemke", bogus=1)
+    with pytest.raises(lcp.InvalidProblem, match="unknown method"):
+        lcp.solve_many(random_lcps(2, 3, 0), "nope")
+    with pytest.raises(lcp.InvalidProblem, match=r"problems\[1\]"):
+        lcp.solve_many([random_lcps(1, 3, 0)[0], "x"])
+    with pytest.raises(lcp.InvalidProblem, match="NaN"):
+        lcp.solve_many((np.full((2, 3, 3), np.nan), np.zeros((2, 3))))
+    with pytest.raises(lcp.InvalidProblem, match="shape"):
+        lcp.solve_many((np.zeros((2, 3, 3)), np.zeros((2, 4))))
+    assert lcp.solve_many([]) == []

@@ -1,0 +1,52 @@
+"""A command loads only what it uses: which modules an import pulls in (no timing here; the
+times are in docs/benchmarks.md, "Import and start-up")."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+HEAVY = ("cvxpy", "matplotlib", "highspy", "scipy.optimize", "clarabel", "osqp")
+
+
+def loaded_after(code: str) -> set[str]:
+    code += "\nimport sys\nprint(' '.join(sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return set(out.stdout.split())
+
+
+def test_import_lcp_loads_no_solver_stack():
+    mods = loaded_after("import rigidlcp.lcp")
+    assert not {m for m in mods if m.startswith(HEAVY)}
+    assert "scipy.sparse" not in mods and "scipy.linalg" not in mods
+
+
+def test_lemke_solve_loads_only_lemke():
+    mods = loaded_after("import numpy as np\nfrom rigidlcp import lcp\n"
+                        "lcp.solve(lcp.LCP(np.eye(2), -np.ones(2)), 'lemke')")
+    assert "rigidlcp.lcp.lemke" in mods
+    assert not {m for m in mods if m.startswith(HEAVY)}
+    assert not {"rigidlcp.lcp.qp", "rigidlcp.lcp.pgs", "rigidlcp.lcp.enumeration",
+                "rigidlcp.lcp.friction"} & mods
+    assert "scipy.sparse" not in mods
+    from rigidlcp.lcp import _lemke_kernel
+
+    if _lemke_kernel.enabled():  # the compiled loop needs no scipy.linalg (dger)
+        assert "scipy.linalg" not in mods
+
+
+def test_cli_parser_loads_no_scipy():
+    mods = loaded_after("import importlib\n"
+                        "importlib.import_module('rigidlcp.cli.main').build_parser()")
+    assert not {m for m in mods if m.startswith("scipy")}
+    assert "rigidlcp.models.engine.dense" not in mods
+
+
+def test_the_lazy_method_table_lists_every_builtin_method_in_order():
+    """lcp.api._BUILTIN (which module registers which method) must follow lcp/methods.py."""
+    out = subprocess.run(
+        [sys.executable, "-c", "import importlib\nfrom rigidlcp.lcp import api\n"
+         "importlib.import_module('rigidlcp.lcp.methods')\n"
+         "print(list(api._REGISTRY) == list(api._BUILTIN))"],
+        capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "True"
