@@ -43,7 +43,7 @@ def plan(quick: bool = False) -> dict[str, dict]:
         "fig8": dict(r, lx=10, ly=4, gamma=0.2, V0=0.0, mu_pp=0.05, mu_plane=0.2, mu_wall=0.0,
                      seeds=(0,), alt_select=("none",)),
         "fig9": dict(r, lx=10, ly=4, gamma=0.16, V0=0.0, **BASE, seeds=(0, 1),
-                     scan=(0.04, 0.08, 0.12, 0.2), alt_select=("none",)),
+                     scan=(0.04, 0.08, 0.12, 0.2), alt_select=("none", "none/pivoting")),
         "fig10": dict(r, lx=10, ly=2, gamma=0.3, V0=0.0, **BASE, seeds=(0, 1, 2, 3)),
         "fig6": dict(r, lx=7, ly=1, gamma=0.05, V0=0.0, mu_pp=0.3, mu_plane=0.3, mu_wall=0.0,
                      seeds=(0, 1, 2, 3, 4)),
@@ -91,6 +91,8 @@ def jobs_of(p: dict) -> list[tuple]:
         jobs += [("sim", name, seed, gamma, SELECT) for seed in cfg["seeds"]]
         jobs += [("sim", name, first, g, SELECT) for g in cfg.get("scan", ())]
         jobs += [("sim", name, first, gamma, sel) for sel in cfg.get("alt_select", ())]
+    # the raw pivoting selection runs into a zeno accumulation (~75 s on 10x4): start it first
+    jobs.sort(key=lambda j: not (j[0] == "sim" and j[4].endswith("/pivoting")))
     for name in ("lx", "ly"):
         lo, hi = p["formulas"][name]
         if not 1 <= lo <= hi:
@@ -115,7 +117,13 @@ class Job:
         kind = job[0]
         if kind == "sim":
             _, name, seed, gamma, select = job
-            return models.simulate(system_of(self.p[name], gamma), seed=seed, select=select)
+            sel, _, method = select.partition("/")  # "none/pivoting": select none, pivoting
+            return models.simulate(system_of(self.p[name], gamma), seed=seed, select=sel,
+                                   method=method or "lemke")
+        if kind in ("ts", "cert", "sweep-ts"):
+            from .crosscheck import check_job
+
+            return check_job(job)
         if kind == "point":
             row = run_point(job[2])
             row.pop("wall_time_s", None)
@@ -141,6 +149,9 @@ class Claim:
     passed: bool
     note: str = ""
     error: str = ""
+    ts_confirmed: bool | None = None  # None: not a steady-state claim (crosscheck.py)
+    ts: str = ""  # "confirmed by time-stepping": the verdict and the drifts
+    determinacy: str = ""  # certified uniqueness at the steady state(s) (crosscheck.py)
 
     @property
     def verdict(self) -> str:
@@ -157,6 +168,10 @@ class Results:
     formulas: list[dict] = field(default_factory=list)
     wall_time: float = 0.0
     executor: str = ""
+    #: cross-checks of steady states by label (crosscheck.py): experiment name, or
+    #: "NAME gamma=G" for sweep points
+    ts_checks: dict = field(default_factory=dict)
+    certificates: dict = field(default_factory=dict)
 
     def seeds(self, name: str) -> list[models.Run]:
         cfg = self.plan[name]
@@ -200,8 +215,50 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
             bar.close()
     for rows in res.sweeps.values():
         rows.sort(key=lambda r: r["gamma"])
+    checks = check_jobs(p, res)
+    if bar is not None:
+        bar = tqdm(total=len(checks), unit="job", desc="cross-checks", file=sys.stderr,
+                   dynamic_ncols=True)
+    try:
+        for k, out in iter_map(Job(p), checks, jobs=jobs, dask=dask):
+            kind, label = checks[k][:2]
+            (res.certificates if kind == "cert" else res.ts_checks)[label] = out
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
     res.wall_time = time.perf_counter() - start
     return res
+
+
+#: The experiments whose steady state (first seed, default selection) is cross-checked.
+STEADY = ("fig7", "fig8", "fig9", "fig10", "fig6", "fig13", "fig13_tri")
+#: Sweep points cross-checked by time-stepping, per sweep (indices into its gamma grid).
+SWEEP_POINTS = 5
+
+
+def sweep_gammas(cfg: dict) -> list[float]:
+    """SWEEP_POINTS gammas of a sweep's grid, evenly spread, both ends included."""
+    grid = parse_grid("gamma", cfg["gamma"])
+    idx = np.unique(np.linspace(0, len(grid) - 1, SWEEP_POINTS).round().astype(int))
+    return [float(grid[k]) for k in idx]
+
+
+def check_jobs(p: dict, res: Results) -> list[tuple]:
+    """The cross-check jobs (crosscheck.py) of the runs in `res`: time-stepping and certificate
+    of each STEADY experiment's first seed, time-stepping at sweep_gammas of each sweep."""
+    out: list[tuple] = []
+    for name in STEADY:
+        cfg = p[name]
+        run = res.runs.get(name, {}).get((cfg["seeds"][0], cfg["gamma"], SELECT))
+        if run is not None:
+            out += [("ts", name, run), ("cert", name, run)]
+    for name in SWEEPS:
+        cfg = p[name]
+        for g in sweep_gammas(cfg):
+            out.append(("sweep-ts", f"{name} gamma={g:g}", system_of(cfg, g), cfg["seed"]))
+    return out
 
 
 # -- helpers for the claims ----------------------------------------------------------------------
@@ -305,4 +362,4 @@ def provenance() -> str:
 
 __all__ = ["plan", "jobs_of", "Job", "run_all", "Results", "Claim", "seed_claim", "first_piece",
            "plateau", "compare", "dissipation_profile", "system_of", "spread", "SWEEPS",
-           "SELECT", "ranges", "provenance"]
+           "SELECT", "ranges", "provenance", "STEADY", "sweep_gammas", "check_jobs"]
