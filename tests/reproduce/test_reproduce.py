@@ -109,7 +109,8 @@ def test_a_broken_evaluation_is_a_fail_with_the_error():
 
 EXPECTED_IDS = {
     "fig7-steady", "fig10-steady", "fig8-row1-mode1", "fig8-rows-mode2", "fig8-columns-mode3",
-    "fig8-any-selection", "fig9-counts", "fig9-any-selection", "fig11-linear", "fig11-plateau", "fig12-inertia", "fig12-friction",
+    "fig8-any-selection", "fig9-counts", "fig9-any-selection", "fig11-linear", "fig11-plateau",
+    "fig12-inertia", "fig12-friction",
     "ivb-plane-m_e", "ivb-plane-mu_e", "ivb-pp-m_e", "ivb-pp-mu_e", "fig13-minimum",
     "fig13-rect-all-ns", "fig13-rect-transmitting-ns", "fig13-tri-higher", "fig6-alternating",
     "fig6-singular", "eq33-rect", "eq33-tri", "eq34-rect", "eq34-tri",
