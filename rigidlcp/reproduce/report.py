@@ -236,7 +236,7 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
 
 def _cross_checks(res: Results, claims: list[Claim], prefixes: tuple) -> list[str]:
     """The time-stepping checks and certificates of a section's steady states, in full."""
-    from .claims import experiments_of
+    from .columns import experiments_of
 
     labels: list[str] = []
     for c in claims:

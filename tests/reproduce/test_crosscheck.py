@@ -9,7 +9,8 @@ import pytest
 
 from rigidlcp import lcp, models
 from rigidlcp.models.event import event_problem
-from rigidlcp.reproduce.claims import evaluate, fig9_any
+from rigidlcp.reproduce.claims import evaluate
+from rigidlcp.reproduce.columns import fig9_any
 from rigidlcp.reproduce.crosscheck import (
     TOL_ALPHA,
     TS_DEFINITION,
