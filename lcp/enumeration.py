@@ -344,7 +344,7 @@ def _check_tol(tol: float) -> None:
 
 
 @register(
-    "enumerate", accepts="small-n", max_n=MAX_N,
+    "enumerate", accepts="small-n", max_n=MAX_N, equilibrate=True,
     description="Every complementary basis (2^n solves; singular bases by LP): all solutions, "
     "hence uniqueness; returns the first (or the min-norm) one.",
 )
