@@ -9,9 +9,13 @@ is found by HiGHS on the *equilibrated* problem (lcp.scaling: M~ = R M C, q~ = R
 and it is checked in floating point, not taken from the solver: with g = M~^T y and gap
 -q~^T y > 0, every feasible z~ obeys gap <= max(g, 0)^T z~, so no feasible point has
 |z~|_1 < radius = gap / max(g_+). The certificate is accepted when gap >= GAP (the data are
-O(1) after equilibration) and radius >= RADIUS, and when HiGHS also finds the primal feasibility
-problem {z~ >= 0, M~ z~ + q~ >= 0} infeasible. y maps back to the user's problem as R y~ (the
-sign conditions are invariant under positive scalings).
+O(1) after equilibration) and radius >= RADIUS ~ 4.5e14 (rounding of M~^T y then cannot hide a
+feasible point of reasonable size), and when HiGHS also finds the primal feasibility problem
+{z~ >= 0, M~ z~ + q~ >= 0} infeasible. Below that radius the float data cannot tell "no
+solution" from "a solution of size ~1/eps": no claim is made (the status says so). y maps back
+to the user's problem as R y~ (the sign conditions are invariant under positive scalings).
+When (1)'s y leaves HiGHS's tolerance in M~^T y, it is projected onto the active constraints
+(`_polish`), and failing that the most robust certificate (`_interior`, margin t > 0) is tried.
 
 A P-matrix LCP always has a solution, so it never gets a certificate (unless its solution is
 beyond `radius` in the equilibrated units, i.e. M is singular to working precision).
@@ -30,8 +34,12 @@ from .scaling import Equilibration
 
 #: Least q~^T y (sum y = 1, |q~|_inf ~ 1) a certificate must reach.
 GAP = 1e-7
-#: Least radius (equilibrated units, |M~|_max ~ 1) inside which no feasible point may exist.
-RADIUS = 1e8
+#: Least radius (equilibrated units, |M~|_max ~ 1) inside which no feasible point may exist:
+#: 1 / (10 eps) ~ 4.5e14. A matrix that is P beyond rounding (lambda_min of the symmetric part
+#: > 100 n eps) has its solution at |z~|_1 <= sqrt(n) / (100 eps), inside this radius for
+#: n <= 100, so it cannot be certified; a smaller radius would "prove" solvable LCPs whose
+#: solution is merely huge (e.g. |z~| ~ 1e16 for cond(M) ~ 1e16) infeasible.
+RADIUS = 0.1 / np.finfo(float).eps
 _HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 
 
@@ -63,6 +71,39 @@ def check_certificate(eq: Equilibration, y_tilde: np.ndarray) -> Farkas | None:
     return Farkas(y=y * eq.r / float(np.sum(y * eq.r)), gap=gap, radius=float(radius))
 
 
+def _polish(eq: Equilibration, y: np.ndarray) -> np.ndarray:
+    """HiGHS's y meets M~^T y <= 0 to its feasibility tolerance (1e-10), far above rounding:
+    on the support S of y and the constraints J it makes (nearly) active, project y onto
+    {(M~^T)_JS y_S = 0} (one least-squares correction, twice) so that the slack is rounding."""
+    y = np.maximum(np.asarray(y, dtype=float), 0.0)
+    for _ in range(2):
+        g = eq.M.T @ y
+        S = np.flatnonzero(y > 1e-12 * y.max())
+        J = np.flatnonzero(g > -1e-8)
+        if S.size == 0 or J.size == 0:
+            break
+        A = eq.M.T[np.ix_(J, S)]
+        step, *_ = np.linalg.lstsq(A, A @ y[S], rcond=None)
+        y[S] = np.maximum(y[S] - step, 0.0)
+    return y
+
+
+def _interior(eq: Equilibration) -> np.ndarray:
+    """The most robust certificate: max t with M~^T y + t 1 <= 0, q~^T y + t <= 0, sum y = 1,
+    y >= 0, t <= 1. When t > 0 every inequality holds with margin t, far above HiGHS's
+    tolerance, so the floating-point check sees M~^T y < 0 (infinite radius)."""
+    n = eq.q.size
+    A = np.vstack([np.column_stack([eq.M.T, np.ones(n)]), np.r_[eq.q, 1.0][None, :]])
+    c = np.zeros(n + 1)
+    c[-1] = -1.0
+    res = linprog(c, A_ub=A, b_ub=np.zeros(n + 1), A_eq=np.r_[np.ones(n), 0.0][None, :],
+                  b_eq=[1.0], bounds=[(0, None)] * n + [(None, 1.0)], method="highs",
+                  options=_HIGHS)
+    if res.status != 0 or res.x is None or res.x[-1] <= 0:
+        return np.zeros(n)
+    return res.x[:n]
+
+
 def find_certificate(eq: Equilibration, candidate: np.ndarray | None = None) -> Farkas | None:
     """A checked Farkas certificate of the equilibrated LCP (try `candidate`, in user units,
     first), or None when none exists (the LCP has feasible points) or none passes the check."""
@@ -78,6 +119,10 @@ def find_certificate(eq: Equilibration, candidate: np.ndarray | None = None) -> 
         if res.status != 0 or res.x is None:
             return None
         found = check_certificate(eq, res.x)
+        if found is None:
+            found = check_certificate(eq, _polish(eq, res.x))
+        if found is None:
+            found = check_certificate(eq, _interior(eq))
         if found is None:
             return None
     primal = linprog(np.zeros(n), A_ub=-eq.M, b_ub=eq.q, bounds=[(0, None)] * n,

@@ -35,7 +35,8 @@ class Equilibration:
     c: np.ndarray  # column factors (powers of 2), including the unit change of q
 
     def z_back(self, z_tilde: np.ndarray) -> np.ndarray:
-        return self.c * z_tilde
+        with np.errstate(over="ignore"):  # a diverged z~ stays visible (inf), and is rejected
+            return self.c * z_tilde
 
     def z_to(self, z: np.ndarray) -> np.ndarray:
         return z / self.c

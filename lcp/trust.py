@@ -188,7 +188,7 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
         got = run.first_accepted(name, equilibrate, options, same_only=False) if repair else None
         if got is not None:
             return _adopt(sol, got, f"the answer had scaled residual {first.scaled_residual:.3g}")
-        best_z, best_c = run.best[1], run.best[2]
+        best_z, best_c = (run.best[1], run.best[2]) if run.best else (sol.z, first)
         sol.status = "inaccurate"
         sol.z = best_z
         sol.message = ((sol.message + "; ") if sol.message else "") + (
@@ -208,9 +208,11 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
         if got is not None:
             return _adopt(sol, got, "it had claimed 'infeasible' without a valid certificate")
         sol.status = "failed"
-        sol.message = ((sol.message + "; ") if sol.message else "") + (
-            "but no Farkas certificate (y >= 0, M^T y <= 0, q^T y < 0) was found by the LP: "
-            "infeasibility is not proved, and no other method solved the problem")
+        sol.info["status_of_method"] = "infeasible"
+        sol.message = (f"the method claimed infeasibility ({sol.message or 'no reason given'}), "
+                       "but no Farkas certificate (y >= 0, M^T y <= 0, q^T y < 0) passes the "
+                       "check (lcp.farkas): infeasibility is not proved, and no other method "
+                       "solved the problem")
         return finish(sol, c)
     if sol.status in ("ray", "max_iter", "failed"):
         if repair:

@@ -68,6 +68,8 @@ def lp_feasible(M: np.ndarray, q: np.ndarray) -> bool | None:
 def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
     """(outcome, reason) of one answer; see the module docstring."""
     if status == "solved":
+        if case.solvable is False:
+            return "WRONG", "solved, but the problem is infeasible by construction"
         r = judge_residual(case.M, case.q, z)
         return ("solved", "") if r <= TOL else ("WRONG", f"solved with scaled residual {r:.3g}")
     if status != "infeasible":
@@ -136,13 +138,38 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
     return {"table": dict(table), "saved": saved, "count": count, "seed": seed}
 
 
+def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | None = None
+              ) -> dict:
+    """Every method on LCP files (Siconos's LCP format, or lcp .npz), judged as the fuzz cases
+    are but with nothing known by construction (class = the file name)."""
+    from verify.siconos_format import read_siconos_lcp
+
+    names = methods or tuple(m.name for m in lcp.methods())
+    table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
+    saved: list[Path] = []
+    for path in map(Path, paths):
+        P = lcp.load(path) if path.suffix == ".npz" else read_siconos_lcp(path)
+        case = Case(path.stem, 0, P.M, P.q)
+        for method in names:
+            if method == "enumerate" and case.n > ENUM_MAX_N:
+                continue
+            res = run_case(case, method)
+            cell = table[(path.stem, method)]
+            cell[res["outcome"]] += 1
+            cell["seconds"].append(res["seconds"])
+            if res["outcome"] in ("WRONG", "crash") and out is not None:
+                saved.append(save_case(case, method, res, Path(out)))
+    return {"table": dict(table), "saved": saved}
+
+
 def format_table(result: dict) -> str:
     """Markdown table: class x method -> solved / honest / refused / crash / WRONG, time."""
     table = result["table"]
     lines = ["| class | method | solved | honest failure | refused | crash | SILENT WRONG "
              "| median ms |", "|---|---|---:|---:|---:|---:|---:|---:|"]
     order = {c: i for i, c in enumerate(CLASSES)}
-    for (kind, method), cell in sorted(table.items(), key=lambda kv: (order[kv[0][0]], kv[0][1])):
+    for (kind, method), cell in sorted(table.items(),
+                                       key=lambda kv: (order.get(kv[0][0], 99), kv[0])):
         ms = 1e3 * float(np.median(cell["seconds"])) if cell["seconds"] else float("nan")
         lines.append(f"| {kind} | {method} | {cell['solved']} | {cell['honest']} | "
                      f"{cell['refused']} | {cell['crash']} | {cell['WRONG']} | {ms:.2f} |")
@@ -157,6 +184,8 @@ def main(argv: list[str] | None = None) -> int:
                     "(must not exist yet)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated classes")
     ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
+    ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
+                    "files (Siconos LCP format or .npz) instead of generated problems")
     args = ap.parse_args(argv)
     classes = tuple(c for c in args.classes.split(",") if c)
     bad = [c for c in classes if c not in CLASSES]
@@ -170,10 +199,19 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     methods = tuple(args.methods.split(",")) if args.methods else None
     t0 = time.perf_counter()
-    result = run_fuzz(args.count, args.seed, args.out, classes, methods)
+    if args.files:
+        missing = [f for f in args.files if not Path(f).is_file()]
+        if missing:
+            print(f"rigidlcp fuzz: error: no such file {missing[0]}", file=sys.stderr)
+            return 2
+        result = run_files(args.files, methods, args.out)
+        what = f"{len(args.files)} files"
+    else:
+        result = run_fuzz(args.count, args.seed, args.out, classes, methods)
+        what = f"{args.count} problems, seed {args.seed}"
     print(format_table(result))
     wrong = sum(c["WRONG"] + c["crash"] for c in result["table"].values())
-    print(f"\n{args.count} problems, seed {args.seed}, {time.perf_counter() - t0:.0f} s; "
+    print(f"\n{what}, {time.perf_counter() - t0:.0f} s; "
           f"{wrong} silent-wrong or crashing answers"
           + (f" saved in {args.out}" if args.out and wrong else ""))
     return 1 if wrong else 0

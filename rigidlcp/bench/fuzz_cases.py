@@ -5,7 +5,9 @@ or a Farkas vector (infeasible). The judge uses these facts, never a solver's wo
 Classes (n from 2 to 60, drawn log-uniformly):
 
 P            M = S + K, S symmetric positive definite, K skew: (M + M^T)/2 = S > 0, so M is P.
-ill-P        the same with eigenvalues of S spread over 1 .. 1e-14 (cond(M) up to ~1e14-1e16).
+ill-P        the same with eigenvalues of S spread over 1 .. 1e-6 to 1e-16.5 (cond(M) up to ~3e16);
+             counted as P (judged as such) only when lambda_min((M + M^T)/2), computed, exceeds
+             100 n eps lambda_max: beyond that the float matrix need not be P.
 PSD          M = B B^T + K (rank n/2 or more), q from a planted solution (solvable).
 singular-PSD M = B B^T, B of rank ~n/3, planted solution (a continuum of solutions is typical).
 copositive+  M = S + N + K, S PSD of low rank, N > 0 entrywise: strictly copositive, solvable.
@@ -15,8 +17,9 @@ nonnegative  M >= 0 entrywise with positive diagonal (strictly copositive: solva
 integer-tie  integer M (-3..3, diagonal 1..3) and q (-3..3): many exact ties; solvability open.
 scaled       a P-class problem with rows and columns scaled by 10^U(-8, 8) (same problem, other
              units): still a P-matrix.
-infeasible   M = P (S + K) P with P the projector orthogonal to y >= 0 and q^T y < 0: M is
-             copositive-plus, {z >= 0, M z + q >= 0} is empty (y is the Farkas vector).
+infeasible   M = P (S + K) P - eps y 1^T / y^T y, P the projector orthogonal to y >= 0, and
+             q^T y < 0 (robust_infeasible): M^T y = -eps 1, so {z >= 0, M z + q >= 0} is empty,
+             robustly (y is the Farkas vector).
 event        the LCP of an event of a small lattice (models.event_problem) with mixed friction
              (sliding and non-sliding contacts); solvability open.
 """
@@ -85,8 +88,12 @@ def make_case(kind: str, seed: int) -> Case:
         M = _spd(rng, n) + _skew(rng, n, rng.uniform(0, 1))
         return Case(kind, seed, M, rng.standard_normal(n), p_matrix=True, solvable=True)
     if kind == "ill-P":
-        M = _spd(rng, n, spread=rng.uniform(6, 14)) + _skew(rng, n, 1e-3 * rng.random())
-        return Case(kind, seed, M, rng.standard_normal(n), p_matrix=True, solvable=True)
+        M = _spd(rng, n, spread=rng.uniform(6, 16.5)) + _skew(rng, n, 1e-3 * rng.random())
+        # In floating point M is P for sure only if lambda_min((M + M^T)/2) clears rounding.
+        lam = np.linalg.eigvalsh(0.5 * (M + M.T))
+        sure = bool(lam[0] > 100 * n * np.finfo(float).eps * abs(lam[-1]))
+        return Case(kind, seed, M, rng.standard_normal(n), p_matrix=sure,
+                    solvable=True if sure else None, meta={"lambda_min": float(lam[0])})
     if kind in ("PSD", "singular-PSD"):
         k = max(1, n // 2 if kind == "PSD" else n // 3)
         B = rng.standard_normal((n, k if kind == "singular-PSD" else n))
@@ -124,16 +131,28 @@ def make_case(kind: str, seed: int) -> Case:
         return Case(kind, seed, r[:, None] * base.M * c[None, :], r * base.q, p_matrix=True,
                     solvable=True, meta={"r": r, "c": c})
     if kind == "infeasible":
-        y = np.where(rng.random(n) < 0.6, rng.random(n), 0.0)
-        y[rng.integers(n)] = 1.0
-        P = np.eye(n) - np.outer(y, y) / (y @ y)
-        M = P @ (_spd(rng, n) + _skew(rng, n)) @ P
-        q = rng.standard_normal(n)
-        q -= (q @ y + rng.uniform(0.1, 2.0)) * y / (y @ y)
+        M, q, y = robust_infeasible(rng, n)
         return Case(kind, seed, M, q, solvable=False, farkas=y)
     if kind == "event":
         return _event_case(rng, seed)
     raise ValueError(f"unknown class {kind!r}; classes: {', '.join(CLASSES)}")
+
+
+def robust_infeasible(rng: np.random.Generator, n: int):
+    """(M, q, y): M = P (S + K) P - eps y 1^T / (y^T y) (P the projector orthogonal to y >= 0),
+    so M^T y = -eps 1 with eps in [0.01, 0.1], and q^T y < 0: y proves {z >= 0 : M z + q >= 0}
+    empty, and so it does for every problem within relative distance ~eps / |M| (a *robust*
+    infeasibility). With eps = 0 (M^T y = 0 only up to rounding) the float problem has
+    neighbours at relative distance ~1e-16 with solutions of size ~1/eps_machine, which the
+    acceptance test (a relative backward error of 1e-8) rightly cannot tell from solutions."""
+    y = np.where(rng.random(n) < 0.6, rng.random(n), 0.0)
+    y[rng.integers(n)] = 1.0
+    P = np.eye(n) - np.outer(y, y) / (y @ y)
+    eps = rng.uniform(0.01, 0.1)
+    M = P @ (_spd(rng, n) + _skew(rng, n)) @ P - eps * np.outer(y, np.ones(n)) / (y @ y)
+    q = rng.standard_normal(n)
+    q -= (q @ y + rng.uniform(0.1, 2.0)) * y / (y @ y)
+    return M, q, y
 
 
 def _event_case(rng: np.random.Generator, seed: int) -> Case:
