@@ -1,4 +1,4 @@
-"""Hypothesis profiles for the whole suite (docs/testing.md).
+"""Hypothesis profiles for the whole suite (docs/fuzz.md, "Property tests").
 
 * "ci" (the default, and whenever the CI environment variable is set): derandomized, so the
   same code gives the same verdict on every run; no deadline (the machine is shared), no
