@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linprog
 
-import lcp
+from rigidlcp import lcp
 
 from .fuzz_cases import CLASSES, Case, make_case
 
@@ -142,7 +142,7 @@ def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | N
               ) -> dict:
     """Every method on LCP files (Siconos's LCP format, or lcp .npz), judged as the fuzz cases
     are but with nothing known by construction (class = the file name)."""
-    from verify.siconos_format import read_siconos_lcp
+    from rigidlcp.lcp.io.siconos import read_siconos_lcp
 
     names = methods or tuple(m.name for m in lcp.methods())
     table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})

@@ -156,7 +156,7 @@ def robust_infeasible(rng: np.random.Generator, n: int):
 
 
 def _event_case(rng: np.random.Generator, seed: int) -> Case:
-    import models
+    from rigidlcp import models
 
     kind = str(rng.choice(["rect", "tri"]))
     ly = int(rng.integers(1, 4))

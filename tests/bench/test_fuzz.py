@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-import lcp
+from rigidlcp import lcp
 from rigidlcp.bench.fuzz import judge, main, run_case, run_fuzz
 from rigidlcp.bench.fuzz_cases import CLASSES, Case, make_case
 

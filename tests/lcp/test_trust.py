@@ -12,14 +12,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import lcp
-from lcp import api
-from lcp.enumeration import _Scales, _singular_basis
-from lcp.farkas import find_certificate
-from lcp.residual import TOL, check, scaled_residual
-from lcp.scaling import ruiz
+from rigidlcp import lcp
 from rigidlcp.bench.fuzz_cases import robust_infeasible
-from verify.certify import certify
+from rigidlcp.lcp import api
+from rigidlcp.lcp.enumeration import _Scales, _singular_basis
+from rigidlcp.lcp.farkas import find_certificate
+from rigidlcp.lcp.residual import TOL, check, scaled_residual
+from rigidlcp.lcp.scaling import ruiz
+from rigidlcp.verify import certify
 
 SEEDS = st.integers(0, 2**32 - 1)
 

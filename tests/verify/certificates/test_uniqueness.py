@@ -198,7 +198,7 @@ def test_milp_finds_another_solution_for_the_issue_family():
 def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
     """A basis whose polish failed without proof (an LP that did not decide) may hold a
     solution: a MILP made infeasible by such cuts must not answer "none"."""
-    import verify.uniqueness as uq
+    import rigidlcp.verify.certificates.uniqueness as uq
 
     monkeypatch.setattr(uq, "_polish", lambda *a, **k: (None, False))
     z = np.array([2.0, 0.0, 1.0])
