@@ -33,6 +33,7 @@ import numpy as np
 from scipy.optimize import linprog
 
 from rigidlcp import lcp
+from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
 
@@ -176,8 +177,8 @@ def format_table(result: dict) -> str:
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="rigidlcp fuzz", description=__doc__.split("\n")[0])
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of `rigidlcp fuzz` (and of `python -m rigidlcp.bench.fuzz`)."""
     ap.add_argument("--count", type=int, default=1000, help="problems to draw (default 1000)")
     ap.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     ap.add_argument("--out", default=None, help="folder for the silent-wrong / crash cases "
@@ -186,24 +187,27 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
     ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
                     "files (Siconos LCP format or .npz) instead of generated problems")
-    args = ap.parse_args(argv)
+
+
+def run_from_args(args: argparse.Namespace) -> int:
+    """Run, print the table; 0 if no answer was silently wrong or crashed, else 1. Bad
+    arguments raise InvalidInput / OutputExists (one line and exit status 2 on the CLI)."""
     classes = tuple(c for c in args.classes.split(",") if c)
     bad = [c for c in classes if c not in CLASSES]
-    if bad or args.count < 1:
-        print(f"rigidlcp fuzz: error: unknown class(es) {bad}; classes: {', '.join(CLASSES)}"
-              if bad else "rigidlcp fuzz: error: --count must be >= 1", file=sys.stderr)
-        return 2
+    if bad:
+        raise InvalidInput(f"unknown class(es) {bad}; classes: {', '.join(CLASSES)}")
+    if args.count < 1:
+        raise InvalidInput(f"--count must be >= 1, got {args.count}")
     if args.out is not None and Path(args.out).exists():
-        print(f"rigidlcp fuzz: error: --out {args.out} exists; give a new folder",
-              file=sys.stderr)
-        return 2
+        raise OutputExists(f"--out {args.out} exists; give a new folder")
     methods = tuple(args.methods.split(",")) if args.methods else None
+    for m in methods or ():
+        lcp.get_method(m)  # an unknown name raises InvalidProblem
     t0 = time.perf_counter()
     if args.files:
         missing = [f for f in args.files if not Path(f).is_file()]
         if missing:
-            print(f"rigidlcp fuzz: error: no such file {missing[0]}", file=sys.stderr)
-            return 2
+            raise InvalidInput(f"no such file {missing[0]}")
         result = run_files(args.files, methods, args.out)
         what = f"{len(args.files)} files"
     else:
@@ -215,6 +219,17 @@ def main(argv: list[str] | None = None) -> int:
           f"{wrong} silent-wrong or crashing answers"
           + (f" saved in {args.out}" if args.out and wrong else ""))
     return 1 if wrong else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="rigidlcp fuzz", description=__doc__.split("\n")[0])
+    add_arguments(ap)
+    args = ap.parse_args(argv)
+    try:
+        return run_from_args(args)
+    except (RigidLCPError, ValueError) as exc:
+        print(f"rigidlcp fuzz: error: {exc}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

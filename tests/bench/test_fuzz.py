@@ -51,9 +51,25 @@ def test_the_judge_calls_a_false_infeasible_wrong():
     assert judge(c, "infeasible", c.q * 0)[0] == "WRONG"
 
 
-def test_bad_arguments_exit_2(tmp_path, capsys):
-    assert main(["--count", "1", "--out", str(tmp_path)]) == 2  # exists: never overwritten
-    assert main(["--classes", "nope"]) == 2
-    assert main(["--files", str(tmp_path / "missing.dat")]) == 2
+@pytest.mark.parametrize("entry", ["module", "cli"])
+def test_bad_arguments_exit_2(tmp_path, capsys, entry):
+    from rigidlcp.cli.main import main as cli
+
+    run = main if entry == "module" else (lambda argv: cli(["fuzz", *argv]))
+    assert run(["--count", "1", "--out", str(tmp_path)]) == 2  # exists: never overwritten
+    assert run(["--classes", "nope"]) == 2
+    assert run(["--files", str(tmp_path / "missing.dat")]) == 2
+    assert run(["--methods", "nope"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 3 and "Traceback" not in err
+    assert err.count("\n") == 4 and "Traceback" not in err
+
+
+def test_the_cli_runs_and_saves_nothing_when_all_is_well(tmp_path, capsys):
+    from rigidlcp.cli.main import main as cli
+
+    out = tmp_path / "fuzz"
+    assert cli(["fuzz", "--count", "3", "--seed", "5", "--methods", "lemke,pivoting",
+                "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "| P | lemke | 1 |" in text and "0 silent-wrong" in text
+    assert not out.exists() or not any(out.iterdir())
