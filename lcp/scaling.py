@@ -23,6 +23,9 @@ import numpy as np
 
 #: Ruiz sweeps (each halves the log-imbalance of rows and columns; 1e16 -> ~1 in 8 sweeps).
 SWEEPS = 12
+#: A matrix whose every row and column maximum is within this factor of the largest entry is
+#: left as it is (only q's unit is changed): the sweeps cost O(n^2) each, for nothing.
+BALANCED = 16.0
 
 
 @dataclass(frozen=True)
@@ -59,16 +62,21 @@ def ruiz(M: np.ndarray, q: np.ndarray, sweeps: int = SWEEPS) -> Equilibration:
     n = q.size
     r, c = np.ones(n), np.ones(n)
     A = np.abs(M)
-    for _ in range(sweeps):
-        S = A * r[:, None] * c[None, :]
-        rmax = S.max(axis=1)
-        rf = np.where(rmax > 0, _pow2(1.0 / np.sqrt(np.where(rmax > 0, rmax, 1.0))), 1.0)
+    rmax, cmax = A.max(axis=1), A.max(axis=0)
+    top = float(rmax.max())
+    if top > 0 and rmax.min() >= top / BALANCED and cmax.min() >= top / BALANCED:
+        sweeps = 0  # already balanced (e.g. every event LCP): Ruiz would change nothing useful
+    for sweep in range(sweeps):
+        rmax = (A * c).max(axis=1) * r
+        rf = _pow2(1.0 / np.sqrt(np.where(rmax > 0, rmax, 1.0)))
         r *= rf
-        S = A * r[:, None] * c[None, :]
-        cmax = S.max(axis=0)
-        cf = np.where(cmax > 0, _pow2(1.0 / np.sqrt(np.where(cmax > 0, cmax, 1.0))), 1.0)
+        cmax = (A * r[:, None]).max(axis=0) * c
+        cf = _pow2(1.0 / np.sqrt(np.where(cmax > 0, cmax, 1.0)))
         c *= cf
-        if np.all(rf == 1.0) and np.all(cf == 1.0):
+        # stop when no factor moves, or (after a few sweeps) none by more than a factor 2:
+        # every row and column maximum is then within [1/4, 4], which is all that is needed
+        moved = max(float(np.abs(np.log2(rf)).max()), float(np.abs(np.log2(cf)).max()))
+        if moved == 0 or (sweep >= 3 and moved <= 1):
             break
     qmax = float(np.max(np.abs(q * r)))
     if qmax > 0:

@@ -117,7 +117,8 @@ def save_case(case: Case, method: str, result: dict, out: Path) -> Path:
 def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
              classes: tuple[str, ...] = CLASSES, methods: tuple[str, ...] | None = None,
              progress=None) -> dict:
-    """Fuzz `count` problems; returns {(class, method): {outcome: count, "seconds": [...]}}."""
+    """Fuzz `count` problems; returns {"table": {(class, method): {outcome: count, "seconds":
+    [...]}}, "saved": [paths], ...}. `progress(k, partial_result)` is called after each."""
     names = methods or tuple(m.name for m in lcp.methods())
     out_dir = Path(out) if out is not None else None
     table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
@@ -135,7 +136,8 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
             if res["outcome"] in ("WRONG", "crash") and out_dir is not None:
                 saved.append(save_case(case, method, res, out_dir))
         if progress is not None:
-            progress(k + 1)
+            progress(k + 1, {"table": dict(table), "saved": saved, "count": k + 1,
+                             "seed": seed})
     return {"table": dict(table), "saved": saved, "count": count, "seed": seed}
 
 
@@ -185,6 +187,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
                     "(must not exist yet)")
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated classes")
     ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
+    ap.add_argument("--progress", type=int, default=0, metavar="K",
+                    help="print the table so far to stderr every K problems (default: never)")
     ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
                     "files (Siconos LCP format or .npz) instead of generated problems")
 
@@ -211,7 +215,15 @@ def run_from_args(args: argparse.Namespace) -> int:
         result = run_files(args.files, methods, args.out)
         what = f"{len(args.files)} files"
     else:
-        result = run_fuzz(args.count, args.seed, args.out, classes, methods)
+        every = max(1, args.progress)
+
+        def progress(k: int, partial: dict) -> None:
+            if k % every == 0 and k < args.count:
+                print(f"[{k} of {args.count} problems, {time.perf_counter() - t0:.0f} s]\n"
+                      + format_table(partial), file=sys.stderr, flush=True)
+
+        result = run_fuzz(args.count, args.seed, args.out, classes, methods,
+                          progress=progress if args.progress else None)
         what = f"{args.count} problems, seed {args.seed}"
     print(format_table(result))
     wrong = sum(c["WRONG"] + c["crash"] for c in result["table"].values())
