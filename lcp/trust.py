@@ -14,8 +14,11 @@ The run (called by `lcp.api.solve` with a validated problem):
 4. "infeasible" is kept only with a checked Farkas certificate (lcp.farkas), found by HiGHS on
    the equilibrated problem; otherwise the same alternatives as in 3 are tried, and if none
    solves the problem the status becomes "failed" (the claim could not be proved);
-5. "ray", "max_iter" and "failed" of a method run with equilibration are retried once with the
-   other setting; a solution found that way (and checked) is returned.
+5. "ray", "max_iter" and "failed" are retried once with the other equilibration setting; a
+   solution found that way (and checked) is returned. Otherwise, if the LP finds a Farkas
+   certificate the status becomes "infeasible"; if it finds none and M is copositive-plus
+   (M + M^T PSD), the LCP has a solution (Lemke's theorem) and the fall-back methods of 3 are
+   tried; else the method's status stays.
 """
 
 from __future__ import annotations
@@ -220,6 +223,14 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
             if alt is not None:
                 return alt
         cert = find_certificate(run.eq(True), sol.info.get("farkas"))
+        if cert is None and repair and numerically_psd(run.lcp.M + run.lcp.M.T):
+            # M copositive-plus and no certificate: by Lemke's theorem (Cottle-Pang-Stone
+            # 4.4.13) a feasible LCP of this kind has a solution, so the method's stop is
+            # numerical trouble: let the other methods find it.
+            got = run.first_accepted(name, equilibrate, options, same_only=False)
+            if got is not None:
+                return _adopt(sol, got, f"it had ended with status {sol.status!r} on a "
+                              "copositive-plus M with no certificate of infeasibility")
         if cert is not None:
             sol.info.update(cert.as_info())
             sol.info["status_of_method"] = sol.status
