@@ -11,8 +11,10 @@ LCP (w = M z + q, 0 <= z perp w >= 0). With the scales
 zero iff z >= 0, w >= 0 and z_i w_i = 0, and invariant when (M, q) is multiplied by a positive
 number or z's unit changes. MLCP (A u + C v + a = 0, w = D u + B v + b): the complementarity part
 is measured on the Schur-reduced LCP (M = B - D A^-1 C, q = b - D A^-1 a) when A is invertible,
-else with z_s = |v|_inf and w_s = |w|_inf; the equality residual max|A u + C v + a| is divided
-by |a|_inf + ||A||_inf |u|_inf + ||C||_inf |v|_inf. Accepted iff both are <= TOL.
+else with z_s = max(|v|_inf, |b|_inf / ||B||_inf) and w_s = |b|_inf + ||D||_inf |u|_inf +
+||B||_inf |v|_inf (lcp.mlcp_full.check_mlcp uses this function); the equality residual
+max|A u + C v + a| is divided by |a|_inf + ||A||_inf |u|_inf + ||C||_inf |v|_inf. Accepted iff
+both are <= TOL.
 """
 
 from __future__ import annotations
@@ -105,9 +107,12 @@ def _check(problem, z: np.ndarray, u, tol: float, lcp_form) -> Check:
                 lcp_form = None
         if lcp_form is not None:
             zs, ws = scales(lcp_form.M, lcp_form.q, z)
-        else:
-            zs = max(float(np.max(np.abs(z), initial=0.0)), 1e-300)
-            ws = max(float(np.max(np.abs(w), initial=0.0)), 1e-300)
+        else:  # no Schur reduction (A singular): the scales of the full system
+            un = float(np.max(np.abs(u), initial=0.0))
+            vn = float(np.max(np.abs(z), initial=0.0))
+            bn = float(np.max(np.abs(problem.b), initial=0.0))
+            zs = max(vn, bn / max(norm_inf(problem.B), 1e-300), 1e-300)
+            ws = max(bn + norm_inf(problem.D) * un + norm_inf(problem.B) * vn, 1e-300)
     scaled = float(np.max(np.abs(np.minimum(z / zs, w / ws)))) if z.size else 0.0
     raw = float(np.max(np.abs(np.minimum(z, w)))) if z.size else 0.0
     return Check(w=w, residual=raw, scaled_residual=scaled, eq_residual=float(eq),
