@@ -37,7 +37,8 @@ from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
 
-#: enumerate (2^n bases) is run for n up to this in the fuzz.
+#: The exhaustive methods (accepts "small-n": enumerate, enumerate-mlcp; 2^n bases) are run
+#: for n up to this in the fuzz.
 ENUM_MAX_N = 10
 #: Acceptance tolerance of verify.certify.
 TOL = 1e-8
@@ -120,6 +121,7 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
     """Fuzz `count` problems; returns {"table": {(class, method): {outcome: count, "seconds":
     [...]}}, "saved": [paths], ...}. `progress(k, partial_result)` is called after each."""
     names = methods or tuple(m.name for m in lcp.methods())
+    exhaustive = {m.name for m in lcp.methods() if m.accepts == "small-n"}
     out_dir = Path(out) if out is not None else None
     table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
     saved: list[Path] = []
@@ -127,7 +129,7 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
         kind = classes[k % len(classes)]
         case = make_case(kind, seed * 1_000_003 + k)
         for method in names:
-            if method == "enumerate" and case.n > ENUM_MAX_N:
+            if method in exhaustive and case.n > ENUM_MAX_N:
                 continue
             res = run_case(case, method)
             cell = table[(kind, method)]
@@ -148,13 +150,14 @@ def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | N
     from rigidlcp.lcp.io.siconos import read_siconos_lcp
 
     names = methods or tuple(m.name for m in lcp.methods())
+    exhaustive = {m.name for m in lcp.methods() if m.accepts == "small-n"}
     table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
     saved: list[Path] = []
     for path in map(Path, paths):
         P = lcp.load(path) if path.suffix == ".npz" else read_siconos_lcp(path)
         case = Case(path.stem, 0, P.M, P.q)
         for method in names:
-            if method == "enumerate" and case.n > ENUM_MAX_N:
+            if method in exhaustive and case.n > ENUM_MAX_N:
                 continue
             res = run_case(case, method)
             cell = table[(path.stem, method)]
