@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog
 
 from .scaling import Equilibration
 
@@ -88,6 +87,12 @@ def _polish(eq: Equilibration, y: np.ndarray) -> np.ndarray:
     return y
 
 
+def _linprog(*args, **kwargs):
+    from scipy.optimize import linprog  # loaded on first use: `import rigidlcp.lcp` stays cheap
+
+    return linprog(*args, **kwargs)
+
+
 def _interior(eq: Equilibration) -> np.ndarray:
     """The most robust certificate: max t with M~^T y + t 1 <= 0, q~^T y + t <= 0, sum y = 1,
     y >= 0, t <= 1. When t > 0 every inequality holds with margin t, far above HiGHS's
@@ -96,7 +101,7 @@ def _interior(eq: Equilibration) -> np.ndarray:
     A = np.vstack([np.column_stack([eq.M.T, np.ones(n)]), np.r_[eq.q, 1.0][None, :]])
     c = np.zeros(n + 1)
     c[-1] = -1.0
-    res = linprog(c, A_ub=A, b_ub=np.zeros(n + 1), A_eq=np.r_[np.ones(n), 0.0][None, :],
+    res = _linprog(c, A_ub=A, b_ub=np.zeros(n + 1), A_eq=np.r_[np.ones(n), 0.0][None, :],
                   b_eq=[1.0], bounds=[(0, None)] * n + [(None, 1.0)], method="highs",
                   options=_HIGHS)
     if res.status != 0 or res.x is None or res.x[-1] <= 0:
@@ -114,7 +119,7 @@ def find_certificate(eq: Equilibration, candidate: np.ndarray | None = None) -> 
         if cand.shape == (n,) and np.all(np.isfinite(cand)):
             found = check_certificate(eq, cand / eq.r)
     if found is None:
-        res = linprog(eq.q, A_ub=eq.M.T, b_ub=np.zeros(n), A_eq=np.ones((1, n)), b_eq=[1.0],
+        res = _linprog(eq.q, A_ub=eq.M.T, b_ub=np.zeros(n), A_eq=np.ones((1, n)), b_eq=[1.0],
                       bounds=[(0, None)] * n, method="highs", options=_HIGHS)
         if res.status != 0 or res.x is None:
             return None
@@ -125,7 +130,7 @@ def find_certificate(eq: Equilibration, candidate: np.ndarray | None = None) -> 
             found = check_certificate(eq, _interior(eq))
         if found is None:
             return None
-    primal = linprog(np.zeros(n), A_ub=-eq.M, b_ub=eq.q, bounds=[(0, None)] * n,
+    primal = _linprog(np.zeros(n), A_ub=-eq.M, b_ub=eq.q, bounds=[(0, None)] * n,
                      method="highs", options=_HIGHS)
     if primal.status != 2:  # HiGHS finds feasible points (or cannot decide): no claim
         return None

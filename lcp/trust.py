@@ -27,7 +27,6 @@ import traceback
 from collections.abc import Callable
 
 import numpy as np
-from scipy.linalg import LinAlgError, lu_factor, lu_solve
 
 from .farkas import find_certificate, numerically_psd
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable
@@ -55,7 +54,7 @@ def attempt(func: Callable[..., Solution], name: str, eq: Equilibration, options
         sol = func(eq.M, eq.q, **options)
     except (InvalidProblem, NotApplicable):
         raise
-    except (ValueError, ArithmeticError, LinAlgError) as exc:
+    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
         return Solution(z=np.zeros(n), w=eq.q.copy(), status="failed", method=name,
                         message=f"the method raised {type(exc).__name__}: {exc}",
                         info={"exception": "".join(traceback.format_exception_only(exc))})
@@ -81,6 +80,8 @@ def refactorize(eq: Equilibration, basis) -> np.ndarray | None:
     equilibrated M~_aa with one step of iterative refinement, in the user's units."""
     if basis is None:
         return None
+    from scipy.linalg import lu_factor, lu_solve  # loaded on first use (cheap import)
+
     a = np.unique(np.asarray(basis, dtype=np.intp).reshape(-1))
     n = eq.q.size
     if a.size and (a.min() < 0 or a.max() >= n):
@@ -90,7 +91,7 @@ def refactorize(eq: Equilibration, basis) -> np.ndarray | None:
         Maa, qa = eq.M[np.ix_(a, a)], eq.q[a]
         try:
             lu = lu_factor(Maa, check_finite=True)
-        except (LinAlgError, ValueError):
+        except (np.linalg.LinAlgError, ValueError):
             return None
         za = -lu_solve(lu, qa)
         za -= lu_solve(lu, Maa @ za + qa)
