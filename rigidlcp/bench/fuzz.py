@@ -30,7 +30,6 @@ from collections import defaultdict
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import linprog
 
 from rigidlcp import lcp
 from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
@@ -60,6 +59,8 @@ def judge_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
 
 def lp_feasible(M: np.ndarray, q: np.ndarray) -> bool | None:
     """Has {z >= 0 : M z + q >= 0} a point? (HiGHS; rows normalized by their largest entry.)"""
+    from scipy.optimize import linprog  # on first use: `rigidlcp --help` loads no scipy
+
     s = np.maximum(np.abs(M).max(axis=1), np.abs(q))
     s[s == 0] = 1.0
     res = linprog(np.zeros(q.size), A_ub=-M / s[:, None], b_ub=q / s,
