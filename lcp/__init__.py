@@ -1,5 +1,6 @@
 """rigidlcp's pure mathematics: LCP/MLCP problems, solvers, residuals. Knows nothing of disks."""
 
+from . import residual
 from .api import MethodInfo, get_method, methods, register, solve
 from .batch import solve_many
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable, load
@@ -8,7 +9,7 @@ from .solution import STATUSES, Solution, complementarity_residual
 __all__ = [
     "LCP", "MLCP", "InvalidProblem", "NotApplicable", "load", "Solution", "STATUSES",
     "complementarity_residual", "solve", "solve_many", "methods", "get_method", "register",
-    "MethodInfo", "enumerate_solutions", "FrictionContact2D", "natural_residual",
+    "MethodInfo", "enumerate_solutions", "FrictionContact2D", "natural_residual", "residual",
 ]
 
 

@@ -1,9 +1,10 @@
 """One entry point, `solve(problem, method=...)`, and the registry of methods.
 
 A method is a function `fn(M, q, **options) -> Solution` on a validated dense LCP; it is
-registered with `@register(name, accepts=..., description=...)`. `solve` validates the problem,
-reduces an MLCP to an LCP (Schur complement), calls the method, recomputes w = M z + q and the
-residual itself (a method's own bookkeeping is never trusted), and recovers u for an MLCP.
+registered with `@register(name, accepts=..., description=..., equilibrate=False)`. `solve`
+validates the problem, reduces an MLCP to an LCP (Schur complement), calls the method (on the
+Ruiz-equilibrated data when `equilibrate`), and checks the answer on the user's problem with the
+acceptance test of `lcp.residual` (a method's own bookkeeping is never trusted): see lcp.trust.
 """
 
 from __future__ import annotations
@@ -12,10 +13,10 @@ import inspect
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from .problem import LCP, MLCP, InvalidProblem, NotApplicable
-from .solution import Solution, complementarity_residual
+from .residual import TOL
+from .solution import Solution
+from .trust import Run, solve_checked
 
 #: What a method accepts, as shown by `methods()`.
 ACCEPTS = {
@@ -36,6 +37,7 @@ class MethodInfo:
     func: Callable[..., Solution]
     #: problem kind ("mlcp", "friction-2d") -> a function taking that problem object itself
     native: dict[str, Callable[..., Solution]] = field(default_factory=dict)
+    equilibrate: bool = False  # solve() runs it on Ruiz-equilibrated data by default
 
     def __str__(self) -> str:
         limit = f", n <= {self.max_n}" if self.max_n else ""
@@ -48,10 +50,13 @@ _REGISTRY: dict[str, MethodInfo] = {}
 
 
 def register(name: str, *, accepts: str, description: str, max_n: int | None = None,
-             native: dict[str, Callable[..., Solution]] | None = None):
+             native: dict[str, Callable[..., Solution]] | None = None,
+             equilibrate: bool = False):
     """Decorator adding a method to the registry. `native` maps a problem kind ("mlcp",
     "friction-2d") to a function `fn(problem, **options)` that solves it without reduction;
-    a method that accepts "friction-2d" is itself such a function."""
+    a method that accepts "friction-2d" is itself such a function. `equilibrate`: whether
+    `solve` runs it on the Ruiz-equilibrated problem by default (for methods whose answer
+    depends on the units)."""
     if accepts not in ACCEPTS:
         raise ValueError(f"accepts must be one of {sorted(ACCEPTS)}, got {accepts!r}")
 
@@ -59,7 +64,7 @@ def register(name: str, *, accepts: str, description: str, max_n: int | None = N
         params = inspect.signature(func).parameters
         options = tuple(p for p in params if params[p].kind is inspect.Parameter.KEYWORD_ONLY)
         _REGISTRY[name] = MethodInfo(name, accepts, description, options, max_n, func,
-                                     dict(native or {}))
+                                     dict(native or {}), equilibrate)
         return func
 
     return deco
@@ -98,9 +103,19 @@ def get_method(name: str) -> MethodInfo:
         ) from None
 
 
-def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
+def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | None = None,
+          repair: bool = True, **options) -> Solution:
     """Solve an LCP (w = M z + q, 0 <= z perp w >= 0) or an MLCP by the named method.
 
+    Every answer is checked on the problem passed, with `lcp.residual.check` (the acceptance
+    test of verify.certify, tolerance `lcp.residual.TOL` = 1e-8 on the scaled residual): a
+    "solved" that fails it is repaired or becomes "inaccurate"; an "infeasible" needs a checked
+    Farkas certificate (lcp.farkas). See lcp.trust for the steps.
+
+    equilibrate: run the method on the Ruiz-equilibrated problem (lcp.scaling); default: the
+    method's registered setting (on for lemke, pivoting and enumerate). repair: allow the
+    repairs of lcp.trust (other scaling, fall-back methods); a false "solved" is never returned
+    either way. Other keyword arguments are the method's options.
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
@@ -137,20 +152,10 @@ def solve(problem: LCP | MLCP, method: str = "lemke", **options) -> Solution:
         raise NotApplicable(
             f"method {method!r} is limited to n <= {info.max_n}; this LCP has n = {lcp.n}"
         )
-    sol = info.func(lcp.M, lcp.q, **options)
+    on = info.equilibrate if equilibrate is None else bool(equilibrate)
+    run = Run(problem, lcp, get_method, TOL)
+    sol = solve_checked(run, method, on, bool(repair), options)
     sol.method = method
-    z = np.asarray(sol.z, dtype=float)
-    if z.shape != (lcp.n,) or not np.all(np.isfinite(z)):
-        sol.status = "failed" if sol.status == "solved" else sol.status
-        sol.message = (sol.message + "; " if sol.message else "") + "method returned a bad z"
-        z = np.where(np.isfinite(z), z, 0.0) if z.shape == (lcp.n,) else np.zeros(lcp.n)
-    sol.z = z
-    if isinstance(problem, MLCP):
-        sol.u = problem.recover_u(z)
-        sol.w, sol.eq_residual = problem.residuals(sol.u, z)
-    else:
-        sol.w = lcp.M @ z + lcp.q
-    sol.residual = complementarity_residual(sol.z, sol.w)
     return sol
 
 

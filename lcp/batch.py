@@ -94,26 +94,44 @@ def _stacked(Ms, qs) -> tuple[np.ndarray, np.ndarray]:
 def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
                  problem_of) -> list[Solution]:
     """Solve the stacked (validated, finite) problems; problem_of(i) is problem i as an LCP
-    (built only when a problem must be solved one by one)."""
+    (built only when a problem must be solved one by one). As `solve` does (lcp.trust): the
+    method runs on the Ruiz-equilibrated data when it is registered so, and each answer is
+    checked on the problem passed (lcp.residual); an answer that is not an accepted "solved"
+    is redone by `solve` itself (repairs, certificates of infeasibility)."""
+    from .residual import check
+    from .scaling import ruiz
+
     k, n = qs.shape
+    on = get_method(method).equilibrate
+    eqs = [ruiz(Ms[i], qs[i]) for i in range(k)] if on else None
+    Mr = np.stack([e.M for e in eqs]) if eqs else Ms
+    qr = np.stack([e.q for e in eqs]) if eqs else qs
     if method == "lemke" and _kernel.enabled() and k:
-        return _lemke_batch(Ms, qs, options, problem_of)
-    func = get_method(method).func
-    sols = []
-    for i in range(k):
-        sol = func(Ms[i], qs[i], **options)
-        sol.method = method
-        sols.append(sol)
-    Z = np.zeros((k, n))
-    bad = np.zeros(k, bool)
+        sols = _lemke_batch(Mr, qr, options, problem_of)
+    else:
+        func = get_method(method).func
+        sols = []
+        for i in range(k):
+            sol = func(Mr[i], qr[i], **options)
+            sol.method = method
+            sols.append(sol)
+    out = []
     for i, sol in enumerate(sols):
+        if sol.info.get("equilibrated") is not None:  # already the answer of `solve`
+            out.append(sol)
+            continue
         z = np.asarray(sol.z, dtype=float)
-        if z.shape == (n,) and np.isfinite(z).all():
-            Z[i] = z
-        else:
-            bad[i] = True
-    _verify(Ms, qs, Z, sols, bad)
-    return sols
+        if sol.status == "solved" and z.shape == (n,) and np.isfinite(z).all():
+            z = eqs[i].z_back(z) if eqs else z
+            chk = check(LCP(Ms[i], qs[i]), z)
+            if chk.accepted:
+                sol.z, sol.w, sol.residual = z, chk.w, chk.residual
+                sol.scaled_residual = chk.scaled_residual
+                sol.info["equilibrated"] = on
+                out.append(sol)
+                continue
+        out.append(solve(problem_of(i), method, **options))
+    return out
 
 
 def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, options: dict, problem_of) -> list[Solution]:
@@ -142,24 +160,3 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, options: dict, problem_of) -> l
         else:  # a ray, a pivot limit or a cycle: the single call gives its evidence
             sols.append(solve(problem_of(i), "lemke", **options))
     return sols
-
-
-def _verify(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, sols: list[Solution],
-            bad: np.ndarray) -> None:
-    """What `solve` does to one answer, for all at once: w = M z + q recomputed, the residual
-    max|min(z, w)| stored, a non-finite z marks the solution failed (z replaced by zeros)."""
-    if not sols:
-        return
-    W = np.einsum("kij,kj->ki", Ms, Z) + qs
-    res = np.abs(np.minimum(Z, W)).max(axis=1)
-    for i, sol in enumerate(sols):
-        if bad[i]:
-            sol.status = "failed" if sol.status == "solved" else sol.status
-            sol.message = (sol.message + "; " if sol.message else "") + "method returned a bad z"
-            z = np.asarray(sol.z, dtype=float)
-            z = np.where(np.isfinite(z), z, 0.0) if z.shape == Z[i].shape else np.zeros_like(Z[i])
-            sol.z, sol.w = z, Ms[i] @ z + qs[i]
-            sol.residual = float(np.abs(np.minimum(sol.z, sol.w)).max())
-        else:
-            sol.z, sol.w, sol.residual = Z[i], W[i], float(res[i])
-

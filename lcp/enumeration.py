@@ -179,6 +179,8 @@ def _singular_basis(
     if np.any(b_ub[free_rows] < 0):
         return None
     d = N.shape[1]
+    if d == 0:  # full rank by the SVD (the cheaper condition estimate said singular): one point
+        return (zp, False) if np.all(b_ub >= 0) else None
     bounds = [(None, None)] * d
     res = linprog(N.sum(axis=0), A_ub=A_ub, b_ub=b_ub, bounds=bounds, method="highs",
                   options=_HIGHS)
@@ -344,7 +346,7 @@ def _check_tol(tol: float) -> None:
 
 
 @register(
-    "enumerate", accepts="small-n", max_n=MAX_N,
+    "enumerate", accepts="small-n", max_n=MAX_N, equilibrate=True,
     description="Every complementary basis (2^n solves; singular bases by LP): all solutions, "
     "hence uniqueness; returns the first (or the min-norm) one.",
 )

@@ -27,6 +27,7 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from .api import register
+from .farkas import numerically_psd
 from .problem import InvalidProblem, as_matrix, as_vector
 from .solution import Solution
 
@@ -43,6 +44,7 @@ _EPS = np.finfo(float).eps
 @register(
     "lemke",
     accepts="any",
+    equilibrate=True,
     description="Lemke's complementary pivot method (covering vector d, lexicographic ratio test)",
 )
 def lemke(
@@ -393,7 +395,7 @@ class _Lemke:
         checked, to rounding, whatever M is.
         """
         M, q, n = self.M, self.q, self.n
-        info["copositive_plus"] = psd = _numerically_psd(M + M.T)
+        info["copositive_plus"] = psd = numerically_psd(M + M.T)
         y = np.maximum(dz, 0.0)
         if y.sum() <= 0:
             return False, "the ray has dz = 0 (no certificate)"
@@ -412,15 +414,3 @@ class _Lemke:
                            "proves infeasibility, but its certificate fails numerically "
                            f"(max M^T y = {slack:.3g}, q^T y = {qTy:.3g}): numerical trouble")
         return False, "M is not known to be copositive-plus: the ray proves nothing"
-
-
-def _numerically_psd(S: np.ndarray) -> bool:
-    """Is the symmetric S positive semidefinite to rounding? Cholesky of S + delta I with
-    delta = 100 n eps ||S||_F succeeds iff (to rounding) lambda_min(S) > -delta."""
-    n = S.shape[0]
-    delta = 100 * n * _EPS * max(float(np.linalg.norm(S)), 1e-300)
-    try:
-        np.linalg.cholesky(S + delta * np.eye(n))
-    except np.linalg.LinAlgError:
-        return False
-    return True

@@ -20,6 +20,7 @@ import numpy as np
 
 from .api import register
 from .problem import LCP, MLCP, NotApplicable
+from .residual import check
 from .solution import Solution, complementarity_residual
 
 #: relative acceptance of an unreduced MLCP answer (verify.certify's default tol)
@@ -50,12 +51,9 @@ def check_mlcp(problem: MLCP, sol: Solution, tol: float = MLCP_TOL) -> Solution:
     w, eq = problem.residuals(u, v)
     sol.z, sol.u, sol.w, sol.eq_residual = v, u, w, eq
     sol.residual = complementarity_residual(v, w)
-    un, vn = float(np.max(np.abs(u), initial=0.0)), float(np.max(np.abs(v), initial=0.0))
-    eq_scale = float(np.max(np.abs(problem.a))) + _norm(problem.A) * un + _norm(problem.C) * vn
-    w_scale = float(np.max(np.abs(problem.b))) + _norm(problem.D) * un + _norm(problem.B) * vn
-    z_scale = max(vn, float(np.max(np.abs(problem.b))) / max(_norm(problem.B), 1e-300), 1e-300)
-    scaled = float(np.max(np.abs(np.minimum(v / z_scale, w / max(w_scale, 1e-300)))))
-    scaled_eq = eq / eq_scale if eq_scale > 0 else eq
+    chk = check(problem, v, u, tol=tol)  # the acceptance test of lcp.solve and certify
+    scaled, scaled_eq = chk.scaled_residual, chk.scaled_eq_residual
+    sol.scaled_residual = max(scaled, scaled_eq)
     sol.info["scaled_residual"], sol.info["scaled_eq_residual"] = scaled, scaled_eq
     if sol.status == "solved" and not (scaled <= tol and scaled_eq <= tol):
         sol.status = "not_converged"

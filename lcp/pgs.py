@@ -73,7 +73,9 @@ def solve_pgs(
             res = complementarity_residual(z, w)
         if not math.isfinite(res):
             z = np.where(np.isfinite(z), z, 0.0)
-            return Solution(z=z, w=M @ z + q, status="failed", method="pgs", iterations=sweeps,
+            with np.errstate(over="ignore", invalid="ignore"):
+                w = M @ z + q
+            return Solution(z=z, w=w, status="failed", method="pgs", iterations=sweeps,
                             message=f"the iterate overflowed after {sweeps} sweeps (diverged)",
                             info={"residual": res, "omega": omega})
     info = {"residual": res, "target": target, "omega": omega}

@@ -182,7 +182,7 @@ def _infeasible(z: np.ndarray, w: np.ndarray, alpha: np.ndarray, M: np.ndarray,
 
 
 @register(
-    "pivoting", accepts="any",
+    "pivoting", accepts="any", equilibrate=True,
     description="The paper's contact-state iteration: block principal pivoting (Judice-Pires) "
     "with Murty's least-index / criss-cross single pivots; warm start with active=.",
 )

@@ -9,9 +9,11 @@ import numpy as np
 
 #: Statuses a method may return. Only "solved" carries a solution; the others carry evidence.
 STATUSES = {
-    "solved": "a complementary solution was found",
+    "solved": "a complementary solution, checked: scaled residual <= lcp.residual.TOL",
     "ray": "Lemke ended on a secondary ray (no conclusion unless M is copositive-plus)",
-    "infeasible": "the LCP has no solution (proved: ray with copositive-plus M)",
+    "infeasible": "the LCP has no solution (proved: a checked Farkas certificate in info)",
+    "inaccurate": "the answer fails the acceptance test and no repair passed it; z is the best "
+    "point found and scaled_residual the evidence",
     "max_iter": "the iteration / pivot limit was reached",
     "not_converged": "an iterative method stopped above its tolerance",
     "failed": "the method failed (numerical breakdown); see message",
@@ -33,6 +35,8 @@ class Solution:
     status: one of STATUSES; iterations: pivots (pivoting methods) or sweeps (iterative);
     residual: max|min(z, w)| with w recomputed as M z + q (or D u + B v + b);
     eq_residual: max|A u + C v + a| for an MLCP (0 for an LCP);
+    scaled_residual: the acceptance measure of lcp.residual (the larger of the complementarity
+    and equality parts), set by `lcp.solve`: "solved" promises it is <= lcp.residual.TOL;
     basis: indices i with z_i basic (the active set), when the method defines one;
     info: evidence (the ray of Lemke, a cycle, ...), method-specific.
     """
@@ -44,6 +48,7 @@ class Solution:
     iterations: int = 0
     residual: float = np.inf
     eq_residual: float = 0.0
+    scaled_residual: float = np.nan  # lcp.residual's measure (with the MLCP equality part)
     basis: np.ndarray | None = None
     u: np.ndarray | None = None
     message: str = ""
@@ -63,7 +68,8 @@ class Solution:
         lines = [
             f"Solution(method={self.method!r}, status={self.status!r}, n={n})",
             f"  iterations : {self.iterations}",
-            f"  residual   : {self.residual:.3e}  (max|min(z, w)|)",
+            f"  residual   : {self.residual:.3e}  (max|min(z, w)|; scaled "
+            f"{self.scaled_residual:.3e})",
         ]
         if self.u is not None:
             lines.append(f"  eq_residual: {self.eq_residual:.3e}  (max|A u + C v + a|)")
@@ -90,6 +96,7 @@ class Solution:
         out = {
             "method": self.method, "status": self.status, "iterations": self.iterations,
             "residual": self.residual, "eq_residual": self.eq_residual,
+            "scaled_residual": self.scaled_residual,
             "message": self.message, "z": self.z, "w": self.w,
             "basis": self.basis, "u": self.u, "info": self.info,
         }

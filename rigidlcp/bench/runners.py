@@ -100,7 +100,10 @@ def _solve_here(problem, method: str) -> dict:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            sol = lcp.solve(problem, method=method)
+            # repair=False: the method's own answer (lcp.solve still checks it: a "solved"
+            # that fails becomes "inaccurate", an unproved "infeasible" "failed"), never
+            # another method's answer credited to it.
+            sol = lcp.solve(problem, method=method, repair=False)
     except lcp.NotApplicable as exc:
         return {"kind": "not_applicable", "message": str(exc), "time": 0.0}
     except Exception as exc:  # noqa: BLE001 - a harness reports, never dies

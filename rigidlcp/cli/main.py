@@ -26,6 +26,7 @@ COMMAND_MODULES = (
     "rigidlcp.cli.forces",  # forces
     "rigidlcp.cli.certify_run",  # certify-run
     "rigidlcp.cli.bench",  # bench
+    "rigidlcp.cli.fuzz",  # fuzz
     "rigidlcp.cli.reproduce",  # reproduce
 )
 

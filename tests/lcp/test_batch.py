@@ -68,7 +68,10 @@ def test_mixed_sizes_statuses_and_mlcp():
     problems = [*random_lcps(3, 5, 1), lcp.LCP(M, q), lcp.LCP(murty_matrix(6), murty_q(6)),
                 mlcp, *random_lcps(2, 7, 2)]
     sols = assert_same_as_loop(problems, max_iter=40)
-    assert [s.status for s in sols[3:5]] == ["infeasible", "max_iter"]
+    assert sols[3].status == "infeasible"
+    # Murty's example needs 2^6 pivots on its raw data; equilibrated (lcp.solve's default for
+    # lemke, issue 11) it is solved within 40, or a fall-back solves it: batch == loop above
+    assert sols[4].status in ("max_iter", "solved")
     assert sols[5].u is not None
 
 

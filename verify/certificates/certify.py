@@ -18,8 +18,8 @@ event LCP's w holds, besides a_n and a_plus, the slack 2 mu R - tau, a force; tw
 have the same accelerations and different w. For an MLCP the observable "u" (the free unknowns,
 the generalized accelerations of an event MLCP) is added.
 
-Acceptance (stated scaling): with z_s = max(|z|_inf, |q|_inf / |M|_max) and
-w_s = |q|_inf + ||M||_inf z_s (verify.certificates.uniqueness.scales), the scaled residual is
+Acceptance (lcp.residual.check, the same test lcp.solve applies to every "solved"): with
+z_s = max(|z|_inf, |q|_inf / |M|_max) and w_s = |q|_inf + ||M||_inf z_s, the scaled residual is
 max_i |min(z_i / z_s, w_i / w_s)|; for an MLCP the equality residual max|A u + C v + a| is divided
 by |a|_inf + ||A||_inf |u|_inf + ||C||_inf |v|_inf. Accepted iff both are <= tol.
 """
@@ -32,17 +32,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp import lcp
-from rigidlcp.lcp import (
-    LCP,
-    MLCP,
-    NotApplicable,
-    Solution,
-    complementarity_residual,
-    enumerate_solutions,
-)
+from rigidlcp.lcp import LCP, MLCP, NotApplicable, Solution, enumerate_solutions
+from rigidlcp.lcp.residual import check
 
 from .friction import forces_map, friction_certificate
-from .uniqueness import Search, milp_search, p_matrix_test, scales, sign_pattern
+from .uniqueness import Search, milp_search, p_matrix_test, sign_pattern
 
 #: "auto" enumerates the complementary bases up to this n (2^n bases; singular ones need LPs).
 ENUM_AUTO_MAX_N = 10
@@ -167,30 +161,19 @@ def certify(
             lcp_form = None
             notes.append(f"no Schur reduction ({exc}): uniqueness not assessed")
         u = getattr(solution, "u", None) if isinstance(solution, Solution) else None
-        if u is None:
-            u = problem.recover_u(z)
-        w, eq = problem.residuals(u, z)
-        eq_scale = (float(np.max(np.abs(problem.a)))
-                    + _norm_inf(problem.A) * float(np.max(np.abs(u), initial=0.0))
-                    + _norm_inf(problem.C) * float(np.max(np.abs(z), initial=0.0)))
-        eq_scaled = eq / eq_scale if eq_scale > 0 else eq
         if lcp_form is not None:
             Ainv_C = np.linalg.solve(problem.A, problem.C)
             obs["u"] = -Ainv_C
     else:
-        lcp_form = problem
-        w = problem.M @ z + problem.q
-        eq = eq_scaled = 0.0
-    if lcp_form is not None:
-        zs, ws = scales(lcp_form.M, lcp_form.q, z)
-    else:
-        zs = max(float(np.max(np.abs(z), initial=0.0)), 1e-300)
-        ws = max(float(np.max(np.abs(w), initial=0.0)), 1e-300)
-    scaled = float(np.max(np.abs(np.minimum(z / zs, w / ws)))) if z.size else 0.0
+        lcp_form, u = problem, None
+    # The acceptance test is lcp.residual's: the one lcp.solve applies to every "solved".
+    chk = check(problem, z, u, tol=tol, lcp_form=lcp_form)
+    w, zs, ws = chk.w, chk.z_scale, chk.w_scale
     cert = Certificate(
-        accepted=bool(scaled <= tol and eq_scaled <= tol), tol=tol,
-        residual=complementarity_residual(z, w), scaled_residual=scaled, eq_residual=eq,
-        scaled_eq_residual=eq_scaled, z_scale=zs, w_scale=ws, delta=delta, notes=notes,
+        accepted=chk.accepted, tol=tol, residual=chk.residual,
+        scaled_residual=chk.scaled_residual, eq_residual=chk.eq_residual,
+        scaled_eq_residual=chk.scaled_eq_residual, z_scale=zs, w_scale=ws, delta=delta,
+        notes=notes,
     )
     if fc_residual is not None:
         notes.append(f"friction contact: relative natural-map residual {fc_residual:.3e}; "
@@ -267,10 +250,6 @@ def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: fl
         if verdict.verdict != UNIQUE or verdict.scope:
             cert.notes.append(f"{name}: {verdict.verdict} [{verdict.stage}] {verdict.reason}"
                               + (f" (scope: {verdict.scope})" if verdict.scope else ""))
-
-
-def _norm_inf(A: np.ndarray) -> float:
-    return float(np.max(np.sum(np.abs(A), axis=1))) if A.size else 0.0
 
 
 class _Context:

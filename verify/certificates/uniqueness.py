@@ -14,8 +14,9 @@ Three tools, from cheapest to most general:
 * ``milp_search``: a mixed-integer program (scipy.optimize.milp, i.e. HiGHS) for a solution other
   than a given z*, with binary variables y for the complementarity and big-M bounds.
 
-Scales (shared with verify.certify): z_s = max(|z*|_inf, |q|_inf / |M|_max) is the size of a
-solution and w_s = |q|_inf + ||M||_inf z_s bounds the size of the terms of w = M z + q.
+Scales (lcp.residual, shared with lcp.solve and verify.certify): z_s = max(|z*|_inf, |q|_inf /
+|M|_max) is the size of a solution and w_s = |q|_inf + ||M||_inf z_s bounds the size of the
+terms of w = M z + q.
 Every margin below is relative to these scales.
 """
 
@@ -33,6 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint, linprog, milp
+
+from rigidlcp.lcp.residual import scaled_residual, scales
+
+__all__ = ["PMatrixTest", "Search", "milp_search", "p_matrix_test", "quiet_highs",
+           "scaled_residual", "scales", "sign_pattern"]
 
 #: Largest n for the principal-minor test (2^n - 1 determinants).
 P_MINORS_MAX_N = 12
@@ -71,28 +77,6 @@ def quiet_highs() -> Iterator[None]:
 # --------------------------------------------------------------------------------------------
 # scales and residuals
 # --------------------------------------------------------------------------------------------
-
-def scales(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> tuple[float, float]:
-    """(z_s, w_s): the solution scale max(|z|_inf, |q|_inf/|M|_max) and the w scale
-    |q|_inf + ||M||_inf z_s (||.||_inf the max row sum of |M|)."""
-    mmax = float(np.max(np.abs(M))) if M.size else 0.0
-    qmax = float(np.max(np.abs(q))) if q.size else 0.0
-    zmax = float(np.max(np.abs(z))) if z.size else 0.0
-    zs = max(zmax, qmax / mmax if mmax > 0 else 0.0)
-    if zs == 0.0:
-        zs = 1.0  # z = 0, q = 0: any unit is as good
-    ws = qmax + float(np.max(np.sum(np.abs(M), axis=1))) * zs if M.size else qmax
-    return zs, (ws if ws > 0 else 1.0)  # M = 0 and q = 0: w = 0 exactly
-
-
-def scaled_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
-    """max_i |min(z_i / z_s, w_i / w_s)| with w = M z + q: zero iff (z, w) is complementary."""
-    if z.size == 0:
-        return 0.0
-    zs, ws = scales(M, q, z)
-    w = M @ z + q
-    return float(np.max(np.abs(np.minimum(z / zs, w / ws))))
-
 
 def sign_pattern(z: np.ndarray, w: np.ndarray, zs: float, ws: float, delta: float) -> np.ndarray:
     """+1 where z_i > delta z_s, -1 where w_i > delta w_s, 0 where both are ~0 (degenerate).
@@ -239,7 +223,10 @@ def milp_search(
     (HiGHS must then prove optimality; a feasible point at the time limit is still used);
     "none" (default) stops at the first feasible point. A basis that fails verification is cut
     off (a no-good cut on y) and the MILP asked again, at most `retries` times; the total time
-    is bounded by `time_limit` seconds.
+    is bounded by `time_limit` seconds. Every way of differing is tried on that basis (the
+    MILP's binaries may pick one that rounding made look satisfied); the cut is *proved* only
+    if all their LPs are infeasible, and an infeasible MILP after an unproved cut answers
+    "unknown", never "none" (a false "unique" is the worst answer a verifier can give).
     """
     t0 = time.perf_counter()
     M = np.asarray(M, dtype=float)
@@ -335,7 +322,7 @@ def milp_search(
     elif objective != "none":
         raise ValueError(f"objective must be 'min-sum' or 'none', got {objective!r}")
     integrality = np.r_[np.zeros(n), np.ones(N - n)]
-    rejected = 0
+    rejected = unproved = 0
     for _attempt in range(retries + 1):
         left = time_limit - (time.perf_counter() - t0)
         if left <= 0:
@@ -349,18 +336,21 @@ def milp_search(
         res.info = {"milp_status": int(out.status), "milp_message": str(out.message),
                     "binaries": N - n, "rejected_bases": rejected}
         if out.x is None:
-            if out.status == 2:  # proved infeasible
+            if out.status == 2 and unproved:  # a cut that was not proved may hide a solution
+                res.message = (f"MILP infeasible after {rejected} bases were cut, {unproved} of "
+                               "them without proof that they hold no other solution: unknown")
+            elif out.status == 2:  # proved infeasible, every cut proved
                 res.status = "none"
                 res.message = (f"no other solution with z <= {U:.3g} (MILP infeasible"
-                               + (f" after {rejected} spurious bases were cut" if rejected
-                                  else "") + ")")
+                               + (f" after {rejected} bases, each proved empty by LP, were cut"
+                                  if rejected else "") + ")")
             else:
                 res.message = f"MILP stopped without a point: {out.message}"
             break
         y = out.x[n:2 * n] > 0.5
         chosen = out.x[2 * n:] > 0.5
-        other = _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws,
-                        deg if target == "pattern" else None, extra)
+        other, proved = _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws,
+                                pat if target == "pattern" else None, extra)
         if other is not None:
             res.status, res.other = "found", other
             if target == "pattern":
@@ -372,8 +362,11 @@ def milp_search(
                            + ("" if out.status == 0 else " (time limit hit)"))
             break
         # The basis proposed carries no exact solution with the target (rounding in the MILP):
-        # cut it off (no-good cut on y) and ask again.
+        # cut it off (no-good cut on y) and ask again. The cut is sound only if every way the
+        # target can differ was proved infeasible on this basis (`proved`); else a "none" at the
+        # end would rest on it, and becomes "unknown".
         rejected += 1
+        unproved += not proved
         r = np.zeros(N)
         r[n:2 * n] = np.where(y, -1.0, 1.0)
         add(r, 1.0 - float(np.sum(y)), np.inf)
@@ -381,46 +374,63 @@ def milp_search(
         res.message = (f"{rejected} bases proposed by the MILP carried no exact solution with "
                        "the target's difference (rounding): verdict unknown")
     res.info["rejected_bases"] = rejected
+    res.info["unproved_cuts"] = unproved
     res.seconds = time.perf_counter() - t0
     res.message += f" [{res.seconds:.2f} s]"
     return res
 
 
-def _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws, deg, extra) -> np.ndarray | None:
-    """The exact solution on the MILP's basis (an LP), with the target's inequality; or None."""
+def _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws, pat, extra
+            ) -> tuple[np.ndarray | None, bool]:
+    """(z, proved): an exact solution z on the MILP's basis y with the target's difference (an
+    LP per way of differing, the MILP's chosen ones first), or None; `proved` is True when every
+    one of those LPs was proved infeasible, i.e. the basis holds no such solution and cutting it
+    off loses nothing. (The MILP's binaries may pick a disjunct that rounding made look
+    satisfied while the basis holds a solution that differs elsewhere: all are tried.)"""
     n = q.size
     a, b = np.flatnonzero(y), np.flatnonzero(~y)
     bounds = [(0.0, None) if y[i] else (0.0, 0.0) for i in range(n)]
-    A_ub = [-M[b]]
-    b_ub = [q[b]]
+    order = np.r_[np.flatnonzero(chosen), np.flatnonzero(~chosen)]
+    ways: list[tuple[np.ndarray, float] | None] = []
+    check = None
     if target == "pattern":
-        for k in np.flatnonzero(chosen):
+        plus, minus = np.flatnonzero(pat == 1), np.flatnonzero(pat == -1)
+        deg = np.flatnonzero(pat == 0)
+        if np.any(~y[plus]) or np.any(y[minus]):
+            ways = [None]  # the basis itself differs from z*'s pattern
+        for k in order if not ways else []:
             i = deg[k]
-            row = np.zeros(n)
             if y[i]:
+                row = np.zeros(n)
                 row[i] = -1.0 / zs  # z_i >= delta zs
-                A_ub.append(row[None, :])
-                b_ub.append(np.array([-delta * (1 - 1e-3)]))
+                ways.append((row, -delta * (1 - 1e-3)))
             else:
-                A_ub.append(-M[i][None, :] / ws)  # w_i >= delta ws
-                b_ub.append(np.array([q[i] / ws - delta * (1 - 1e-3)]))
-            break  # one of the chosen disjuncts suffices
+                ways.append((-M[i] / ws, q[i] / ws - delta * (1 - 1e-3)))  # w_i >= delta ws
     else:
         v_star = L @ z_star
         sL = max(float(np.max(np.sum(np.abs(L), axis=1))) * zs, float(np.max(np.abs(v_star))),
                  1e-300)
-        k = int(np.flatnonzero(chosen)[0]) if chosen.any() else None
-        if k is None:
-            return None
-        j, sgn = extra[k]
-        A_ub.append(-sgn * L[j][None, :] / sL)
-        b_ub.append(np.array([-sgn * v_star[j] / sL - delta * (1 - 1e-3)]))
-    res = linprog(np.ones(n), A_ub=np.vstack(A_ub), b_ub=np.concatenate(b_ub),
-                  A_eq=M[a] if a.size else None, b_eq=-q[a] if a.size else None,
-                  bounds=bounds, method="highs", options=_HIGHS_LP)
-    if res.status != 0:
-        return None
-    z = np.maximum(res.x, 0.0)
-    if scaled_residual(M, q, z) > 1e-8:
-        return None
-    return z
+        for k in order:
+            j, sgn = extra[k]
+            ways.append((-sgn * L[j] / sL, -sgn * v_star[j] / sL - delta * (1 - 1e-3)))
+
+        def check(z):
+            return float(np.max(np.abs(L @ (z - z_star)))) >= delta * sL * (1 - 1e-2)
+    proved = True
+    for way in ways:
+        A_ub, b_ub = [-M[b]], [q[b]]
+        if way is not None:
+            A_ub.append(way[0][None, :])
+            b_ub.append(np.array([way[1]]))
+        res = linprog(np.ones(n), A_ub=np.vstack(A_ub), b_ub=np.concatenate(b_ub),
+                      A_eq=M[a] if a.size else None, b_eq=-q[a] if a.size else None,
+                      bounds=bounds, method="highs", options=_HIGHS_LP)
+        if res.status == 2:
+            continue
+        proved = False
+        if res.status != 0 or res.x is None:
+            continue
+        z = np.maximum(res.x, 0.0)
+        if scaled_residual(M, q, z) <= 1e-8 and (check is None or check(z)):
+            return z, False
+    return None, proved

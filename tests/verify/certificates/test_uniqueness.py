@@ -163,3 +163,45 @@ def test_milp_bad_arguments():
         milp_search(TWO_M, TWO_Q, TWO_SOLUTIONS[0], "nonsense")
     with pytest.raises(ValueError):
         milp_search(TWO_M, TWO_Q, TWO_SOLUTIONS[0], "values")
+
+
+#: Issue 11: M = diag(0.5, [[1, 2], [2, 1]]), q = -1 has the solutions (2, 0, 1), (2, 1, 0) and
+#: (2, 1/3, 1/3) (the block of TWO_M next to 0.5 z_0 = 1). With scipy 1.11.1 the MILP chose a
+#: disjunct (row 0 of w moves) that only rounding satisfied, the polish tried that disjunct
+#: alone, and the three true bases were cut: a false "none".
+ISSUE_M = np.block([[np.array([[0.5]]), np.zeros((1, 2))], [np.zeros((2, 1)), TWO_M]])
+ISSUE_Q = -np.ones(3)
+
+
+@pytest.mark.parametrize("target", ["values", "pattern"])
+def test_milp_finds_the_other_solutions_of_the_issue_example(target):
+    z = np.array([2.0, 0.0, 1.0])
+    assert is_solution(ISSUE_M, ISSUE_Q, z)
+    res = milp_search(ISSUE_M, ISSUE_Q, z, target, ISSUE_M if target == "values" else None)
+    assert res.status == "found", res.message
+    assert is_solution(ISSUE_M, ISSUE_Q, res.other)
+    assert any(np.allclose(res.other, o, atol=1e-9)
+               for o in ([2, 1, 0], [2, 1 / 3, 1 / 3]))
+
+
+def test_milp_finds_another_solution_for_the_issue_family():
+    """The issue's 30 variants (M[0, 0] and q[0] changed): every one has three solutions."""
+    for m00 in np.linspace(0.2, 3.0, 6):
+        for q0 in (-0.5, -1.0, -2.0, -3.0, -4.0):
+            M, q = ISSUE_M.copy(), ISSUE_Q.copy()
+            M[0, 0], q[0] = m00, q0
+            z = np.array([-q0 / m00, 0.0, 1.0])
+            res = milp_search(M, q, z, "values", M)
+            assert res.status == "found", (m00, q0, res.message)
+
+
+def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
+    """A basis whose polish failed without proof (an LP that did not decide) may hold a
+    solution: a MILP made infeasible by such cuts must not answer "none"."""
+    import rigidlcp.verify.certificates.uniqueness as uq
+
+    monkeypatch.setattr(uq, "_polish", lambda *a, **k: (None, False))
+    z = np.array([2.0, 0.0, 1.0])
+    res = uq.milp_search(ISSUE_M, ISSUE_Q, z, "values", ISSUE_M, retries=10)
+    assert res.status == "unknown", res.message
+    assert res.info["unproved_cuts"] >= 1

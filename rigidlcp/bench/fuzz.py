@@ -1,0 +1,252 @@
+"""Fuzz harness: every registered method on generated LCPs, judged independently of the solvers.
+
+`run_fuzz(count, seed, out)` draws `count` problems (the classes of rigidlcp.bench.fuzz_cases,
+in turn), runs every method of `lcp.methods()` on each (enumerate only for n <= ENUM_MAX_N),
+and judges each answer with what is known *without the solvers*:
+
+* "solved": w = M z + q recomputed here and the scaled residual of verify.certify's acceptance
+  test (re-implemented below, not imported from the solver side) <= 1e-8 on the problem as
+  generated (unscaled). Otherwise SILENT WRONG.
+* "infeasible": true only if the LCP has no feasible point, decided by an LP (HiGHS through
+  scipy, on the problem as generated, after a Ruiz-free row normalization) and, for n <= 10,
+  by the enumeration of every complementary basis finding nothing; it is SILENT WRONG for a
+  P-matrix (by construction), a planted solution, or a strictly copositive class.
+* any other status: an honest failure; NotApplicable: refused; any other exception (or
+  ``info["exception"]``): crash.
+
+It prints a table class x method (solved / honest failure / refused / crash / SILENT WRONG,
+median time per solve) and writes every silent-wrong or crashing case to OUT as
+`<class>-<seed>-<method>.npz` (an `lcp.LCP` file with the verdict in its meta), which
+tests/lcp/test_fuzz_regressions.py loads. Run: `python -m rigidlcp.bench.fuzz --count N
+--seed S --out DIR` (CLI: `rigidlcp fuzz`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from rigidlcp import lcp
+from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
+
+from .fuzz_cases import CLASSES, Case, make_case
+
+#: The exhaustive methods (accepts "small-n": enumerate, enumerate-mlcp; 2^n bases) are run
+#: for n up to this in the fuzz.
+ENUM_MAX_N = 10
+#: Acceptance tolerance of verify.certify.
+TOL = 1e-8
+#: Options per method, to bound the time of slow iterations (pgs sweeps in pure Python).
+OPTIONS = {"pgs": {"max_iter": 2000}}
+OUTCOMES = ("solved", "honest", "refused", "crash", "WRONG")
+
+
+def judge_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
+    """max|min(z/z_s, w/w_s)| with z_s = max(|z|, |q|/|M|max), w_s = |q| + ||M||_inf z_s."""
+    z = np.asarray(z, dtype=float)
+    if z.shape != q.shape or not np.all(np.isfinite(z)):
+        return np.inf
+    mmax = float(np.abs(M).max())
+    zs = max(float(np.abs(z).max()), float(np.abs(q).max()) / mmax if mmax else 0.0) or 1.0
+    ws = (float(np.abs(q).max()) + float(np.abs(M).sum(axis=1).max()) * zs) or 1.0
+    return float(np.max(np.abs(np.minimum(z / zs, (M @ z + q) / ws))))
+
+
+def lp_feasible(M: np.ndarray, q: np.ndarray) -> bool | None:
+    """Has {z >= 0 : M z + q >= 0} a point? (HiGHS; rows normalized by their largest entry.)"""
+    from scipy.optimize import linprog  # on first use: `rigidlcp --help` loads no scipy
+
+    s = np.maximum(np.abs(M).max(axis=1), np.abs(q))
+    s[s == 0] = 1.0
+    res = linprog(np.zeros(q.size), A_ub=-M / s[:, None], b_ub=q / s,
+                  bounds=[(0, None)] * q.size, method="highs")
+    return {0: True, 2: False}.get(res.status)
+
+
+def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
+    """(outcome, reason) of one answer; see the module docstring."""
+    if status == "solved":
+        if case.solvable is False:
+            return "WRONG", "solved, but the problem is infeasible by construction"
+        r = judge_residual(case.M, case.q, z)
+        return ("solved", "") if r <= TOL else ("WRONG", f"solved with scaled residual {r:.3g}")
+    if status != "infeasible":
+        return "honest", status
+    if case.solvable:
+        return "WRONG", "infeasible, but the problem is solvable by construction"
+    if case.solvable is False:
+        return "solved", ""
+    feasible = lp_feasible(case.M, case.q)
+    if feasible is False:
+        return "solved", ""
+    if case.n <= ENUM_MAX_N:
+        if not lcp.enumerate_solutions(lcp.LCP(case.M, case.q)):
+            return "solved", ""
+        return "WRONG", "infeasible, but the enumeration finds a solution"
+    return "WRONG", f"infeasible not confirmed (LP feasible: {feasible})"
+
+
+def run_case(case: Case, method: str) -> dict:
+    problem = lcp.LCP(case.M, case.q)
+    t0 = time.perf_counter()
+    try:
+        sol = lcp.solve(problem, method, **OPTIONS.get(method, {}))
+    except lcp.NotApplicable as exc:
+        return {"outcome": "refused", "reason": str(exc), "seconds": time.perf_counter() - t0}
+    except Exception as exc:  # noqa: BLE001 - a crash is what the harness is looking for
+        return {"outcome": "crash", "reason": f"{type(exc).__name__}: {exc}",
+                "seconds": time.perf_counter() - t0}
+    seconds = time.perf_counter() - t0
+    if "exception" in sol.info:
+        return {"outcome": "crash", "reason": sol.info["exception"].strip(), "seconds": seconds}
+    outcome, reason = judge(case, sol.status, sol.z)
+    return {"outcome": outcome, "reason": reason, "seconds": seconds, "status": sol.status}
+
+
+def save_case(case: Case, method: str, result: dict, out: Path) -> Path:
+    meta = {"class": case.kind, "seed": case.seed, "method": method,
+            "outcome": result["outcome"], "reason": result["reason"],
+            "p_matrix": case.p_matrix, "solvable": case.solvable}
+    return lcp.LCP(case.M, case.q, name=f"{case.kind}-{case.seed}-{method}",
+                   meta=meta).save(out / f"{case.kind}-{case.seed}-{method}.npz")
+
+
+def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
+             classes: tuple[str, ...] = CLASSES, methods: tuple[str, ...] | None = None,
+             progress=None) -> dict:
+    """Fuzz `count` problems; returns {"table": {(class, method): {outcome: count, "seconds":
+    [...]}}, "saved": [paths], ...}. `progress(k, partial_result)` is called after each."""
+    names = methods or tuple(m.name for m in lcp.methods())
+    exhaustive = {m.name for m in lcp.methods() if m.accepts == "small-n"}
+    out_dir = Path(out) if out is not None else None
+    table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
+    saved: list[Path] = []
+    for k in range(count):
+        kind = classes[k % len(classes)]
+        case = make_case(kind, seed * 1_000_003 + k)
+        for method in names:
+            if method in exhaustive and case.n > ENUM_MAX_N:
+                continue
+            res = run_case(case, method)
+            cell = table[(kind, method)]
+            cell[res["outcome"]] += 1
+            cell["seconds"].append(res["seconds"])
+            if res["outcome"] in ("WRONG", "crash") and out_dir is not None:
+                saved.append(save_case(case, method, res, out_dir))
+        if progress is not None:
+            progress(k + 1, {"table": dict(table), "saved": saved, "count": k + 1,
+                             "seed": seed})
+    return {"table": dict(table), "saved": saved, "count": count, "seed": seed}
+
+
+def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | None = None
+              ) -> dict:
+    """Every method on LCP files (Siconos's LCP format, or lcp .npz), judged as the fuzz cases
+    are but with nothing known by construction (class = the file name)."""
+    from rigidlcp.lcp.io.siconos import read_siconos_lcp
+
+    names = methods or tuple(m.name for m in lcp.methods())
+    exhaustive = {m.name for m in lcp.methods() if m.accepts == "small-n"}
+    table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
+    saved: list[Path] = []
+    for path in map(Path, paths):
+        P = lcp.load(path) if path.suffix == ".npz" else read_siconos_lcp(path)
+        case = Case(path.stem, 0, P.M, P.q)
+        for method in names:
+            if method in exhaustive and case.n > ENUM_MAX_N:
+                continue
+            res = run_case(case, method)
+            cell = table[(path.stem, method)]
+            cell[res["outcome"]] += 1
+            cell["seconds"].append(res["seconds"])
+            if res["outcome"] in ("WRONG", "crash") and out is not None:
+                saved.append(save_case(case, method, res, Path(out)))
+    return {"table": dict(table), "saved": saved}
+
+
+def format_table(result: dict) -> str:
+    """Markdown table: class x method -> solved / honest / refused / crash / WRONG, time."""
+    table = result["table"]
+    lines = ["| class | method | solved | honest failure | refused | crash | SILENT WRONG "
+             "| median ms |", "|---|---|---:|---:|---:|---:|---:|---:|"]
+    order = {c: i for i, c in enumerate(CLASSES)}
+    for (kind, method), cell in sorted(table.items(),
+                                       key=lambda kv: (order.get(kv[0][0], 99), kv[0])):
+        ms = 1e3 * float(np.median(cell["seconds"])) if cell["seconds"] else float("nan")
+        lines.append(f"| {kind} | {method} | {cell['solved']} | {cell['honest']} | "
+                     f"{cell['refused']} | {cell['crash']} | {cell['WRONG']} | {ms:.2f} |")
+    return "\n".join(lines)
+
+
+def add_arguments(ap: argparse.ArgumentParser) -> None:
+    """The options of `rigidlcp fuzz` (and of `python -m rigidlcp.bench.fuzz`)."""
+    ap.add_argument("--count", type=int, default=1000, help="problems to draw (default 1000)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
+    ap.add_argument("--out", default=None, help="folder for the silent-wrong / crash cases "
+                    "(must not exist yet)")
+    ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated classes")
+    ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
+    ap.add_argument("--progress", type=int, default=0, metavar="K",
+                    help="print the table so far to stderr every K problems (default: never)")
+    ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
+                    "files (Siconos LCP format or .npz) instead of generated problems")
+
+
+def run_from_args(args: argparse.Namespace) -> int:
+    """Run, print the table; 0 if no answer was silently wrong or crashed, else 1. Bad
+    arguments raise InvalidInput / OutputExists (one line and exit status 2 on the CLI)."""
+    classes = tuple(c for c in args.classes.split(",") if c)
+    bad = [c for c in classes if c not in CLASSES]
+    if bad:
+        raise InvalidInput(f"unknown class(es) {bad}; classes: {', '.join(CLASSES)}")
+    if args.count < 1:
+        raise InvalidInput(f"--count must be >= 1, got {args.count}")
+    if args.out is not None and Path(args.out).exists():
+        raise OutputExists(f"--out {args.out} exists; give a new folder")
+    methods = tuple(args.methods.split(",")) if args.methods else None
+    for m in methods or ():
+        lcp.get_method(m)  # an unknown name raises InvalidProblem
+    t0 = time.perf_counter()
+    if args.files:
+        missing = [f for f in args.files if not Path(f).is_file()]
+        if missing:
+            raise InvalidInput(f"no such file {missing[0]}")
+        result = run_files(args.files, methods, args.out)
+        what = f"{len(args.files)} files"
+    else:
+        every = max(1, args.progress)
+
+        def progress(k: int, partial: dict) -> None:
+            if k % every == 0 and k < args.count:
+                print(f"[{k} of {args.count} problems, {time.perf_counter() - t0:.0f} s]\n"
+                      + format_table(partial), file=sys.stderr, flush=True)
+
+        result = run_fuzz(args.count, args.seed, args.out, classes, methods,
+                          progress=progress if args.progress else None)
+        what = f"{args.count} problems, seed {args.seed}"
+    print(format_table(result))
+    wrong = sum(c["WRONG"] + c["crash"] for c in result["table"].values())
+    print(f"\n{what}, {time.perf_counter() - t0:.0f} s; "
+          f"{wrong} silent-wrong or crashing answers"
+          + (f" saved in {args.out}" if args.out and wrong else ""))
+    return 1 if wrong else 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(prog="rigidlcp fuzz", description=__doc__.split("\n")[0])
+    add_arguments(ap)
+    args = ap.parse_args(argv)
+    try:
+        return run_from_args(args)
+    except (RigidLCPError, ValueError) as exc:
+        print(f"rigidlcp fuzz: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
