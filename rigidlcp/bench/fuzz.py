@@ -144,31 +144,6 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
     return {"table": dict(table), "saved": saved, "count": count, "seed": seed}
 
 
-def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | None = None
-              ) -> dict:
-    """Every method on LCP files (Siconos's LCP format, or lcp .npz), judged as the fuzz cases
-    are but with nothing known by construction (class = the file name)."""
-    from rigidlcp.lcp.io.siconos import read_siconos_lcp
-
-    names = methods or tuple(m.name for m in lcp.methods())
-    exhaustive = {m.name for m in lcp.methods() if m.accepts == "small-n"}
-    table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
-    saved: list[Path] = []
-    for path in map(Path, paths):
-        P = lcp.load(path) if path.suffix == ".npz" else read_siconos_lcp(path)
-        case = Case(path.stem, 0, P.M, P.q)
-        for method in names:
-            if method in exhaustive and case.n > ENUM_MAX_N:
-                continue
-            res = run_case(case, method)
-            cell = table[(path.stem, method)]
-            cell[res["outcome"]] += 1
-            cell["seconds"].append(res["seconds"])
-            if res["outcome"] in ("WRONG", "crash") and out is not None:
-                saved.append(save_case(case, method, res, Path(out)))
-    return {"table": dict(table), "saved": saved}
-
-
 def format_table(result: dict) -> str:
     """Markdown table: class x method -> solved / honest / refused / crash / WRONG, time."""
     table = result["table"]
@@ -194,7 +169,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--progress", type=int, default=0, metavar="K",
                     help="print the table so far to stderr every K problems (default: never)")
     ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
-                    "files (Siconos LCP format or .npz) instead of generated problems")
+                    "and MLCP files (Siconos's text formats or .npz) instead of generated "
+                    "problems")
 
 
 def run_from_args(args: argparse.Namespace) -> int:
@@ -216,6 +192,8 @@ def run_from_args(args: argparse.Namespace) -> int:
         missing = [f for f in args.files if not Path(f).is_file()]
         if missing:
             raise InvalidInput(f"no such file {missing[0]}")
+        from .fuzz_files import run_files
+
         result = run_files(args.files, methods, args.out)
         what = f"{len(args.files)} files"
     else:

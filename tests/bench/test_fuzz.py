@@ -73,3 +73,35 @@ def test_the_cli_runs_and_saves_nothing_when_all_is_well(tmp_path, capsys):
     text = capsys.readouterr().out
     assert "| P | lemke | 1 |" in text and "0 silent-wrong" in text
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_files_of_every_kind_are_judged_and_a_non_square_mlcp_is_refused():
+    """rigidlcp fuzz --files: LCP and MLCP files, each answer judged on the problem as given
+    (rigidlcp.bench.fuzz_files); the non-square MLCP is a refused row, never a crash."""
+    from rigidlcp.bench.fuzz_files import run_files
+
+    siconos = Path(__file__).parent.parent / "data" / "siconos"
+    files = [siconos / n for n in ("lcp_CPS_1.dat", "m2n1_mlcp.dat", "diodeBridge_mlcp.dat",
+                                   "Rectangular_mlcp.dat")]
+    result = run_files(files, methods=("lemke", "pivoting", "newton-min", "enumerate"))
+    table = result["table"]
+    for key, cell in table.items():
+        assert cell["WRONG"] == 0 and cell["crash"] == 0, key
+    assert table[("m2n1_mlcp", "lemke")]["solved"] == 1
+    assert table[("diodeBridge_mlcp", "newton-min")]["solved"] == 1  # A singular: full system
+    assert table[("Rectangular_mlcp", "lemke")]["refused"] == 1
+    assert "rectangular" in table[("Rectangular_mlcp", "reader")]["reason"]
+
+
+def test_a_wrong_mlcp_answer_is_judged_wrong():
+    """The MLCP judge does not trust a status: a perturbed answer is SILENT WRONG."""
+    import numpy as np
+
+    from rigidlcp.bench.fuzz_files import judge_mlcp
+
+    P = lcp.load(Path(__file__).parent.parent / "data" / "siconos" / "m2n1_mlcp.dat")
+    sol = lcp.solve(P, "lemke")
+    assert judge_mlcp(P, sol.status, sol.u, sol.z) == ("solved", "")
+    outcome, reason = judge_mlcp(P, "solved", sol.u + 0.1, sol.z)
+    assert outcome == "WRONG" and "eq" in reason
+    assert judge_mlcp(P, "infeasible", None, np.zeros(P.n))[0] == "WRONG"  # it has a solution
