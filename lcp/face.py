@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .problem import LCP
+from .quiet import new_highs
 
 
 @dataclass
@@ -296,8 +297,8 @@ def _face_lp(M: np.ndarray, q: np.ndarray, A: np.ndarray, c: np.ndarray) -> np.n
     lp.row_upper_ = np.concatenate([-q[A], np.full(Ac.size, inf)])
     lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = K.indptr, K.indices, K.data
-    h = highspy.Highs()
-    for key, value in (("output_flag", False), ("presolve", "off"),
+    h = new_highs()
+    for key, value in (("presolve", "off"),
                        ("primal_feasibility_tolerance", 1e-10),
                        ("dual_feasibility_tolerance", 1e-10)):
         h.setOptionValue(key, value)

@@ -9,14 +9,15 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .errors import InvalidProblem, NotApplicable
+from .errors import InvalidFile, InvalidProblem, NotApplicable, RigidLCPError
+from .io.files import atomic_write, open_npz
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
@@ -199,16 +200,13 @@ def _save_npz(path, kind: str, arrays: dict, name: str, meta: dict) -> Path:
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(path.suffix + ".npz") if path.suffix else path.with_suffix(".npz")
-    path.parent.mkdir(parents=True, exist_ok=True)
     header = json.dumps({"kind": kind, "name": name, "meta": meta}, default=str)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp.npz")
-    os.close(fd)
-    try:
-        np.savez_compressed(tmp, __header__=np.array(header), **arrays)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+
+    def write(tmp: str) -> None:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, __header__=np.array(header), **arrays)
+
+    atomic_write(path, write)
     return path
 
 
@@ -219,24 +217,32 @@ def load(path: str | os.PathLike):
     InvalidProblem (lcp.io.text.FileFormatError) naming the file, the line and what was
     expected."""
     path = Path(path)
-    if not path.exists():
-        raise FileNotFoundError(f"no problem file at {path}")
-    with open(path, "rb") as fh:
-        magic = fh.read(4)
-    if magic[:2] != b"PK" and path.suffix != ".npz":  # not an .npz: a Siconos text file
-        from .io.siconos import read_siconos
+    if path.is_file():
+        with open(path, "rb") as fh:
+            magic = fh.read(4)
+        if magic and magic[:2] != b"PK" and path.suffix != ".npz":  # a Siconos text file
+            from .io.siconos import read_siconos
 
-        return read_siconos(path)
-    with np.load(path, allow_pickle=False) as data:
-        keys = set(data.files)
-        header = json.loads(str(data["__header__"])) if "__header__" in keys else {}
-        name, meta = header.get("name", path.stem), header.get("meta", {})
-        if {"M", "q"} <= keys:
-            return LCP(data["M"], data["q"], name=name, meta=meta)
-        mlcp_keys = {"A", "C", "D", "B", "a", "b"}
-        if mlcp_keys <= keys:
-            return MLCP(*(data[k] for k in ("A", "C", "D", "B", "a", "b")), name=name, meta=meta)
-    raise InvalidProblem(
-        f"{path} holds neither an LCP (arrays M, q) nor an MLCP (arrays A, C, D, B, a, b); "
-        f"found {sorted(keys - {'__header__'})}"
+            return read_siconos(path)
+    try:
+        with open_npz(path, "an LCP/MLCP problem file (.npz)") as data:
+            keys = set(data.files)
+            header = json.loads(str(data["__header__"])) if "__header__" in keys else {}
+            name, meta = header.get("name", path.stem), header.get("meta", {})
+            if {"M", "q"} <= keys:
+                return LCP(data["M"], data["q"], name=name, meta=meta)
+            mlcp_keys = {"A", "C", "D", "B", "a", "b"}
+            if mlcp_keys <= keys:
+                return MLCP(*(data[k] for k in ("A", "C", "D", "B", "a", "b")), name=name,
+                            meta=meta)
+    except (RigidLCPError, OSError):
+        raise
+    except (ValueError, EOFError, KeyError, AttributeError, zipfile.BadZipFile) as exc:  # damaged
+        raise InvalidFile(f"{path}: cannot read the problem "
+                          f"({type(exc).__name__}: {' '.join(str(exc).split())[:80]})") from None
+    found = sorted(keys - {"__header__"})
+    kind = " (it is a run saved by `rigidlcp simulate`)" if "__meta__" in keys else ""
+    raise InvalidFile(
+        f"{path} holds neither an LCP (arrays M, q) nor an MLCP (arrays A, C, D, B, a, b)"
+        f"{kind}; found {', '.join(found[:6])}{', ...' if len(found) > 6 else ''}"
     )

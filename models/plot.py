@@ -11,6 +11,11 @@ from rigidlcp.models.engine.records import Run
 from .lattice import LEFT_WALL, PLANE, RIGHT_WALL
 from .system import System
 
+#: The files `plot_run` writes, in order.
+PLOT_FILES = ("angular_acceleration.png", "angular_velocity.png",
+              "angular_acceleration_rows.png", "normal_forces.png", "friction_forces.png",
+              "mu_g.png", "dissipation.png")
+
 
 def _plt():
     import matplotlib
@@ -156,5 +161,5 @@ def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
     return files
 
 
-__all__ = ["plot_run", "draw_lattice", "draw_forces", "dissipation_curve", "step_series",
-           "LEFT_WALL", "RIGHT_WALL", "PLANE"]
+__all__ = ["PLOT_FILES", "plot_run", "draw_lattice", "draw_forces", "dissipation_curve",
+           "step_series", "LEFT_WALL", "RIGHT_WALL", "PLANE"]

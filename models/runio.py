@@ -8,12 +8,15 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import zipfile
 from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+
+from rigidlcp.lcp.errors import InvalidFile, RigidLCPError
+from rigidlcp.lcp.io.files import atomic_write, open_npz
 
 if TYPE_CHECKING:  # loaded by load_run only: models.sweep needs _json_default, not the engine
     from rigidlcp.models.engine.records import Run
@@ -21,18 +24,6 @@ if TYPE_CHECKING:  # loaded by load_run only: models.sweep needs _json_default, 
 FORMAT = "rigidlcp-run/1"
 _SCALARS = ("t", "V", "mu_g", "dissipation", "iterations", "residual", "n_lcp", "fallback")
 _ARRAYS = ("omega", "omega_dot", "R", "S", "s", "s_in", "vt", "at")
-
-
-def _atomic_write(path: Path, write) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 def run_paths(path: str | os.PathLike) -> tuple[Path, Path]:
@@ -68,24 +59,39 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
     def write_json(tmp: str) -> None:
         Path(tmp).write_text(text + "\n")
 
-    _atomic_write(data_path, write_npz)
-    _atomic_write(meta_path, write_json)
+    atomic_write(data_path, write_npz)
+    atomic_write(meta_path, write_json)
     return data_path
 
 
 def load_run(path: str | os.PathLike) -> Run:
     """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
+    data_path, _ = run_paths(path)
+    try:
+        return _load_run(data_path)
+    except (RigidLCPError, OSError):
+        raise
+    except (ValueError, EOFError, KeyError, TypeError, AttributeError, IndexError,
+            zipfile.BadZipFile) as exc:  # a damaged archive or metadata
+        raise InvalidFile(f"{data_path}: damaged run file ({type(exc).__name__}: "
+                          f"{' '.join(str(exc).split())[:80]})") from None
+
+
+def _load_run(data_path: Path) -> Run:
     from rigidlcp.models.engine.records import EventRecord, Run
     from rigidlcp.models.event import State
     from rigidlcp.models.system import make_system
 
-    data_path, _ = run_paths(path)
-    if not data_path.exists():
-        raise FileNotFoundError(f"no run file at {data_path}")
-    with np.load(data_path, allow_pickle=False) as data:
+    with open_npz(data_path, "a run saved by `rigidlcp simulate` (.npz)") as data:
+        if "__meta__" not in data.files:
+            kind = (" (it is an LCP/MLCP problem file: see `rigidlcp solve`)"
+                    if "__header__" in data.files else "")
+            raise InvalidFile(f"{data_path} is not a run saved by `rigidlcp simulate`{kind}")
         meta = json.loads(str(data["__meta__"]))
-        if meta.get("format") != FORMAT:
-            raise ValueError(f"{data_path} is not a rigidlcp run (format {meta.get('format')!r})")
+        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+            fmt = meta.get("format") if isinstance(meta, dict) else None
+            raise InvalidFile(f"{data_path} is not a rigidlcp run (format {fmt!r}, expected "
+                              f"{FORMAT!r})")
         cols = {k: data[k] for k in _SCALARS + _ARRAYS}
         final = None
         if "final_omega" in data.files:

@@ -30,11 +30,13 @@ import json
 import math
 import os
 import sys
-import tempfile
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+from rigidlcp.lcp.errors import InvalidFile, InvalidInput, OutputExists
+from rigidlcp.lcp.io.files import atomic_write_text
 
 from .executors import default_jobs, iter_map
 from .runio import _json_default
@@ -146,6 +148,41 @@ class Sweep:
         for name, values in self.axes.items():
             if not values:
                 raise ValueError(f"sweep axis {name!r} has no value")
+
+    def validate(self) -> None:
+        """Check every point of the grid before any runs (raises ValueError / InvalidSystem
+        naming the first bad value): each distinct system is built, each run option checked."""
+        from rigidlcp import lcp
+        from rigidlcp.models.engine.dense import SELECT
+
+        from .system import make_system
+
+        opts = {**RUN_OPTIONS, **self.options}
+        for name in (opts["method"], opts["fallback"]):
+            if name is not None and name != "sparse-pivoting":
+                lcp.get_method(name)
+        if opts["select"] not in SELECT:
+            raise ValueError(f"select must be one of {', '.join(SELECT)}, got {opts['select']!r}")
+        if not (isinstance(opts["max_events"], int) and opts["max_events"] >= 1):
+            raise ValueError(f"max_events must be an integer >= 1, got {opts['max_events']!r}")
+        if opts["t_max"] is not None and not float(opts["t_max"]) > 0:
+            raise ValueError(f"t_max must be > 0, got {opts['t_max']!r}")
+        if not (math.isfinite(opts["omega_scale"]) and opts["omega_scale"] >= 0):
+            raise ValueError(f"omega_scale must be a finite number >= 0, "
+                             f"got {opts['omega_scale']!r}")
+        seen = set()
+        for point in self.points():
+            sysp = tuple(point[k] for k in PARAMS if k != "seed")
+            if sysp in seen:
+                continue
+            seen.add(sysp)
+            where = ", ".join(f"{k}={point[k]}" for k in self.axes) or "the fixed parameters"
+            try:
+                make_system(point["lattice"], point["lx"], point["ly"], mu_pp=point["mu_pp"],
+                            mu_plane=point["mu_plane"], mu_wall=point["mu_wall"],
+                            gamma=point["gamma"], V0=point["v0"], inertia=point["inertia"])
+            except ValueError as exc:
+                raise type(exc)(f"sweep point ({where}): {exc}") from None
 
     def points(self) -> list[dict]:
         """Every point: all of PARAMS then all of RUN_OPTIONS (a JSON-friendly dict)."""
@@ -289,19 +326,7 @@ def _last_byte(path: Path, size: int) -> bytes:
 
 
 def _atomic_write_text(path: Path, text: str) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-
-
+    atomic_write_text(path, text)
 
 
 def read_results(out: str | os.PathLike) -> list[dict]:
@@ -310,8 +335,16 @@ def read_results(out: str | os.PathLike) -> list[dict]:
     if path.is_dir():
         path = path / RESULTS
     if not path.exists():
-        raise FileNotFoundError(f"no sweep results at {path}")
-    return ResultsFile(path).read()
+        raise FileNotFoundError(2, "No sweep results (results.jsonl)", str(path))
+    results = ResultsFile(path)
+    try:
+        rows = results.read()
+    except UnicodeDecodeError:
+        raise InvalidFile(f"{path} is not a sweep's results.jsonl (not text)") from None
+    if not rows:
+        raise InvalidFile(f"{path} holds no sweep result" + (
+            f" ({results.bad_lines} unreadable line(s))" if results.bad_lines else " (empty)"))
+    return rows
 
 
 # -- the sweep -----------------------------------------------------------------------------------
@@ -332,13 +365,28 @@ class SweepResult:
         return all(r.get("status") is not None for r in self.rows)
 
 
+def check_out(out: str | os.PathLike, force: bool = False) -> Path:
+    """OUT of a sweep: new, empty, or a sweep directory (resumed); otherwise `OutputExists`
+    (unless `force`), or `InvalidInput` for a file."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InvalidInput(f"{out} is a file, not a sweep directory")
+    if not force and out.is_dir() and any(out.iterdir()) and not (out / SPEC).exists():
+        raise OutputExists(f"{out} is not empty and not a sweep directory (no {SPEC}); "
+                           "pass --force (force=True) to write into it")
+    return out
+
+
 def run_sweep(sweep: Sweep, out: str | os.PathLike, *, jobs: int | None = None,
               dask: str | None = None, progress: bool = True, save_runs: bool = False,
-              log: Callable[[str], None] | None = None) -> SweepResult:
+              log: Callable[[str], None] | None = None, force: bool = False) -> SweepResult:
     """Run the points of `sweep` not yet in OUT/results.jsonl, appending each as it finishes,
     then rewrite the file in grid order. A KeyboardInterrupt propagates after the finished
-    points are safe on disk (rerun to resume)."""
-    out = Path(out)
+    points are safe on disk (rerun to resume). The grid is validated first
+    (`Sweep.validate`); OUT must be new, empty or a sweep directory (else `OutputExists`,
+    unless `force`)."""
+    sweep.validate()  # the whole grid, before anything is written or run
+    out = check_out(out, force)
     out.mkdir(parents=True, exist_ok=True)
     log = log or (lambda msg: print(msg, file=sys.stderr))
     _atomic_write_text(out / SPEC, json.dumps(sweep.to_dict(), indent=1) + "\n")

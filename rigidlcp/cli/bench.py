@@ -49,6 +49,8 @@ def register(sub) -> None:
     p.add_argument("--no-isolation", action="store_true",
                    help="solve in this process (the time limit is then checked afterwards, "
                    "a solve cannot be interrupted)")
+    p.add_argument("--force", action="store_true",
+                   help="write into an --out directory that is not empty")
     p.add_argument("--list", action="store_true", help="list the sets and methods and exit")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=cmd_bench)
@@ -81,8 +83,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
             return 0
         if not args.sets or not args.out:
             raise ValueError("--set and --out are required (or --list)")
-        if args.time_limit <= 0 or args.tol <= 0:
+        if not (args.time_limit > 0 and args.tol > 0):
             raise ValueError("--time-limit and --tol must be positive")
+        from rigidlcp.lcp.io.files import output_dir
+
+        output_dir(args.out, force=args.force)  # new or empty, unless --force
         notes: list[str] = []
         siconos_ok = siconos is not None and siconos.available
         if args.methods:

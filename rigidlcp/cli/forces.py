@@ -38,6 +38,8 @@ def register(sub) -> None:
     p.add_argument("--time-limit", type=float, default=10.0,
                    help="seconds for the paper's-choice MILP")
     p.add_argument("--out", required=True, metavar="DIR", help="directory for the PNGs")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite forces.json / network PNGs already in --out")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=cmd_forces)
 
@@ -45,6 +47,7 @@ def register(sub) -> None:
 def cmd_forces(args: argparse.Namespace) -> int:
     from rigidlcp import lcp, models
     from rigidlcp.cli.simulate import system_from_args
+    from rigidlcp.lcp.io.files import atomic_write_text, output_dir
     from rigidlcp.models.event import acceleration_tol
     from rigidlcp.verify.certificates.certify import certify
     from rigidlcp.verify.forces.particular import (
@@ -60,7 +63,13 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
     if args.networks < 1:
         raise ValueError(f"--networks must be >= 1, got {args.networks}")
+    if not args.time_limit > 0:
+        raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
     system = system_from_args(args)
+    lcp.get_method(args.method)
+    names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"
+                                              for k in range(args.networks)]
+    out = output_dir(args.out, force=args.force, names=names)
     state = models.initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
     ep = models.event_problem(system, state)
     sol = lcp.solve(ep.lcp, method=args.method)
@@ -110,8 +119,6 @@ def cmd_forces(args: argparse.Namespace) -> int:
             "omega_dot": nu_dot[2 * p:].tolist(), "accepted": cert.accepted,
             "scaled_residual": cert.scaled_residual, "R": R.tolist(), "S": x[c:].tolist(),
         })
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     paths = _draw(system, networks, out, args)
     indet = ranges.indeterminate(1e-6 * fscale)
     summary = {
@@ -126,8 +133,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
     if len(networks) < args.networks:
         summary["note"] = (f"only {len(networks)} distinct networks found (the admissible set "
                            f"has few vertices); {args.networks} were asked for")
-    with open(out / "forces.json", "w") as fh:
-        json.dump(summary, fh, indent=1, default=float)
+    atomic_write_text(out / "forces.json", json.dumps(summary, indent=1, default=float) + "\n")
     if args.json:
         print(json.dumps(summary, indent=1, default=float))
     else:

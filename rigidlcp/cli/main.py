@@ -31,10 +31,18 @@ COMMAND_MODULES = (
 )
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line (not the usage block), exit status 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        text = " ".join(message.split())
+        self.exit(2, f"{self.prog}: error: {text} (see `{self.prog} --help`)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     from rigidlcp import __version__
 
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="rigidlcp",
         description="Rigid disks with Signorini's condition and exact Coulomb friction as LCPs "
         "(Radjai, Brendel & Roux, PRE 54, 861, 1996).",
@@ -52,12 +60,23 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
+    except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more
+        _silence_stdout()
+        return 0
     except (RigidLCPError, ValueError, OSError) as exc:
         print(f"rigidlcp {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more
-        sys.stderr.close()
-        return 0
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that the interpreter's final flush does not fail again."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 def _one_line(exc: BaseException) -> str:

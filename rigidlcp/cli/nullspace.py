@@ -51,7 +51,9 @@ def add_nullspace(sub) -> None:
     p.add_argument("--no-localize", action="store_true",
                    help="skip the localized basis (one LP per contact)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
-    p.add_argument("--plot", metavar="OUT.png", help="draw the localized basis on the lattice")
+    p.add_argument("--plot", metavar="OUT.png", help="draw the localized basis on the lattice "
+                   "(with --loops also OUT_loops.png)")
+    p.add_argument("--force", action="store_true", help="overwrite existing --plot files")
     p.set_defaults(func=cmd_nullspace)
 
 
@@ -68,6 +70,20 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
 
     system = models.System(models.make_lattice(args.lattice, args.lx, args.ly),
                            mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
+    if args.plot:  # checked before the SVD: never overwrite a user's file without --force
+        from pathlib import Path
+
+        from rigidlcp.lcp.io.files import check_new, output_dir
+
+        if args.no_localize:
+            raise ValueError("--plot needs the localized basis (drop --no-localize)")
+        plot = Path(args.plot)
+        if plot.suffix.lower() not in (".png", ".pdf", ".svg"):
+            raise ValueError(f"--plot takes a .png, .pdf or .svg file name, got {args.plot!r}")
+        targets = [plot] + ([plot.with_name(plot.stem + "_loops" + plot.suffix)]
+                            if args.loops else [])
+        check_new(targets, force=args.force)
+        output_dir(plot.parent, force=True)
     if args.states in ("normal", "tangential"):
         normal, tangential = paper_states(system, args.states)
     else:

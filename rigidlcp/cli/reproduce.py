@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
-from pathlib import Path
 
 
 def register(sub) -> None:
@@ -25,17 +24,21 @@ def register(sub) -> None:
                    help="worker processes (default: the CPUs available; 1: in this process)")
     p.add_argument("--dask", default=None, metavar="tcp://HOST:PORT|local",
                    help="run the jobs on a dask.distributed scheduler or a LocalCluster")
+    p.add_argument("--force", action="store_true",
+                   help="write into an --out directory that is not empty")
     p.add_argument("--no-progress", action="store_true")
     p.set_defaults(func=cmd_reproduce)
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
+    from rigidlcp.lcp.io.files import output_dir
     from rigidlcp.reproduce.claims import evaluate
     from rigidlcp.reproduce.experiments import plan, run_all
     from rigidlcp.reproduce.report import figures, write_report
 
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    if args.jobs is not None and args.jobs < 1:
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
+    out = output_dir(args.out, force=args.force)  # new or empty, unless --force
     command = "rigidlcp reproduce " + " ".join(
         shlex.quote(a) for a in (sys.argv[2:] if sys.argv[1:2] == ["reproduce"] else
                                  ["--out", str(out)] + (["--quick"] if args.quick else [])))

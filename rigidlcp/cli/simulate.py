@@ -46,13 +46,16 @@ def register(sub) -> None:
     g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
     g.add_argument("--fallback", default="lemke",
                    help="method used at an event where --method fails ('none': stop)")
-    g.add_argument("--select", choices=("face-min-norm", "none"), default="face-min-norm",
+    g.add_argument("--select", choices=("face-min-norm", "global", "none"),
+                   default="face-min-norm",
                    help="particular solution when an event's solution is not unique")
-    g.add_argument("--t-max", type=float, default=np.inf)
+    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
     g.add_argument("--max-events", type=int, default=100_000)
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")
     g.add_argument("--dump-problems", default=None, metavar="DIR",
-                   help="write every event's LCP to DIR/event_NNNNNN.npz")
+                   help="write every event's LCP to DIR/event_NNNNNN.npz (DIR new or empty)")
+    g.add_argument("--force", action="store_true",
+                   help="overwrite an existing --out run / write into a non-empty DIR")
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
     g.add_argument("--no-progress", action="store_true")
     p.set_defaults(func=cmd_simulate)
@@ -61,20 +64,36 @@ def register(sub) -> None:
     p.add_argument("run", help="a run saved by `rigidlcp simulate --out`")
     p.add_argument("--out", required=True, help="directory for the PNGs")
     p.add_argument("--event", type=int, default=-1, help="event to draw (default: the last)")
+    p.add_argument("--force", action="store_true", help="overwrite PNGs already in --out")
     p.set_defaults(func=cmd_plot)
 
 
 def cmd_simulate(args) -> int:
+    from rigidlcp import lcp
+    from rigidlcp.lcp.io.files import check_new, output_dir
     from rigidlcp.models.engine import simulate
     from rigidlcp.models.event import initial_state
     from rigidlcp.models.observables import state_counts
-    from rigidlcp.models.runio import save_run
+    from rigidlcp.models.runio import run_paths, save_run
 
     system = system_from_args(args)
     if args.omega_scale < 0 or not np.isfinite(args.omega_scale):
         raise ValueError(f"--omega-scale must be a finite number >= 0, got {args.omega_scale}")
     if args.max_events < 1:
         raise ValueError(f"--max-events must be >= 1, got {args.max_events}")
+    if not args.t_max > 0:
+        raise ValueError(f"--t-max must be > 0, got {args.t_max}")
+    for name in (args.method, args.fallback):
+        if name not in ("none", "sparse-pivoting"):
+            lcp.get_method(name)  # an unknown method fails now, not at the first event
+    # Outputs are checked before the run, not after it: a user's file is never overwritten
+    # (without --force) and a run is never lost to an unwritable folder.
+    if args.out:
+        paths = run_paths(args.out)
+        check_new(paths, force=args.force)
+        output_dir(paths[0].parent, force=True)
+    if args.dump_problems:
+        output_dir(args.dump_problems, force=args.force)
     state = initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
     fallback = None if args.fallback == "none" else args.fallback
     bar = None
@@ -131,7 +150,8 @@ def cmd_simulate(args) -> int:
 
 
 def cmd_plot(args) -> int:
-    from rigidlcp.models.plot import plot_run
+    from rigidlcp.lcp.io.files import output_dir
+    from rigidlcp.models.plot import PLOT_FILES, plot_run
     from rigidlcp.models.runio import load_run
 
     run = load_run(args.run)
@@ -139,6 +159,7 @@ def cmd_plot(args) -> int:
         raise ValueError(f"{args.run} has no event to draw")
     if not -run.n_events <= args.event < run.n_events:
         raise ValueError(f"--event must be in [-{run.n_events}, {run.n_events - 1}]")
-    for path in plot_run(run, args.out, event=args.event):
+    out = output_dir(args.out, force=args.force, names=PLOT_FILES)
+    for path in plot_run(run, out, event=args.event):
         print(path)
     return 0

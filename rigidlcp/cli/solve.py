@@ -99,12 +99,9 @@ def _jsonable(x: Any) -> Any:
 
 
 def _load(path: str):
-    try:
-        return load(path)
-    except (FileNotFoundError, InvalidProblem):
-        raise
-    except Exception as exc:  # a corrupt or foreign file: numpy/zipfile say why
-        raise InvalidProblem(f"cannot read {path} as a problem file: {exc}") from None
+    """lcp.load: a missing, corrupt or foreign file raises FileNotFoundError / InvalidFile
+    naming it (one line on the command line)."""
+    return load(path)
 
 
 def cmd_certify(args: argparse.Namespace) -> int:

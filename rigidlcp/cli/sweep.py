@@ -65,6 +65,8 @@ def add_sweep(sub) -> None:
                    "of --jobs workers on 127.0.0.1 ('local'); needs rigidlcp[dask]")
     e.add_argument("--save-runs", action="store_true",
                    help="also save every run to OUT/runs/<id>.npz (see `rigidlcp plot`)")
+    e.add_argument("--force", action="store_true",
+                   help="write into an --out directory that is not empty and not a sweep's")
     e.add_argument("--json", action="store_true", help="print the rows as JSON lines")
     e.add_argument("--no-progress", action="store_true")
     p.set_defaults(func=cmd_sweep)
@@ -88,25 +90,24 @@ def sweep_from_args(args: argparse.Namespace):
     options = {"method": args.method, "select": args.select, "max_events": args.max_events,
                "t_max": args.t_max, "omega_scale": args.omega_scale,
                "fallback": None if args.fallback == "none" else args.fallback}
-    from rigidlcp import lcp
-
-    for name in (options["method"], options["fallback"]):
-        if name is not None:
-            lcp.get_method(name)  # unknown methods fail here, not once per point
-    return Sweep(axes, fixed, options)
+    sweep = Sweep(axes, fixed, options)
+    sweep.validate()  # every point of the grid, before anything runs
+    return sweep
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from rigidlcp.models.sweep import run_sweep, varying
+    from rigidlcp.models.sweep import check_out, run_sweep, varying
 
     sweep = sweep_from_args(args)
+    check_out(args.out, force=args.force)
     n = len(sweep.points())
     print(f"sweep: {n} point(s); axes: " + (", ".join(
         f"{k} ({len(v)})" for k, v in sweep.axes.items()) or "none") + f"; out: {args.out}",
         file=sys.stderr)
     try:
         res = run_sweep(sweep, args.out, jobs=args.jobs, dask=args.dask,
-                        progress=not args.no_progress, save_runs=args.save_runs)
+                        progress=not args.no_progress, save_runs=args.save_runs,
+                        force=args.force)
     except KeyboardInterrupt:
         print(f"\ninterrupted: the finished points are in {Path(args.out) / 'results.jsonl'};"
               " rerun the same command to resume", file=sys.stderr)
@@ -152,6 +153,10 @@ def _fmt(v) -> str:
 # -- rigidlcp effective --------------------------------------------------------------------------
 
 
+#: The files `rigidlcp effective` writes.
+EFFECTIVE_FILES = ("effective.json", "mu_g.png", "effective.png")
+
+
 def add_effective(sub) -> None:
     p = sub.add_parser(
         "effective", help="effective inertia and friction of a gamma sweep (Eqs. 4.1-4.2)",
@@ -166,6 +171,8 @@ def add_effective(sub) -> None:
                    "effective.json (default: the sweep directory)")
     p.add_argument("--degree", type=int, default=1, help="degree of the local fits")
     p.add_argument("--window", type=int, default=3, help="points per local fit")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite effective.json, mu_g.png, effective.png if present")
     p.add_argument("--json", action="store_true", help="print the table as JSON")
     p.set_defaults(func=cmd_effective)
 
@@ -193,8 +200,10 @@ def cmd_effective(args: argparse.Namespace) -> int:
                 "left_out": [{"gamma": r["gamma"], "seed": r["seed"], "status": r["status"]}
                              for r in lo]}
                for (p, e, lo), lab in zip(usable, labels)]
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "effective.json").write_text(json.dumps(payload, indent=1) + "\n")
+    from rigidlcp.lcp.io.files import atomic_write_text, output_dir
+
+    output_dir(out, force=args.force, names=EFFECTIVE_FILES)
+    atomic_write_text(out / "effective.json", json.dumps(payload, indent=1) + "\n")
     files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out)
     if args.json:
         print(json.dumps(payload, indent=1))

@@ -174,17 +174,25 @@ def read_states(path: str, lattice: models.Lattice) -> tuple[np.ndarray, np.ndar
     import json
     from pathlib import Path
 
+    from rigidlcp.lcp.errors import InvalidFile
+    from rigidlcp.lcp.io.files import open_npz
+
     path = Path(path)
     if not path.exists():
-        raise FileNotFoundError(f"no such states file: {path}")
+        raise FileNotFoundError(2, "No such states file", str(path))
+    if path.is_dir():
+        raise InvalidFile(f"{path} is a directory, not a states file (.json or .npz)")
     if path.suffix == ".npz":
-        with np.load(path, allow_pickle=False) as f:
+        with open_npz(path, "a states file (.npz with 'normal' and 'tangential')") as f:
             data = {k: f[k] for k in f.files}
             data = {k: (v.item() if v.ndim == 0 else v) for k, v in data.items()}
     else:
-        data = json.loads(path.read_text())
+        try:
+            data = json.loads(path.read_text())
+        except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise InvalidFile(f"{path} is not a states file (JSON: {exc})") from None
         if not isinstance(data, dict):
-            raise ValueError(f"{path}: expected a JSON object with 'normal' and 'tangential'")
+            raise InvalidFile(f"{path}: expected a JSON object with 'normal' and 'tangential'")
     names = {"rect": ("rect", "rectangular"), "tri": ("tri", "triangular")}[lattice.name]
     checks = (("lattice", lambda v: str(v).lower() in names, lattice.name),
               ("lx", lambda v: int(v) == lattice.lx, lattice.lx),
