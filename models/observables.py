@@ -25,9 +25,85 @@ def global_friction_coefficient(system: System, S: np.ndarray) -> float:
     return global_friction(system, S) / (system.total_mass * system.g)
 
 
+#: A reported observable whose magnitude is below ZERO_TOL times its natural scale is rounding
+#: noise and reported as 0 (`reported`): mu_g against 1, F_g against the weight m_g g, the
+#: dissipation rate against (sum |R| + sum |S|) max |v_t|, its slope with max |a_t|.
+ZERO_TOL = 1e-9
+
+#: Stop statuses of a run outside the regime the paper studies (no particle displacement,
+#: Sec. II; a finite number of events): its numbers are not the paper's observables.
+EXCLUDED = {"detachment": "a contact opens (a_n > 0): particles would move, which the paper's "
+                          "model (fixed geometry, Sec. II) excludes",
+            "zeno": "events accumulate in finite time (Zeno): the event-driven evolution of "
+                    "Sec. II C does not continue past it"}
+
+
 def dissipation_rate(S: np.ndarray, vt: np.ndarray) -> float:
-    """D = -sum_alpha S_alpha v_t,alpha (>= 0 under Coulomb's law)."""
+    """D = -sum_alpha S_alpha v_t,alpha (>= 0 under Coulomb's law), the power dissipated by
+    friction: the paper's total dissipation rate W' = sum S theta'^t of Fig. 13 (Sec. IV C),
+    with this toolkit's sign of S (DESIGN.md). Raw value: see `reported` for the noise."""
     return float(-np.dot(S, vt))
+
+
+def reported(value: float, scale: float) -> float:
+    """`value`, or 0.0 when |value| <= ZERO_TOL * scale (rounding noise such as -9.6e-31)."""
+    return 0.0 if abs(value) <= ZERO_TOL * abs(scale) else float(value)
+
+
+def dissipated_energy(records, t_end: float | None = None) -> float:
+    """Energy dissipated by friction from the first event to `t_end` (default: the last
+    event): the integral of D(t). Between events S is constant and v_t = v_t,k + a_t,k (t -
+    t_k), so D is linear there and the integral is exact: sum_k D_k dt_k - (S_k . a_t,k)
+    dt_k^2 / 2."""
+    recs = list(records)
+    if not recs:
+        return 0.0
+    if any(r.S.size == 0 for r in recs):
+        raise ValueError("the run keeps light records (no S, v_t, a_t per event): run it with "
+                         "records='full' to integrate the dissipation")
+    t_end = recs[-1].t if t_end is None else t_end
+    E = 0.0
+    for k, rec in enumerate(recs):
+        t1 = min(recs[k + 1].t if k + 1 < len(recs) else t_end, t_end)
+        dt = max(t1 - rec.t, 0.0)
+        E += -float(rec.S @ rec.vt) * dt - 0.5 * float(rec.S @ rec.at) * dt * dt
+    return E
+
+
+def dissipation_summary(records) -> dict:
+    """The dissipation observables of a run (Sec. IV C, Fig. 13), with units r = m = g = 1:
+
+    * dissipation_rate: D = -sum S v_t right after the last event (a power, m g sqrt(g r));
+      in a steady state at constant driving velocity (gamma = 0) it is the steady-state rate;
+    * dissipation_rate_slope: dD/dt = -sum S a_t after the last event: 0 when D is stationary;
+      under a constant acceleration gamma != 0 the sliding velocities, hence D, grow linearly;
+    * dissipated_energy over dissipated_energy_interval = [first event, last event]: the
+      integral of D (exact, `dissipated_energy`), in m g r.
+
+    Rates within ZERO_TOL of their terms' magnitude are reported as 0 (`reported`)."""
+    recs = list(records)
+    if not recs:
+        return {}
+    last = recs[-1]
+    if any(r.S.size == 0 for r in recs):  # light records (sparse engine): the rate only
+        return {"dissipation_rate": float(last.dissipation), "dissipation_rate_slope": None,
+                "dissipated_energy": None, "dissipated_energy_interval": None}
+    force = float(np.sum(np.abs(last.R)) + np.sum(np.abs(last.S)))
+    return {
+        "dissipation_rate": reported(-float(last.S @ last.vt),
+                                     force * float(np.max(np.abs(last.vt), initial=0.0))),
+        "dissipation_rate_slope": reported(-float(last.S @ last.at),
+                                           force * float(np.max(np.abs(last.at), initial=0.0))),
+        "dissipated_energy": dissipated_energy(recs),
+        "dissipated_energy_interval": [float(recs[0].t), float(last.t)],
+    }
+
+
+def regime(status: str) -> dict:
+    """{"paper_regime": bool, "regime_note": why not} for a run's stop status."""
+    if status in EXCLUDED:
+        return {"paper_regime": False, "regime_note": EXCLUDED[status]}
+    return {"paper_regime": True}
 
 
 def rotational_energy(system: System, omega: np.ndarray) -> float:
@@ -75,7 +151,9 @@ def states_text(system: System, R: np.ndarray, s: np.ndarray) -> list[str]:
 
 
 __all__ = [
-    "global_friction", "global_friction_coefficient", "dissipation_rate", "rotational_energy",
+    "global_friction", "global_friction_coefficient", "dissipation_rate", "reported",
+    "dissipated_energy", "dissipation_summary", "regime", "EXCLUDED", "ZERO_TOL",
+    "rotational_energy",
     "obstacle_force_on_disks", "horizontal_balance", "state_counts", "states_text",
     "LEFT_WALL", "RIGHT_WALL", "PLANE",
 ]

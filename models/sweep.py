@@ -3,8 +3,9 @@
 A sweep is the Cartesian product of value lists for the system's parameters (`PARAMS`: lattice,
 lx, ly, the three friction coefficients, gamma, V0, inertia, seed) with fixed run options
 (`RUN_OPTIONS`). Each point is one `models.simulate` run to its steady state (Sec. IV); its
-summary -- steady-state F_g and mu_g (Eq. 2.1-2.2), dissipation rate, contact-state counts,
-number of events, stop status -- is one line of `OUT/results.jsonl`.
+summary -- steady-state F_g and mu_g (Eq. 2.1-2.2), dissipation rate (and its slope),
+contact-state counts, number of events, stop status, whether it stayed in the paper's regime --
+is one line of `OUT/results.jsonl`.
 
 Durability: a line is written by a single `write` on a file opened with O_APPEND and fsync'ed
 as soon as its point finishes, by the one process that owns the file (the workers only compute).
@@ -40,6 +41,7 @@ from rigidlcp.lcp.io.files import atomic_write_text
 
 from .executors import default_jobs, iter_map
 from .runio import _json_default
+from .system import DEFAULT_MU
 
 #: Sweepable parameters and their types (names as in `rigidlcp.cli.simulate.add_system_arguments`).
 PARAMS: dict[str, type] = {
@@ -48,7 +50,7 @@ PARAMS: dict[str, type] = {
 }
 #: Defaults of the parameters (those of `rigidlcp simulate`).
 DEFAULTS: dict[str, Any] = {
-    "lattice": "rect", "lx": 10, "ly": 4, "mu_pp": 0.1, "mu_plane": 0.2, "mu_wall": 0.0,
+    "lattice": "rect", "lx": 10, "ly": 4, **DEFAULT_MU,
     "gamma": 0.1, "v0": 0.0, "inertia": None, "seed": 1,
 }
 #: Run options, fixed for a sweep and part of every point's identity.
@@ -60,9 +62,9 @@ RESULTS = "results.jsonl"
 TIMINGS = "timings.jsonl"
 SPEC = "sweep.json"
 #: Result columns written for every point, in this order after the parameters.
-RESULT_FIELDS = ("status", "steady", "events", "t", "m_g", "F_g", "mu_g", "dissipation",
-                 "T", "NT", "NS_pp", "NS_plane", "NS_wall", "sliding_pp", "sliding_plane",
-                 "sliding_wall", "fallbacks", "message")
+RESULT_FIELDS = ("status", "steady", "events", "t", "m_g", "F_g", "mu_g", "dissipation_rate",
+                 "dissipation_rate_slope", "paper_regime", "T", "NT", "NS_pp", "NS_plane",
+                 "NS_wall", "sliding_pp", "sliding_plane", "sliding_wall", "fallbacks", "message")
 
 
 def _round(v: float) -> float:
@@ -244,10 +246,14 @@ def run_point(point: dict, runs_dir: str | None = None) -> dict:
     res: dict[str, Any] = {"status": run.status, "steady": run.steady, "events": run.n_events,
                            "m_g": m_g, "message": run.message,
                            "fallbacks": int(sum(r.fallback for r in run.records))}
+    summary = run.summary()
+    res["paper_regime"] = summary["paper_regime"]
     if run.records:
         last = run.last
-        res.update(t=last.t, mu_g=last.mu_g, F_g=last.mu_g * m_g * system.g,
-                   dissipation=last.dissipation, **state_counts(system, last))
+        res.update(t=last.t, mu_g=summary["mu_g"], F_g=summary["F_g"],
+                   dissipation_rate=summary["dissipation_rate"],
+                   dissipation_rate_slope=summary["dissipation_rate_slope"],
+                   **state_counts(system, last))
     row.update({f: res.get(f) for f in RESULT_FIELDS})
     if runs_dir is not None:
         from .runio import save_run
@@ -405,7 +411,7 @@ def run_sweep(sweep: Sweep, out: str | os.PathLike, *, jobs: int | None = None,
             f"{len(todo)} to run")
     bar = None
     if progress:
-        from tqdm import tqdm
+        from .progress import new_bar as tqdm  # erased at the end: no stale bar on screen
 
         bar = tqdm(total=len(points), initial=skipped, unit="pt", desc="sweep",
                    file=sys.stderr, dynamic_ncols=True)

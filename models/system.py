@@ -42,18 +42,25 @@ def _finite(name: str, value) -> float:
     return v
 
 
+#: The default friction coefficients of every entry point (models.System, `rigidlcp simulate`,
+#: `sweep`, `forces`): those of the paper's Figs. 7, 9 and 10. (`rigidlcp nullspace` alone uses
+#: one coefficient everywhere, 0.3, so that the structures of Fig. 5 stay local.)
+DEFAULT_MU = {"mu_pp": 0.1, "mu_plane": 0.2, "mu_wall": 0.0}
+
+
 @dataclass(frozen=True, eq=False)
 class System:
     """Lattice + friction (mu_pp particle-particle, mu_plane, mu_wall) + m, I, g + driving.
 
     gamma: constant acceleration of the box relative to the plane (either sign; 0 = constant
     velocity); V0: the relative velocity at t = 0. I defaults to m r^2 / 2 (uniform disks).
+    The friction coefficients default to DEFAULT_MU (the paper's Figs. 7, 9, 10).
     """
 
     lattice: Lattice
-    mu_pp: float = 0.0
-    mu_plane: float = 0.0
-    mu_wall: float = 0.0
+    mu_pp: float = DEFAULT_MU["mu_pp"]
+    mu_plane: float = DEFAULT_MU["mu_plane"]
+    mu_wall: float = DEFAULT_MU["mu_wall"]
     gamma: float = 0.0
     V0: float = 0.0
     mass: float = 1.0
@@ -115,4 +122,4 @@ def make_system(lattice: str, lx: int, ly: int, **params) -> System:
     return System(make_lattice(lattice, lx, ly, radius), **params)
 
 
-__all__ = ["System", "make_system", "KINDS"]
+__all__ = ["System", "make_system", "KINDS", "DEFAULT_MU"]

@@ -36,6 +36,11 @@ class EventRecord:
     method: str
     fallback: bool = False
 
+    def __repr__(self) -> str:
+        return (f"<EventRecord t = {self.t:.6g}: mu_g = {self.mu_g:.6g}, D = "
+                f"{self.dissipation:.3g}, {int((self.s != 0).sum())} of {self.s.size} contacts "
+                f"sliding, {self.method}{' (fallback)' if self.fallback else ''}>")
+
 
 @dataclass
 class Run:
@@ -79,13 +84,30 @@ class Run:
         return self.records[-1]
 
     def summary(self) -> dict:
-        from rigidlcp.models.observables import state_counts
+        """Status, the last event's observables (dissipation: models.observables.
+        dissipation_summary) and whether the run stayed in the paper's regime."""
+        from rigidlcp.models.observables import (
+            dissipation_summary,
+            regime,
+            reported,
+            state_counts,
+        )
 
         out = {"status": self.status, "message": self.message, "events": self.n_events,
-               "wall_time_s": round(self.wall_time, 4), "method": self.method}
+               "wall_time_s": round(self.wall_time, 4), "method": self.method,
+               **regime(self.status)}
         if self.records:
             last = self.last
-            out.update(t=last.t, mu_g=last.mu_g, F_g=last.mu_g * self.system.total_mass
-                       * self.system.g, dissipation=last.dissipation,
+            weight = self.system.total_mass * self.system.g
+            out.update(t=last.t, mu_g=reported(last.mu_g, 1.0),
+                       F_g=reported(last.mu_g * weight, weight),
+                       **dissipation_summary(self.records),
                        **state_counts(self.system, last))
         return out
+
+    def __repr__(self) -> str:
+        lat = self.system.lattice
+        last = (f", t = {self.records[-1].t:.6g}, mu_g = {self.records[-1].mu_g:.6g}"
+                if self.records else "")
+        return (f"<Run {lat.name} {lat.lx}x{lat.ly}: {self.status}, {self.n_events} events"
+                f"{last}, method {self.method!r}>")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,8 +29,8 @@ def register(sub) -> None:
         "ranges over the admissible set (linear programs), including the global friction F_g.")
     from rigidlcp.cli.simulate import add_system_arguments
 
-    add_system_arguments(p)  # the system options of `rigidlcp simulate`, with Fig. 4's defaults
-    p.set_defaults(lattice="tri", lx=5, ly=4, mu_pp=0.3, mu_plane=0.3, mu_wall=0.0, gamma=0.0)
+    add_system_arguments(p)  # the system options of `rigidlcp simulate` (and its friction)
+    p.set_defaults(lattice="tri", lx=5, ly=4, gamma=0.0)  # Fig. 4: a triangular array
     p.add_argument("--seed", type=int, default=0, help="seed of the angular velocities")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
@@ -130,6 +131,16 @@ def cmd_forces(args: argparse.Namespace) -> int:
         "F_g_range": list(ranges.observables["F_g"]),
         "networks": rows, "png": [str(q) for q in paths],
     }
+    opening = np.flatnonzero(~normal)
+    if opening.size:  # a_n > 0: contacts open, particles would move (not the paper's model)
+        from rigidlcp.models.observables import EXCLUDED
+
+        summary.update(paper_regime=False, regime_note=(
+            f"{opening.size} contact(s) open (a_n > 0 at "
+            + ", ".join(f"#{a}" for a in opening) + "): " + EXCLUDED["detachment"]))
+        print(f"warning: detachment regime: {summary['regime_note']}", file=sys.stderr)
+    else:
+        summary["paper_regime"] = True
     if len(networks) < args.networks:
         summary["note"] = (f"only {len(networks)} distinct networks found (the admissible set "
                            f"has few vertices); {args.networks} were asked for")

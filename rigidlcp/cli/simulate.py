@@ -12,13 +12,16 @@ import numpy as np
 
 def add_system_arguments(p: argparse.ArgumentParser) -> None:
     """The options that define a system (shared with other commands)."""
+    from rigidlcp.models.system import DEFAULT_MU
+
     g = p.add_argument_group("system")
     g.add_argument("--lattice", choices=("rect", "tri"), default="rect")
     g.add_argument("--lx", type=int, default=10, help="disks in the rows touching both walls")
     g.add_argument("--ly", type=int, default=4, help="number of rows")
-    g.add_argument("--mu-pp", type=float, default=0.1, help="particle-particle friction")
-    g.add_argument("--mu-plane", type=float, default=0.2, help="particle-plane friction")
-    g.add_argument("--mu-wall", type=float, default=0.0, help="particle-wall friction")
+    for name, text in (("mu_pp", "particle-particle"), ("mu_plane", "particle-plane"),
+                       ("mu_wall", "particle-wall")):
+        g.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
+                       help=f"{text} friction coefficient (default {DEFAULT_MU[name]})")
     g.add_argument("--gamma", type=float, default=0.1,
                    help="acceleration of the box relative to the plane, in g "
                    "(0: constant velocity)")
@@ -98,9 +101,9 @@ def cmd_simulate(args) -> int:
     fallback = None if args.fallback == "none" else args.fallback
     bar = None
     if not args.no_progress:
-        from tqdm import tqdm
+        from rigidlcp.models.progress import new_bar
 
-        bar = tqdm(desc="events", unit="ev", file=sys.stderr, dynamic_ncols=True)
+        bar = new_bar(desc="events", unit="ev")  # erased at the end: no stale bar on screen
     last_save = [time.monotonic()]
 
     def progress(run) -> None:
@@ -120,6 +123,9 @@ def cmd_simulate(args) -> int:
     if args.out:
         path = save_run(run, args.out)
     summary = run.summary()
+    if not summary["paper_regime"]:
+        print(f"warning: the run left the paper's regime ({run.status}): "
+              f"{summary['regime_note']}", file=sys.stderr)
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
@@ -132,9 +138,12 @@ def cmd_simulate(args) -> int:
         if run.records:
             last = run.last
             counts = state_counts(system, last)
-            rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{last.mu_g:.6f}"),
-                     ("F_g", f"{last.mu_g * system.total_mass * system.g:.6f}"),
-                     ("dissipation rate", f"{last.dissipation:.6g}"),
+            rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{summary['mu_g']:.6f}"),
+                     ("F_g", f"{summary['F_g']:.6f}"),
+                     ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"),
+                     ("dD/dt", f"{summary['dissipation_rate_slope']:.6g}"),
+                     ("dissipated energy", f"{summary['dissipated_energy']:.6g} over t in "
+                      "[{:.6g}, {:.6g}]".format(*summary["dissipated_energy_interval"])),
                      ("transmitting / not", f"{counts['T']} / {counts['NT']}"),
                      ("non-sliding pp/plane/wall", f"{counts['NS_pp']} / {counts['NS_plane']}"
                       f" / {counts['NS_wall']}"),

@@ -120,6 +120,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         print_table(res.rows, cols)
         print(f"{len(res.rows)} points: {res.ran} run now, {res.skipped} found done; "
               f"results: {res.out / 'results.jsonl'}")
+    outside = [r for r in res.rows if r.get("paper_regime") is False]
+    if outside:
+        print(f"warning: {len(outside)} point(s) left the paper's regime (status "
+              + ", ".join(sorted({r['status'] for r in outside})) + "): their numbers are not "
+              "the paper's observables (paper_regime: false in results.jsonl)", file=sys.stderr)
     bad = [r for r in res.rows if r["status"] not in ("steady",)]
     if bad:
         print(f"{len(bad)} point(s) did not reach a steady state (status: "
@@ -128,14 +133,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def print_table(rows: list[dict], cols: list[str]) -> None:
-    head = cols + ["status", "events", "mu_g", "F_g", "dissipation", "NS", "sliding"]
+    head = cols + ["status", "events", "mu_g", "F_g", "D (rate)", "NS", "sliding"]
     table = []
     for r in rows:
         ns = sum(r.get(f"NS_{k}") or 0 for k in ("pp", "plane", "wall"))
         sl = sum(r.get(f"sliding_{k}") or 0 for k in ("pp", "plane", "wall"))
         table.append([_fmt(r.get(c)) for c in cols] + [
             str(r["status"]), str(r["events"]), _fmt(r.get("mu_g")), _fmt(r.get("F_g")),
-            _fmt(r.get("dissipation")), str(ns), str(sl)])
+            _fmt(r.get("dissipation_rate")), str(ns), str(sl)])
     widths = [max(len(h), *(len(t[k]) for t in table)) for k, h in enumerate(head)]
     print("  ".join(h.rjust(w) for h, w in zip(head, widths)))
     for t in table:

@@ -187,17 +187,15 @@ class Results:
 def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
             progress: bool = True) -> Results:
     """Run every job of plan `p` on the executor and collect the results."""
-    import sys
 
     todo = jobs_of(p)
     where = f"dask {dask}" if dask else f"{jobs or default_jobs()} local process(es)"
     res = Results(p, executor=where)
     bar = None
     if progress:
-        from tqdm import tqdm
+        from rigidlcp.models.progress import new_bar  # erased at the end: no stale bar
 
-        bar = tqdm(total=len(todo), unit="job", desc="reproduce", file=sys.stderr,
-                   dynamic_ncols=True)
+        bar = new_bar(total=len(todo), unit="job", desc="reproduce")
     start = time.perf_counter()
     try:
         for k, out in iter_map(Job(p), todo, jobs=jobs, dask=dask):

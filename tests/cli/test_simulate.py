@@ -47,7 +47,7 @@ def test_simulate_bad_input(args, message, capsys):
 
 def test_plot_missing_file(tmp_path, capsys):
     assert main(["plot", str(tmp_path / "nope.npz"), "--out", str(tmp_path)]) == 2
-    assert "no run file" in capsys.readouterr().err
+    assert "no such file" in capsys.readouterr().err.lower()
 
 
 def test_simulate_sparse_path_from_the_command_line(capsys):

@@ -196,4 +196,4 @@ def test_sweep_bad_input(tmp_path, args, message, capsys):
 
 def test_effective_needs_results(tmp_path, capsys):
     assert main(["effective", str(tmp_path)]) == 2
-    assert "no sweep results" in capsys.readouterr().err
+    assert "no sweep results" in capsys.readouterr().err.lower()
