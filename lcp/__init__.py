@@ -14,7 +14,8 @@ __all__ = [
 
 
 def __getattr__(name: str):
-    # Loaded on first use: enumeration needs scipy.optimize, friction scipy.sparse.
+    # Loaded on first use: enumeration needs scipy.optimize, friction scipy.sparse; and the
+    # public submodules are attributes (lcp.face, lcp.io, ...).
     if name == "enumerate_solutions":
         from .enumeration import enumerate_solutions
 
@@ -23,4 +24,10 @@ def __getattr__(name: str):
         from . import friction
 
         return getattr(friction, name)
-    raise AttributeError(f"module 'lcp' has no attribute {name!r}")
+    if not name.startswith("_"):  # a public submodule, as an attribute (issue 14.1)
+        import importlib
+        from importlib.util import find_spec
+
+        if find_spec(f"{__name__}.{name}") is not None:
+            return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

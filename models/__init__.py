@@ -2,7 +2,8 @@
 
 Dependencies point lcp <- models <- verify: this package imports `lcp`, never `verify`.
 The names below load on first use (PEP 562), so that a command loads only the modules it uses
-(e.g. `rigidlcp sweep --help` reads models.sweep's defaults without scipy.sparse).
+(e.g. `rigidlcp sweep --help` reads models.sweep's defaults without scipy.sparse). The public
+submodules are attributes too (`models.runio.save_run`, `models.plot`, ...).
 """
 
 from __future__ import annotations
@@ -33,6 +34,11 @@ def __getattr__(name: str):
         value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
         globals()[name] = value
         return value
+    if not name.startswith("_"):  # a public submodule, as an attribute (issue 14.1)
+        from importlib.util import find_spec
+
+        if find_spec(f"{__name__}.{name}") is not None:
+            return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

@@ -4,10 +4,22 @@ Subpackages by job: `certificates` (certify, uniqueness, laws), `nullspace` (nul
 contact matrix, the paper's formulas, loops, exact ranks), `forces` (force polyhedra, ranges,
 particular solutions); `strategies` holds hypothesis strategies for users' property tests.
 `rigidlcp.verify.certify` is the function; import the module's other names with
-`from verify.certify import ...`.
+`from rigidlcp.verify.certificates.certify import ...`. The subpackages and `strategies` are
+attributes of the package, imported on first use (`verify.strategies.lcps()`).
 """
 
 from .certificates.certify import Certificate as Certificate
 from .certificates.certify import certify as certify
 from .nullspace.contact import null_space as null_space
 from .nullspace.formulas import paper_singularities as paper_singularities
+
+#: Public subpackages and modules, importable as attributes on first use.
+SUBMODULES = ("certificates", "forces", "nullspace", "strategies")
+
+
+def __getattr__(name: str):
+    if name in SUBMODULES:
+        import importlib
+
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from rigidlcp import lcp
+from rigidlcp.lcp.errors import InvalidFile
 
 GOOD_M, GOOD_Q = np.eye(2), np.array([-1.0, 1.0])
 
@@ -106,10 +107,16 @@ def test_mlcp_save_load_round_trip(tmp_path):
 
 def test_load_refuses_foreign_and_missing_files(tmp_path):
     np.savez(tmp_path / "x.npz", X=np.eye(2))
-    with pytest.raises(lcp.InvalidProblem, match="neither an LCP"):
+    with pytest.raises(InvalidFile, match="neither an LCP"):
         lcp.load(tmp_path / "x.npz")
     with pytest.raises(FileNotFoundError):
         lcp.load(tmp_path / "missing.npz")
+    (tmp_path / "text.npz").write_text("not an archive")
+    with pytest.raises(InvalidFile, match="text.npz is not"):
+        lcp.load(tmp_path / "text.npz")
+    (tmp_path / "empty.npz").write_bytes(b"")
+    with pytest.raises(InvalidFile, match="empty"):
+        lcp.load(tmp_path / "empty.npz")
     np.savez(tmp_path / "bad.npz", M=np.ones((2, 3)), q=np.ones(2))
     with pytest.raises(lcp.InvalidProblem, match="square"):
         lcp.load(tmp_path / "bad.npz")

@@ -189,8 +189,11 @@ def test_forces_command(tmp_path, capsys):
         assert (out / path.split("/")[-1]).stat().st_size > 1000
     assert (out / "forces.json").exists()
     # a small array has few vertices: fewer networks than asked, and it says so
-    code = main(["forces", "--lattice", "tri", "--lx", "3", "--ly", "2", "--seed", "3",
-                 "--networks", "6", "--out", str(out)])
+    argv = ["forces", "--lattice", "tri", "--lx", "3", "--ly", "2", "--seed", "3",
+            "--networks", "6", "--out", str(out)]
+    assert main(argv) == 2  # the files of the first call are the user's now
+    assert "--force" in capsys.readouterr().err
+    code = main(argv + ["--force"])
     assert code == 0 and "only 4 distinct networks" in capsys.readouterr().out
 
 

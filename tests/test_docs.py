@@ -1,0 +1,142 @@
+"""The documentation runs (issue 14.3): a renamed function or option breaks CI, not a user.
+
+* Every ```python block of README.md and docs/*.md is executed; the blocks of one file share a
+  namespace (in order) and run in a temporary directory. A block preceded by the line
+  `<!-- not-run: REASON -->` is skipped (the reason is required).
+* Every `rigidlcp ...` line of a ```bash block is parsed by the real parser (the command and
+  every option must exist, choices must be valid), and the cheap commands (CHEAP) are run.
+* In the other fenced blocks (listings, transcripts), every `rigidlcp NAME` must name an
+  existing command.
+* The README lists every command.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+#: Commands cheap enough to run from the docs' bash blocks (seconds).
+CHEAP = {"methods", "verify-formulas"}
+_NOT_RUN = re.compile(r"<!--\s*not-run:\s*(\S.*?)\s*-->")
+
+
+def blocks(path: Path) -> list[tuple[str, int, str, str | None]]:
+    """(language, first line number, code, not-run reason) of every fenced block."""
+    out, lines, k = [], path.read_text().splitlines(), 0
+    while k < len(lines):
+        m = re.match(r"^(\s*)```(\w*)\s*$", lines[k])
+        if not m:
+            k += 1
+            continue
+        indent, lang, start = m.group(1), m.group(2), k + 1
+        prev = next((lines[j] for j in range(k - 1, -1, -1) if lines[j].strip()), "")
+        reason = _NOT_RUN.search(prev)
+        k += 1
+        body = []
+        while k < len(lines) and lines[k].strip() != "```":
+            body.append(lines[k][len(indent):] if lines[k].startswith(indent) else lines[k])
+            k += 1
+        k += 1
+        out.append((lang, start + 1, "\n".join(body), reason.group(1) if reason else None))
+    return out
+
+
+def _commands() -> set[str]:
+    from rigidlcp.cli.main import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    return set(sub.choices)
+
+
+def _command_lines(code: str) -> list[str]:
+    """The `rigidlcp ...` command lines of a shell block (continuations joined, prompts and
+    comments dropped, `.venv/bin/rigidlcp` and `&&` chains understood)."""
+    text = re.sub(r"\\\n\s*", " ", code)
+    out = []
+    for line in text.splitlines():
+        line = line.strip().removeprefix("$ ")
+        for part in line.split("&&"):
+            part = part.split(" #")[0].strip()
+            m = re.match(r"^(?:\S*/)?rigidlcp(\s.*)?$", part)
+            if m:
+                out.append("rigidlcp" + (m.group(1) or ""))
+    return out
+
+
+@pytest.mark.parametrize("path", DOCS, ids=[p.name for p in DOCS])
+def test_python_blocks_run(path: Path, tmp_path, monkeypatch):
+    code = [(line, c, why) for lang, line, c, why in blocks(path) if lang == "python"]
+    if not code:
+        pytest.skip("no python block")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    namespace: dict = {"__name__": f"docs_{path.stem}"}
+    ran = 0
+    for line, c, why in code:
+        if why is not None:
+            continue
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                exec(compile(c, f"{path.name}:{line}", "exec"), namespace)
+        except Exception as exc:
+            pytest.fail(f"{path.name}, the python block at line {line}: "
+                        f"{type(exc).__name__}: {exc}")
+        ran += 1
+    assert ran or all(why for _, _, why in code)
+
+
+@pytest.mark.parametrize("path", DOCS, ids=[p.name for p in DOCS])
+def test_shell_commands_exist_and_parse(path: Path, tmp_path, monkeypatch, capsys):
+    from rigidlcp.cli.main import build_parser, main
+
+    names = _commands()
+    problems = []
+    for lang, line, code, why in blocks(path):
+        if lang in ("python", "json") or why is not None:
+            continue
+        for cmd in _command_lines(code):
+            words = shlex.split(cmd)[1:]
+            if not words or words[0].startswith("-"):
+                continue
+            if words[0] not in names:
+                problems.append(f"line {line}: no command {words[0]!r}: {cmd}")
+                continue
+            if lang != "bash":  # listings: the name is enough ([OPTIONS] are placeholders)
+                continue
+            try:
+                build_parser().parse_args(words)
+            except SystemExit:
+                problems.append(f"line {line}: does not parse: {cmd}: "
+                                f"{capsys.readouterr().err.strip()}")
+                continue
+            if words[0] in CHEAP:
+                monkeypatch.chdir(tmp_path)
+                if main(words) != 0:
+                    problems.append(f"line {line}: exit status != 0: {cmd}")
+    assert not problems, f"{path.name}:\n" + "\n".join(problems)
+
+
+def test_readme_lists_every_command():
+    text = (ROOT / "README.md").read_text()
+    missing = [n for n in sorted(_commands()) if not re.search(rf"rigidlcp {n}\b", text)]
+    assert not missing, f"README.md does not list: {missing}"
+
+
+def test_not_run_markers_give_a_reason():
+    for path in DOCS:
+        for m in re.finditer(r"<!--\s*not-run(.*?)-->", path.read_text()):
+            assert m.group(1).strip(": ").strip(), f"{path.name}: not-run without a reason"
+
+
+if os.environ.get("RIGIDLCP_DOCS_DEBUG"):  # pragma: no cover
+    for p in DOCS:
+        print(p.name, [(lang, line, why) for lang, line, _, why in blocks(p)])
