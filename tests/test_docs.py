@@ -61,8 +61,11 @@ def _command_lines(code: str) -> list[str]:
     """The `rigidlcp ...` command lines of a shell block (continuations joined, prompts and
     comments dropped, `.venv/bin/rigidlcp` and `&&` chains understood)."""
     text = re.sub(r"\\\n\s*", " ", code)
+    lines = text.splitlines()
+    if any(line.startswith("$ ") for line in lines):  # a transcript: the prompts only
+        lines = [line for line in lines if line.startswith("$ ")]
     out = []
-    for line in text.splitlines():
+    for line in lines:
         line = line.strip().removeprefix("$ ")
         for part in line.split("&&"):
             part = part.split(" #")[0].strip()
@@ -140,3 +143,24 @@ def test_not_run_markers_give_a_reason():
 if os.environ.get("RIGIDLCP_DOCS_DEBUG"):  # pragma: no cover
     for p in DOCS:
         print(p.name, [(lang, line, why) for lang, line, _, why in blocks(p)])
+
+
+def test_public_submodules_are_attributes():
+    """`from rigidlcp import models; models.runio.save_run` works without importing the
+    submodule by hand (checked in a fresh interpreter, where nothing is imported yet)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import pkgutil\n"
+        "from rigidlcp import lcp, models, verify\n"
+        "missing = []\n"
+        "for pkg in (lcp, models, verify):\n"
+        "    for m in pkgutil.iter_modules(pkg.__path__):\n"
+        "        if not m.name.startswith('_') and not hasattr(pkg, m.name):\n"
+        "            missing.append(pkg.__name__ + '.' + m.name)\n"
+        "print(' '.join(missing))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "", f"not attributes of their package: {out}"
