@@ -26,9 +26,15 @@ def _plt():
     return plt
 
 
+#: Units of the quantities drawn (r = m = g = 1, DESIGN.md).
+UNITS = {"omega_dot": "g / r", "omega": "sqrt(g / r)", "t": "sqrt(r / g)", "force": "m g",
+         "D": "m g sqrt(g r)"}
+
+
 def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: str = "",
                  cmap: str = "coolwarm") -> None:
-    """Disks (coloured by `values`, symmetric colour scale), walls and plane."""
+    """Disks (coloured by `values`, symmetric colour scale, with a colourbar of this panel's
+    own whose label `label` is written horizontally above it), walls and plane."""
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle
 
@@ -45,7 +51,8 @@ def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: st
         coll.set_facecolor("whitesmoke")
     ax.add_collection(coll)
     if values is not None:
-        ax.figure.colorbar(coll, ax=ax, label=label, shrink=0.8)
+        cb = ax.figure.colorbar(coll, ax=ax, shrink=0.8, pad=0.02)
+        cb.ax.set_title(label, fontsize="small", loc="left")
     top = lat.x[:, 1].max() + r
     ax.plot([0, 0], [0, top], "k-", lw=2)
     ax.plot([lat.width, lat.width], [0, top], "k-", lw=2)
@@ -65,13 +72,16 @@ def contact_points(system: System) -> tuple[np.ndarray, np.ndarray]:
 
 
 def draw_forces(ax, system: System, F: np.ndarray, signed: bool = False,
-                max_width: float = 6.0) -> None:
-    """Contact forces as segments whose width is proportional to |F| (Fig. 8b-c, Fig. 4).
-    signed: colour by sign (red +, blue -), for friction forces."""
+                max_width: float = 6.0, fmax: float | None = None, key: bool = True,
+                name: str = "R") -> float:
+    """Contact forces as segments from centre to centre (or to the obstacle) whose width is
+    proportional to |F| (Fig. 8b-c, Fig. 4): `max_width` points for `fmax` (default: the
+    largest |F|; pass one value to share a scale between panels). signed: colour by sign (red
+    +, blue -), for friction forces. key: a width scale below the panel. Returns fmax."""
     from matplotlib.collections import LineCollection
 
     a, b = contact_points(system)
-    fmax = max(np.abs(F).max(initial=0.0), 1e-12)
+    fmax = max(np.abs(F).max(initial=0.0), 1e-12) if fmax is None else fmax
     widths = max_width * np.abs(F) / fmax
     colors = ["tab:red" if f > 0 else "tab:blue" for f in F] if signed else "k"
     segs = np.stack([a, b], axis=1)
@@ -79,6 +89,55 @@ def draw_forces(ax, system: System, F: np.ndarray, signed: bool = False,
     if np.any(keep):
         ax.add_collection(LineCollection(segs[keep], linewidths=widths[keep],
                                          colors=np.array(colors)[keep] if signed else colors))
+    if key:
+        force_key(ax, fmax, max_width, name=name, signed=signed)
+    return fmax
+
+
+def force_key(ax, fmax: float, max_width: float, name: str = "R", signed: bool = False) -> None:
+    """A legend below the panel: segment widths for |F| = fmax, fmax/2, fmax/4 (in m g)."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="k", lw=max_width * f) for f in (1.0, 0.5, 0.25)]
+    labels = [f"|{name}| = {fmax * f:.3g} m g" for f in (1.0, 0.5, 0.25)]
+    if signed:
+        handles += [Line2D([], [], color=c, lw=3) for c in ("tab:red", "tab:blue")]
+        labels += [f"{name} > 0", f"{name} < 0"]
+    ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0),
+              ncol=len(labels), fontsize="x-small", frameon=False, handlelength=2.5)
+
+
+def plot_rows(fig, system: System, omega_dot: np.ndarray, title: str = "") -> None:
+    """Fig. 9: the angular accelerations against the position along each row, one panel per
+    row (top row at the top, shared axes), so that rows with equal values do not hide each
+    other."""
+    lat = system.lattice
+    axes = fig.subplots(lat.ly, 1, sharex=True, sharey=True, squeeze=False)[:, 0]
+    lim = max(float(np.abs(omega_dot).max(initial=0.0)), 1e-12) * 1.15
+    for k, ax in enumerate(axes):
+        row = lat.ly - 1 - k
+        sel = np.flatnonzero(lat.row == row)
+        sel = sel[np.argsort(lat.x[sel, 0])]
+        ax.plot(lat.x[sel, 0], omega_dot[sel], "o-", ms=4, color=f"C{row % 10}")
+        ax.axhline(0, color="grey", lw=0.5)
+        ax.set_ylim(-lim, lim)
+        ax.text(1.01, 0.5, f"row {row + 1}", transform=ax.transAxes, va="center",
+                fontsize="small")
+    axes[-1].set_xlabel("x / r (position along the row)")
+    fig.supylabel(r"$\dot\omega$ (" + UNITS["omega_dot"] + ")")
+    if title:
+        axes[0].set_title(title, fontsize="medium")
+
+
+def time_axis(ax, t: np.ndarray) -> None:
+    """A time axis that shows the transient: symmetric-log, linear below the first event
+    interval (on a linear scale the early events are squeezed against the axis)."""
+    t = np.asarray(t)
+    pos = t[t > 0]
+    if pos.size and pos.max() > 20 * pos.min():
+        ax.set_xscale("symlog", linthresh=float(pos.min()), linscale=1.0)
+    log = ax.get_xscale() == "symlog"
+    ax.set_xlabel(f"t ({UNITS['t']})" + (", log scale" if log else ""))
 
 
 def step_series(run: Run, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -119,47 +178,45 @@ def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
 
     lat = system.lattice
     size = (max(6.0, 0.6 * lat.lx + 2), max(3.0, 0.6 * lat.ly * (0.87 if lat.name == "tri" else 1)
-                                            + 1.5))
-    for name, values, label in (("angular_acceleration", rec.omega_dot, r"$\dot\omega$"),
-                                ("angular_velocity", rec.omega, r"$\omega$")):
+                                            + 1.8))
+    when = f"t = {rec.t:.4g} ({run.status}, event {event % run.n_events})"
+    for name, values, label, unit in (
+            ("angular_acceleration", rec.omega_dot, r"$\dot\omega$", UNITS["omega_dot"]),
+            ("angular_velocity", rec.omega, r"$\omega$", UNITS["omega"])):
         fig, ax = plt.subplots(figsize=size)
-        draw_lattice(ax, system, values, label=label)
-        ax.set_title(f"{label} at t = {rec.t:.4g} ({run.status}, event {event % run.n_events})")
+        draw_lattice(ax, system, values, label=f"{label} ({unit})")
+        ax.set_title(f"{label} at {when}")
         save(fig, f"{name}.png")
     # Fig. 9: angular accelerations against the position in each row.
-    fig, ax = plt.subplots(figsize=(6.5, 4))
-    for row in range(lat.ly):
-        sel = lat.row == row
-        ax.plot(lat.x[sel, 0], rec.omega_dot[sel], "o-", label=f"row {row + 1}")
-    ax.axhline(0, color="grey", lw=0.5)
-    ax.set_xlabel("x / r")
-    ax.set_ylabel(r"$\dot\omega$ (g / r)")
-    ax.legend(fontsize="small")
+    fig = plt.figure(figsize=(6.5, 1.0 + 1.1 * lat.ly), layout="constrained")
+    plot_rows(fig, system, rec.omega_dot, title=f"angular accelerations by row, {when}")
     save(fig, "angular_acceleration_rows.png")
-    for name, F, signed, title in (("normal_forces", rec.R, False, "normal forces R"),
-                                   ("friction_forces", rec.S, True, "friction forces S")):
+    for name, F, signed, title, sym in (
+            ("normal_forces", rec.R, False, "normal forces R", "R"),
+            ("friction_forces", rec.S, True, "friction forces S", "S")):
         fig, ax = plt.subplots(figsize=size)
         draw_lattice(ax, system)
-        draw_forces(ax, system, F, signed=signed)
-        ax.set_title(f"{title} at t = {rec.t:.4g} (width ~ |force|)")
+        draw_forces(ax, system, F, signed=signed, name=sym)
+        ax.set_title(f"{title} at {when}; width ~ |{sym}|")
         save(fig, f"{name}.png")
     # Fig. 10: mu_g(t); Fig. 13: dissipation rate.
     fig, ax = plt.subplots(figsize=(6.5, 4))
     t, mu = step_series(run, "mu_g")
     ax.step(t, mu, where="post")
-    ax.set_xlabel("t (sqrt(r/g))")
-    ax.set_ylabel(r"$\mu_g$")
-    ax.set_title("global friction coefficient")
+    time_axis(ax, t)
+    ax.set_ylabel(r"$\mu_g = F_g / (m_g\, g)$")
+    ax.set_title("global friction coefficient (Fig. 10)")
     save(fig, "mu_g.png")
     fig, ax = plt.subplots(figsize=(6.5, 4))
     t, D = dissipation_curve(run)
     ax.plot(t, D)
-    ax.set_xlabel("t (sqrt(r/g))")
-    ax.set_ylabel("dissipation rate D")
-    ax.set_title(r"$D = -\sum S\, v_t$")
+    time_axis(ax, t)
+    ax.set_ylabel(f"dissipation rate D ({UNITS['D']})")
+    ax.set_title(r"$D = -\sum S\, v_t$ (Fig. 13's $\dot W$)")
     save(fig, "dissipation.png")
     return files
 
 
-__all__ = ["PLOT_FILES", "plot_run", "draw_lattice", "draw_forces", "dissipation_curve",
-           "step_series", "LEFT_WALL", "RIGHT_WALL", "PLANE"]
+__all__ = ["PLOT_FILES", "UNITS", "plot_run", "draw_lattice", "draw_forces", "force_key",
+           "plot_rows", "time_axis", "dissipation_curve", "step_series", "LEFT_WALL",
+           "RIGHT_WALL", "PLANE"]

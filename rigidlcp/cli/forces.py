@@ -196,13 +196,16 @@ def _draw(system, networks: list[tuple[str, np.ndarray]], out: Path, args) -> li
         on = R > 1e-9 * rmax
         if np.any(on):
             ax.add_collection(LineCollection(segs[on], colors="k",
-                                             linewidths=0.3 + 7.0 * R[on] / rmax))
+                                             linewidths=np.maximum(7.3 * R[on] / rmax, 0.3)))
         ax.set_title(f"{name}\n{int(on.sum())} T, {int((~on).sum())} NT", fontsize="small")
 
     paths = []
     for k, (name, x) in enumerate(networks):
         fig, ax = plt.subplots(figsize=(w, h))
         panel(ax, name, x)
+        from rigidlcp.models.plot import force_key
+
+        force_key(ax, rmax, 7.3)
         path = out / f"network_{k + 1}.png"
         fig.savefig(path, dpi=120, bbox_inches="tight")
         plt.close(fig)
@@ -216,6 +219,9 @@ def _draw(system, networks: list[tuple[str, np.ndarray]], out: Path, args) -> li
         panel(ax, name, x)
     fig.suptitle(f"{lat.name} {lat.lx}x{lat.ly}, seed {args.seed}: admissible normal forces "
                  "(width ~ R, common scale)", fontsize="small")
+    from rigidlcp.models.plot import force_key
+
+    force_key(axes.flat[len(networks) - 1], rmax, 7.3)
     path = out / "networks.png"
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)

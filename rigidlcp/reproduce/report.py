@@ -9,7 +9,15 @@ from pathlib import Path
 import numpy as np
 
 from rigidlcp.models.modes import fig5e_loops, row_modes
-from rigidlcp.models.plot import dissipation_curve, draw_forces, draw_lattice, step_series
+from rigidlcp.models.plot import (
+    UNITS,
+    dissipation_curve,
+    draw_forces,
+    draw_lattice,
+    plot_rows,
+    step_series,
+    time_axis,
+)
 
 from .crosscheck import TS_DEFINITION
 from .experiments import SELECT, SWEEP_POINTS, Claim, Results, provenance
@@ -48,45 +56,41 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     fig, axes = plt.subplots(1, 3, figsize=(3 * w, h))
     for ax, k in zip(axes, (0, run.n_events // 2, run.n_events - 1)):
         rec = run.records[k]
-        draw_lattice(ax, run.system, rec.omega_dot, label=r"$\dot\omega$")
+        draw_lattice(ax, run.system, rec.omega_dot,
+                     label=r"$\dot\omega$ (" + UNITS["omega_dot"] + ")")
         ax.set_title(f"event {k}, t = {rec.t:.3g}" + (" (steady)" if k == run.n_events - 1
                                                       else ""))
     files["fig7"] = _save(fig, out / "fig7_stages.png")
     # Fig. 8: angular accelerations, normal and friction forces of the steady state.
     run = res.seeds("fig8")[0]
     w, h = _size(run.system)
-    fig, axes = plt.subplots(3, 1, figsize=(w, 3 * h))
-    draw_lattice(axes[0], run.system, run.last.omega_dot, label=r"$\dot\omega$")
+    fig, axes = plt.subplots(3, 1, figsize=(w, 3.3 * h))
+    draw_lattice(axes[0], run.system, run.last.omega_dot,
+                 label=r"$\dot\omega$ (" + UNITS["omega_dot"] + ")")
     axes[0].set_title("(a) angular accelerations; first-row modes "
                       + row_modes(run.system, run.last).text())
-    for ax, F, signed, title in ((axes[1], run.last.R, False, "(b) normal forces"),
-                                 (axes[2], run.last.S, True, "(c) friction forces")):
+    for ax, F, signed, title, sym in (
+            (axes[1], run.last.R, False, "(b) normal forces R, width ~ R", "R"),
+            (axes[2], run.last.S, True, "(c) friction forces S, width ~ |S|", "S")):
         draw_lattice(ax, run.system)
-        draw_forces(ax, run.system, F, signed=signed)
+        draw_forces(ax, run.system, F, signed=signed, name=sym)
         ax.set_title(title)
     files["fig8"] = _save(fig, out / "fig8_steady_state.png")
-    # Fig. 9: steady angular accelerations against position, per row.
+    # Fig. 9: steady angular accelerations against position, one panel per row.
     run = res.seeds("fig9")[0]
-    lat = run.system.lattice
-    fig, ax = plt.subplots(figsize=(6.5, 4))
-    for row in range(lat.ly):
-        sel = np.flatnonzero(lat.row == row)
-        sel = sel[np.argsort(lat.x[sel, 0])]
-        ax.plot(lat.x[sel, 0], run.last.omega_dot[sel], "o-", label=f"row {row + 1}")
-    ax.axhline(0, color="grey", lw=0.5)
-    ax.set_xlabel("x / r")
-    ax.set_ylabel(r"$\dot\omega$ (g / r)")
-    ax.set_title(f"first row modes {row_modes(run.system, run.last).text()}")
-    ax.legend(fontsize="small")
+    fig = plt.figure(figsize=(6.5, 1.0 + 1.1 * run.system.lattice.ly), layout="constrained")
+    plot_rows(fig, run.system, run.last.omega_dot,
+              title=f"steady state; first-row modes {row_modes(run.system, run.last).text()}")
     files["fig9"] = _save(fig, out / "fig9_rows.png")
     # Fig. 10: mu_g(t) from several initial states.
     fig, ax = plt.subplots(figsize=(6.5, 4))
     for seed, run in zip(res.plan["fig10"]["seeds"], res.seeds("fig10")):
         t, mu = step_series(run, "mu_g")
         ax.step(t, mu, where="post", label=f"seed {seed}")
-    ax.set_xlabel("t (sqrt(r/g))")
-    ax.set_ylabel(r"$\mu_g$")
-    ax.legend(fontsize="small")
+    time_axis(ax, t)
+    ax.set_ylabel(r"$\mu_g = F_g / (m_g\, g)$")
+    ax.set_title("global friction coefficient from several initial states (Fig. 10)")
+    ax.legend(fontsize="small", title="initial angular velocities")
     files["fig10"] = _save(fig, out / "fig10_mu_g.png")
     # Figs. 11-12 (base system) and Sec. IV B (three systems).
     d = out / "fig11_12"
@@ -107,8 +111,8 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
             ax.plot(t, D, lw=1, label=f"seed {seed}")
         lat = run.system.lattice
         ax.set_title(f"{lat.name} {lat.lx}x{lat.ly}, constant velocity")
-        ax.set_xlabel("t (sqrt(r/g))")
-        ax.set_ylabel(r"$D = -\sum S\,v_t$")
+        time_axis(ax, t)
+        ax.set_ylabel(r"$D = -\sum S\,v_t$ (" + UNITS["D"] + ")")
         ax.legend(fontsize="small")
     files["fig13"] = _save(fig, out / "fig13_dissipation.png")
     # Fig. 6: initial and final angular velocities, and the loops of Fig. 5(e).
@@ -118,10 +122,11 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     k = np.arange(lat.p)
     axes[0].bar(k - 0.2, run.records[0].omega, 0.4, label="t = 0")
     axes[0].bar(k + 0.2, run.last.omega, 0.4, label=f"steady, t = {run.last.t:.3g}")
-    axes[0].set_xlabel("disk")
-    axes[0].set_ylabel(r"$\omega$")
+    axes[0].set_xlabel("disk (left to right)")
+    axes[0].set_ylabel(r"$\omega$ (" + UNITS["omega"] + ")")
     axes[0].legend(fontsize="small")
-    draw_lattice(axes[1], run.system, run.last.omega, label=r"$\omega$")
+    draw_lattice(axes[1], run.system, run.last.omega,
+                 label=r"$\omega$ (" + UNITS["omega"] + ")")
     pts = lat.x[lat.i] + lat.radius * lat.n
     for loop in fig5e_loops(run.system, run.last):
         axes[1].plot(pts[list(loop), 0], pts[list(loop), 1], "k*", ms=10)

@@ -45,6 +45,18 @@ def _draw_vector(ax, system: models.System, R: np.ndarray, S: np.ndarray, title:
     ax.set_title(title, fontsize="small")
 
 
+def _key():
+    """Legend of the drawing: colours by sign, widths relative to the vector's largest entry
+    (a null-space vector has no unit: it is defined up to a factor)."""
+    from matplotlib.lines import Line2D
+
+    handles = [Line2D([], [], color="tab:red", lw=5), Line2D([], [], color="tab:blue", lw=5),
+               Line2D([], [], color="tab:green", lw=5), Line2D([], [], color="k", lw=5),
+               Line2D([], [], color="k", lw=1)]
+    labels = ["R > 0", "R < 0", "S only", "largest |(R, S)|", "smallest drawn"]
+    return handles, labels
+
+
 def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarray, str]],
                  out: str | Path, suptitle: str = "", max_panels: int = 30) -> Path:
     """Write one figure with a panel per (R, S, title) to `out` (PNG); returns the path."""
@@ -56,13 +68,16 @@ def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarr
     lat = system.lattice
     w = max(2.5, 0.45 * lat.lx + 0.8)
     h = max(1.8, 0.45 * lat.ly * (0.87 if lat.name == "tri" else 1.0) + 0.9)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(w * ncol, h * nrow), squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(w * ncol, h * nrow), squeeze=False,
+                             layout="constrained")
     for ax in axes.flat[len(vectors):]:
         ax.axis("off")
     for ax, (R, S, title) in zip(axes.flat, vectors):
         _draw_vector(ax, system, R, S, title)
     if suptitle:
-        fig.suptitle(suptitle, y=1.0 + 0.12 / nrow)  # above the panel titles
+        fig.suptitle(suptitle)
+    fig.legend(*_key(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=5,
+               fontsize="small", frameon=False)
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight")
