@@ -34,7 +34,7 @@ UNITS = {"omega_dot": "g / r", "omega": "sqrt(g / r)", "t": "sqrt(r / g)", "forc
 def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: str = "",
                  cmap: str = "coolwarm") -> None:
     """Disks (coloured by `values`, symmetric colour scale, with a colourbar of this panel's
-    own whose label `label` is written horizontally above it), walls and plane."""
+    own whose label `label` is written horizontally below it), walls and plane."""
     from matplotlib.collections import PatchCollection
     from matplotlib.patches import Circle
 
@@ -52,7 +52,7 @@ def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: st
     ax.add_collection(coll)
     if values is not None:
         cb = ax.figure.colorbar(coll, ax=ax, shrink=0.8, pad=0.02)
-        cb.ax.set_title(label, fontsize="small", loc="left")
+        cb.ax.set_xlabel(label, fontsize="small")  # horizontal, below the bar
     top = lat.x[:, 1].max() + r
     ax.plot([0, 0], [0, top], "k-", lw=2)
     ax.plot([lat.width, lat.width], [0, top], "k-", lw=2)
@@ -135,7 +135,8 @@ def time_axis(ax, t: np.ndarray) -> None:
     t = np.asarray(t)
     pos = t[t > 0]
     if pos.size and pos.max() > 20 * pos.min():
-        ax.set_xscale("symlog", linthresh=float(pos.min()), linscale=1.0)
+        lin = 10.0 ** np.floor(np.log10(pos.min()))  # a power of ten: no tick inside
+        ax.set_xscale("symlog", linthresh=float(lin), linscale=1.0)
     log = ax.get_xscale() == "symlog"
     ax.set_xlabel(f"t ({UNITS['t']})" + (", log scale" if log else ""))
 

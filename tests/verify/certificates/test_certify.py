@@ -172,9 +172,13 @@ def test_2x2_example_is_not_unique_in_w(example_2x2):
     assert cert.accepted and cert.method == "milp"
     assert cert.w_unique is False and cert.z_unique is False and cert.pattern_unique is False
     assert cert.observables["accelerations"] is False
+    # The evidence, whichever other solutions the MILP returns (HiGHS versions differ): each
+    # is a checked solution of the event, and one has other angular accelerations.
+    assert cert.others
     for other in cert.others:
         assert certify(ep, other, uniqueness="none").accepted
-    assert any(np.max(np.abs(ep.unpack(o).omega_dot - [-0.1, -0.1, 0.1, 0.1])) > 0.1
+    mine = ep.unpack(natural).omega_dot
+    assert any(np.max(np.abs(ep.unpack(o).omega_dot - mine)) > 1e-6 * np.max(np.abs(mine))
                for o in cert.others)
 
 
