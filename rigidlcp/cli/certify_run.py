@@ -55,8 +55,10 @@ def cmd_certify_run(args: argparse.Namespace) -> int:
 
     if args.resume and args.force:
         raise ValueError("--resume and --force exclude each other")
-    if args.time_limit <= 0 or args.tries < 0:
+    if not args.time_limit > 0 or args.tries < 0:
         raise ValueError("--time-limit must be > 0 and --tries >= 0")
+    if args.jobs < 1:  # before the progress bar starts: one line, not a bar and a line
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     data_path, _ = run_paths(args.run)
     out = Path(args.out) if args.out else data_path.with_name(data_path.stem + "_cert")
     try:

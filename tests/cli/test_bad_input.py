@@ -99,6 +99,16 @@ CASES: list[tuple[str, str]] = [
     ("forces --method nope --out f", "unknown method"),
     ("forces --out existfile", "existfile"),
     ("forces --out figs", "--force"),
+    # certify-run
+    ("certify-run missing.npz", "missing.npz"),
+    ("certify-run lcp.npz", "problem file"),
+    ("certify-run corrupt.npz", "not a .npz"),
+    ("certify-run empty.npz", "empty"),
+    ("certify-run trunc.npz", "damaged"),
+    ("certify-run run.npz --out existfile", "existfile"),
+    ("certify-run run.npz --out figs", "--force"),
+    ("certify-run run.npz --jobs 0", "--jobs"),
+    ("certify-run run.npz --time-limit 0", "--time-limit"),
     # bench
     ("bench --set nope --out b", "nope"),
     ("bench --set emptydir --out b", "emptydir"),
