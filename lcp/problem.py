@@ -225,7 +225,7 @@ def load(path: str | os.PathLike):
 
             return read_siconos(path)
     try:
-        with open_npz(path, "an LCP/MLCP problem file (.npz)") as data:
+        with open_npz(path, "a problem file (.npz, or a Siconos text file)") as data:
             keys = set(data.files)
             header = json.loads(str(data["__header__"])) if "__header__" in keys else {}
             name, meta = header.get("name", path.stem), header.get("meta", {})

@@ -1,7 +1,8 @@
 """The documentation runs (issue 14.3): a renamed function or option breaks CI, not a user.
 
 * Every ```python block of README.md and docs/*.md is executed; the blocks of one file share a
-  namespace (in order) and run in a temporary directory. A block preceded by the line
+  namespace (in order) and run in a temporary directory (which links the repository's tests/
+  and docs/, for the data files the examples read). A block preceded by the line
   `<!-- not-run: REASON -->` is skipped (the reason is required).
 * Every `rigidlcp ...` line of a ```bash block is parsed by the real parser (the command and
   every option must exist, choices must be valid), and the cheap commands (CHEAP) are run.
@@ -80,6 +81,8 @@ def test_python_blocks_run(path: Path, tmp_path, monkeypatch):
     code = [(line, c, why) for lang, line, c, why in blocks(path) if lang == "python"]
     if not code:
         pytest.skip("no python block")
+    for data in ("tests", "docs"):  # blocks may read the repository's data files
+        (tmp_path / data).symlink_to(ROOT / data, target_is_directory=True)
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
     namespace: dict = {"__name__": f"docs_{path.stem}"}

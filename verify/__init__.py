@@ -13,13 +13,14 @@ from .certificates.certify import certify as certify
 from .nullspace.contact import null_space as null_space
 from .nullspace.formulas import paper_singularities as paper_singularities
 
-#: Public subpackages and modules, importable as attributes on first use.
-SUBMODULES = ("certificates", "forces", "nullspace", "strategies")
-
 
 def __getattr__(name: str):
-    if name in SUBMODULES:
+    """Public subpackages and modules are attributes, imported on first use
+    (verify.strategies, verify.nullspace, ...)."""
+    if not name.startswith("_"):
         import importlib
+        import importlib.util
 
-        return importlib.import_module(f"{__name__}.{name}")
+        if importlib.util.find_spec(f"{__name__}.{name}") is not None:
+            return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -58,3 +58,18 @@ def test_simulate_sparse_path_from_the_command_line(capsys):
     assert main(["simulate", "--lx", "4", "--ly", "2", "--method", "sparse-pivoting",
                  "--no-progress"]) == 2
     assert "use select='none'" in capsys.readouterr().err
+
+
+def test_one_default_friction_everywhere():
+    """models.System, simulate, sweep and forces share models.system.DEFAULT_MU (issue 14.4)."""
+    from rigidlcp import models
+    from rigidlcp.cli.main import build_parser
+    from rigidlcp.models.sweep import DEFAULTS
+    from rigidlcp.models.system import DEFAULT_MU
+
+    system = models.System(models.rectangular(2, 1))
+    parser = build_parser()
+    for name, value in DEFAULT_MU.items():
+        assert getattr(system, name) == value and DEFAULTS[name] == value
+        for argv in (["simulate"], ["forces", "--out", "x"]):
+            assert getattr(parser.parse_args(argv), name) == value, (argv, name)

@@ -117,7 +117,8 @@ def test_planted_second_block_found_by_enumeration_and_milp(problem):
 def test_w_unique_but_z_not_frictionless_row():
     """A frictionless row between walls: the row compression is free (a self-stress), so the
     forces are not unique; M is symmetric PSD (a convex QP), so w = M z + q is."""
-    system = models.System(models.rectangular(3, 1), gamma=0.1)
+    system = models.System(models.rectangular(3, 1), mu_pp=0.0, mu_plane=0.0, mu_wall=0.0,
+                           gamma=0.1)
     ep = models.event_problem(system, models.initial_state(system))
     sol = lcp.solve(ep.lcp, method="lemke")
     for method in ("enumeration", "milp"):

@@ -46,7 +46,8 @@ def test_single_row_ranges_are_tight(lx, gamma):
     but every R_k >= 0: R_k in [max over the row of the lower bounds, inf). The plane carries
     m g per disk; F_g = 0."""
     m, g = 1.0, 1.0
-    system = models.System(models.rectangular(lx, 1), gamma=gamma, mass=m, g=g)
+    system = models.System(models.rectangular(lx, 1), mu_pp=0.0, mu_plane=0.0, mu_wall=0.0,
+                           gamma=gamma, mass=m, g=g)
     lat = system.lattice
     poly = state_polyhedron(system, np.ones(system.c, bool), np.zeros(system.c, int))
     rng = force_ranges(poly, {"F_g": global_friction_vector(system)})
@@ -74,7 +75,8 @@ def test_single_row_ranges_are_tight(lx, gamma):
 
 
 def test_single_row_lcp_solution_inside_ranges():
-    system = models.System(models.rectangular(3, 1), gamma=0.1)
+    system = models.System(models.rectangular(3, 1), mu_pp=0.0, mu_plane=0.0, mu_wall=0.0,
+                           gamma=0.1)  # frictionless, as the analytic case above
     ep, sol, poly = all_transmitting(system)
     x = ep.forces(sol.z)
     rng = force_ranges(solution_polyhedron(ep, sol.z))
