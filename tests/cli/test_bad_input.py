@@ -99,6 +99,16 @@ CASES: list[tuple[str, str]] = [
     ("forces --method nope --out f", "unknown method"),
     ("forces --out existfile", "existfile"),
     ("forces --out figs", "--force"),
+    # certify, timestep, compare-integrators
+    ("certify missing.npz", "missing.npz"),
+    ("certify corrupt.npz", "not a .npz"),
+    ("certify run.npz", "run saved by"),
+    ("certify lcp.npz --method nope", "unknown method"),
+    ("timestep --lx 0", "lx"),
+    ("timestep --mu-pp -1", "mu_pp"),
+    ("timestep --lx 3 --ly 2 --out run.npz", "exists"),
+    ("compare-integrators --lx 0", "lx"),
+    ("compare-integrators --mu-plane -1", "mu_plane"),
     # certify-run
     ("certify-run missing.npz", "missing.npz"),
     ("certify-run lcp.npz", "problem file"),
