@@ -215,8 +215,7 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
         rows.sort(key=lambda r: r["gamma"])
     checks = check_jobs(p, res)
     if bar is not None:
-        bar = tqdm(total=len(checks), unit="job", desc="cross-checks", file=sys.stderr,
-                   dynamic_ncols=True)
+        bar = new_bar(total=len(checks), unit="job", desc="cross-checks")
     try:
         for k, out in iter_map(Job(p), checks, jobs=jobs, dask=dask):
             kind, label = checks[k][:2]
