@@ -6,8 +6,8 @@ the toolkit's way (verify/nullspace/qsqrt3.py) against sympy.
 * qsqrt3 — `qsqrt3.exact_rank`: python-flint's `fmpq_mat.rank()` on the regular representation
   of Q(sqrt 3), a + b sqrt 3 -> [[a, 3b], [b, a]] (an injective ring map into 2x2 rational
   matrices: the rational rank of the 2m x 2n block matrix is twice the rank over Q(sqrt 3));
-* sympy — `DomainMatrix` over the algebraic field QQ<sqrt(3)> (`rank()`);
-* flint — the same as qsqrt3 written out here, as an independent check of the embedding.
+* sympy — `DomainMatrix` over the algebraic field QQ<sqrt(3)> (`rank()`): an independent
+  check of the embedding (same ranks), and the slower library.
 
 Until commit 2a976d6 qsqrt3 eliminated by hand (sparse Gauss-Jordan on pairs of Fractions);
 that version's numbers are in docs/architecture.md.
@@ -47,21 +47,6 @@ def rank_sympy(rows, ncols: int) -> int:
     return DomainMatrix(dense, (len(rows), ncols), K).rank()
 
 
-def rank_flint(rows, ncols: int) -> int:
-    import flint
-
-    m = flint.fmpq_mat(2 * len(rows), 2 * ncols)
-    for i, row in enumerate(rows):
-        for j, v in row.items():
-            a = flint.fmpq(v.a.numerator, v.a.denominator)
-            b = flint.fmpq(v.b.numerator, v.b.denominator)
-            m[2 * i, 2 * j], m[2 * i, 2 * j + 1] = a, 3 * b
-            m[2 * i + 1, 2 * j], m[2 * i + 1, 2 * j + 1] = b, a
-    rank = m.rank()
-    assert rank % 2 == 0
-    return rank // 2
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--lx", type=_range, default=_range("2:8"))
@@ -76,8 +61,7 @@ def main() -> None:
                 for kind in ("normal", "tangential"):
                     rows = q3.exact_contact_matrix(system, *paper_states(system, kind))
                     cases.append((f"{lattice} {lx}x{ly} {kind}", rows, 2 * system.c))
-    methods = {"qsqrt3": lambda rows, n: q3.exact_rank(rows), "sympy": rank_sympy,
-               "flint": rank_flint}
+    methods = {"qsqrt3": lambda rows, n: q3.exact_rank(rows), "sympy": rank_sympy}
     ranks, seconds = {}, {}
     for name, func in methods.items():
         t0 = time.perf_counter()

@@ -21,10 +21,7 @@ repeated; the polished point is kept only if it lowers the residual max|min(z, w
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-import sys
 
 import numpy as np
 import scipy.sparse as sp
@@ -32,6 +29,7 @@ from scipy.linalg import lstsq
 
 from .api import register
 from .problem import InvalidProblem, NotApplicable
+from .quiet import quiet_stdout
 from .solution import Solution, complementarity_residual
 
 
@@ -100,26 +98,6 @@ def active_set_polish(
         if res < best:
             best_z, best = z, res
     return best_z, done
-
-
-@contextlib.contextmanager
-def _quiet_stdout():
-    """Silence C-level prints on file descriptor 1 (OSQP prints its polishing notes even with
-    verbose=False)."""
-    try:
-        fd = sys.stdout.fileno()
-    except (AttributeError, OSError, ValueError):  # no real descriptor: nothing to silence
-        yield
-        return
-    sys.stdout.flush()
-    saved = os.dup(fd)
-    try:
-        with open(os.devnull, "w") as devnull:
-            os.dup2(devnull.fileno(), fd)
-            yield
-    finally:
-        os.dup2(saved, fd)
-        os.close(saved)
 
 
 def _check_options(eps: float, max_iter: int, tol: float) -> None:
@@ -239,7 +217,7 @@ def solve_qp_osqp(
         np.full(n, np.inf), verbose=False, eps_abs=eps, eps_rel=eps, max_iter=int(max_iter),
         polishing=bool(polish),
     )
-    with _quiet_stdout():
+    with quiet_stdout():
         out = prob.solve(raise_error=False)
     status = str(out.info.status)
     iters = int(out.info.iter)

@@ -91,21 +91,30 @@ def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
     return "WRONG", f"infeasible not confirmed (LP feasible: {feasible})"
 
 
-def run_case(case: Case, method: str) -> dict:
-    problem = lcp.LCP(case.M, case.q)
+def attempt(problem, method: str) -> tuple[lcp.Solution | None, dict]:
+    """Solve, timed; (None, result) when the method refused or crashed, else (solution,
+    {"seconds": ...}) for the judge."""
     t0 = time.perf_counter()
     try:
         sol = lcp.solve(problem, method, **OPTIONS.get(method, {}))
     except lcp.NotApplicable as exc:
-        return {"outcome": "refused", "reason": str(exc), "seconds": time.perf_counter() - t0}
+        return None, {"outcome": "refused", "reason": str(exc),
+                      "seconds": time.perf_counter() - t0}
     except Exception as exc:  # noqa: BLE001 - a crash is what the harness is looking for
-        return {"outcome": "crash", "reason": f"{type(exc).__name__}: {exc}",
-                "seconds": time.perf_counter() - t0}
+        return None, {"outcome": "crash", "reason": f"{type(exc).__name__}: {exc}",
+                      "seconds": time.perf_counter() - t0}
     seconds = time.perf_counter() - t0
     if "exception" in sol.info:
-        return {"outcome": "crash", "reason": sol.info["exception"].strip(), "seconds": seconds}
-    outcome, reason = judge(case, sol.status, sol.z)
-    return {"outcome": outcome, "reason": reason, "seconds": seconds, "status": sol.status}
+        return None, {"outcome": "crash", "reason": sol.info["exception"].strip(),
+                      "seconds": seconds}
+    return sol, {"seconds": seconds, "status": sol.status}
+
+
+def run_case(case: Case, method: str) -> dict:
+    sol, res = attempt(lcp.LCP(case.M, case.q), method)
+    if sol is not None:
+        res["outcome"], res["reason"] = judge(case, sol.status, sol.z)
+    return res
 
 
 def save_case(case: Case, method: str, result: dict, out: Path) -> Path:

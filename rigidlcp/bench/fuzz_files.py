@@ -12,7 +12,6 @@ reason, for every method.
 
 from __future__ import annotations
 
-import time
 from collections import defaultdict
 from pathlib import Path
 
@@ -20,7 +19,7 @@ import numpy as np
 
 from rigidlcp import lcp
 
-from .fuzz import ENUM_MAX_N, OUTCOMES, TOL, judge, save_case
+from .fuzz import ENUM_MAX_N, OUTCOMES, TOL, attempt, judge, save_case
 from .fuzz_cases import Case
 
 
@@ -97,22 +96,14 @@ def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | N
 
 
 def _run(P, method: str) -> dict:
-    t0 = time.perf_counter()
-    try:
-        sol = lcp.solve(P, method)
-    except lcp.NotApplicable as exc:
-        return {"outcome": "refused", "reason": str(exc), "seconds": time.perf_counter() - t0}
-    except Exception as exc:  # noqa: BLE001 - a crash is what the harness is looking for
-        return {"outcome": "crash", "reason": f"{type(exc).__name__}: {exc}",
-                "seconds": time.perf_counter() - t0}
-    seconds = time.perf_counter() - t0
-    if "exception" in sol.info:
-        return {"outcome": "crash", "reason": sol.info["exception"].strip(), "seconds": seconds}
+    sol, res = attempt(P, method)
+    if sol is None:
+        return res
     if isinstance(P, lcp.MLCP):
-        outcome, reason = judge_mlcp(P, sol.status, sol.u, sol.z)
+        res["outcome"], res["reason"] = judge_mlcp(P, sol.status, sol.u, sol.z)
     else:
-        outcome, reason = judge(Case("file", 0, P.M, P.q), sol.status, sol.z)
-    return {"outcome": outcome, "reason": reason, "seconds": seconds, "status": sol.status}
+        res["outcome"], res["reason"] = judge(Case("file", 0, P.M, P.q), sol.status, sol.z)
+    return res
 
 
 def _save(P, path: Path, method: str, res: dict, out: Path) -> Path:
