@@ -103,6 +103,16 @@ def get_method(name: str) -> MethodInfo:
         ) from None
 
 
+def check_options(info: MethodInfo, options: dict) -> None:
+    """Raise InvalidProblem naming the options `info`'s method does not accept."""
+    unknown = set(options) - set(info.options)
+    if unknown:
+        raise InvalidProblem(
+            f"method {info.name!r} does not accept option(s) {sorted(unknown)}; "
+            f"it accepts {list(info.options) or 'none'}"
+        )
+
+
 def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | None = None,
           repair: bool = True, **options) -> Solution:
     """Solve an LCP (w = M z + q, 0 <= z perp w >= 0) or an MLCP by the named method.
@@ -129,12 +139,7 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
                 f"{type(problem).__name__}"
             )
     info = get_method(method)
-    unknown = set(options) - set(info.options)
-    if unknown:
-        raise InvalidProblem(
-            f"method {method!r} does not accept option(s) {sorted(unknown)}; "
-            f"it accepts {list(info.options) or 'none'}"
-        )
+    check_options(info, options)
     if friction:
         from .friction import solve_friction
 

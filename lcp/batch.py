@@ -22,7 +22,7 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from .api import get_method, solve
+from .api import check_options, get_method, solve
 from .problem import LCP, MLCP, InvalidProblem
 from .solution import Solution
 
@@ -40,12 +40,7 @@ def solve_many(
     problem. Returns one Solution per problem, in order, each as `lcp.solve` would return it.
     """
     info = get_method(method)
-    unknown = set(options) - set(info.options)
-    if unknown:
-        raise InvalidProblem(
-            f"method {method!r} does not accept option(s) {sorted(unknown)}; "
-            f"it accepts {list(info.options) or 'none'}"
-        )
+    check_options(info, options)
     if isinstance(problems, tuple) and len(problems) == 2 and not isinstance(
             problems[0], (LCP, MLCP)):
         Ms, qs = _stacked(*problems)
