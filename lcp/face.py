@@ -24,10 +24,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
+from .face_coords import _Face, small_lp, small_qp
+from .face_reference import _face_lp, _qp
 from .problem import LCP
-from .quiet import new_highs
+
+SOLVERS = ("small", "reference")
 
 
 @dataclass
@@ -48,6 +50,7 @@ def face_minimum_norm(
     eps: float = 1e-10,
     max_walk: int = 20,
     z_side: np.ndarray | None = None,
+    solvers: str = "small",
 ) -> FaceResult:
     """The point of the face of z minimizing c'y, then |G y| (see the module docstring).
 
@@ -59,60 +62,136 @@ def face_minimum_norm(
     again a solution, whose own face (its degenerate indices, z_i = w_i = 0, may now go either
     way) can hold a lower c'y; the walk stops when c'y no longer decreases (at most max_walk
     linear programs), so it reaches a local minimum of c'y over the solution set.
+
+    solvers: "small" (default) solves both programs in the face's own coordinates
+    y_A = z_A + N x, x of dimension nullity(M_AA), by DAQP (lcp.face_coords); "reference" solves
+    them in the unknowns y_A by HiGHS and Clarabel with an SVD null space (the code before
+    issue 13, lcp.face_reference). Both give the same point to rounding where the linear
+    program's minimizer is unique (tests/lcp/test_face_paths.py). "small" falls back to
+    "reference" when one of its programs is not solved or not proved optimal.
     """
+    if solvers not in SOLVERS:
+        raise ValueError(f"solvers must be one of {SOLVERS}, got {solvers!r}")
     M, q = problem.M, problem.q
     z0 = np.asarray(z, dtype=float)
     scale = max(np.abs(q).max(initial=0.0), np.abs(z0).max(initial=0.0), 1e-300)
     tol = 1e-9 * scale if tol is None else tol
-    z = z0
-    bound = None
-    if c is not None:  # stage 1: descend c'y over faces, then keep c'y at its minimum
-        c = np.asarray(c, dtype=float)
+    walk = _Walk(M, q, tol, z_side, solvers == "small")
+    try:
+        return walk.select(z0, G, c, eps, max_walk, scale)
+    except _SmallFailed:  # a small program not solved (or not proved optimal): as before
+        return face_minimum_norm(problem, z0, G, c=c, tol=tol, eps=eps, max_walk=max_walk,
+                                 z_side=z_side, solvers="reference")
+
+
+class _SmallFailed(Exception):
+    pass
+
+
+class _Walk:
+    """The two stages of face_minimum_norm with one kind of solver: "small" (the face's
+    coordinates, lcp.face_coords; faces kept by support so that the final stage reuses the null
+    space of the linear stage's face) or "reference" (lcp.face_reference, SVD null space)."""
+
+    def __init__(self, M, q, tol, z_side, small: bool):
+        self.M, self.q, self.tol, self.z_side, self.small = M, q, tol, z_side, small
+        self.faces: dict[bytes, tuple[_Face, np.ndarray]] = {}  # small: face, its LP minimizer
+        self.origin: bytes | None = None  # small: the face whose LP minimizer is the current z
+
+    def supports(self, z: np.ndarray) -> tuple[np.ndarray, ...]:
+        """The candidate faces of z: for degenerate pairs both sides (A = {w <= tol} first), or
+        the side prescribed by z_side."""
+        w = self.M @ z + self.q
+        if self.z_side is None:
+            return w <= self.tol, (w <= self.tol) & (z > self.tol)
+        return ((w <= self.tol) & ((z > self.tol) | self.z_side),)
+
+    def linear(self, z: np.ndarray, in_A: np.ndarray, c: np.ndarray) -> np.ndarray | None:
+        """A minimizer of c'y over the face with support in_A (a vertex for the reference)."""
+        if not self.small or not in_A.any():  # an empty face: no program (None)
+            return _face_lp(self.M, self.q, np.flatnonzero(in_A), c)
+        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A))
+        if face.nullity == 0:
+            x = np.zeros(0)
+        else:
+            x = small_lp(c[face.A] @ face.N, face.Aineq, face.bineq)
+            if x is None:
+                raise _SmallFailed
+        self.faces[np.packbits(in_A).tobytes()] = (face, x)
+        return face.point(x)
+
+    def descend(self, z: np.ndarray, c: np.ndarray, max_walk: int, scale: float
+                ) -> tuple[np.ndarray, float]:
+        """Stage 1: descend c'y over faces (module doc); the last point and its c'y."""
         slack = 1e-11 * max(abs(c @ z), scale)
-        best_value = c @ z
         seen: set[bytes] = set()
         for _ in range(max_walk):
-            best = None
-            w = M @ z + q
-            faces = ((w <= tol, (w <= tol) & (z > tol)) if z_side is None
-                     else ((w <= tol) & ((z > tol) | z_side),))
-            for in_A in faces:  # degenerate pairs: both sides, or the prescribed one
+            best, origin = None, None
+            for in_A in self.supports(z):  # degenerate pairs: both sides, or the prescribed one
                 key = np.packbits(in_A).tobytes()
                 if key in seen:  # a face already minimized over
                     continue
                 seen.add(key)
-                z1 = _face_lp(M, q, np.flatnonzero(in_A), c)
+                z1 = self.linear(z, in_A, c)
                 if z1 is not None and (best is None or c @ z1 < c @ best):
-                    best = z1
+                    best, origin = z1, key
             if best is None or c @ best >= c @ z - slack:
                 break
-            z, best_value = best, c @ best
-        bound = best_value
-    if z_side is None:
-        face = _Face(M, q, z, tol)
-    else:
-        w = M @ z + q
-        face = _Face(M, q, z, tol, A=np.flatnonzero((w <= tol) & ((z > tol) | z_side)))
-    if face.nullity == 0:
-        moved = float(np.abs(z - z0).max())
-        return FaceResult(z, 0, moved, "selected" if moved > 0 else "unique")
-    GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
-    GN = GA @ face.N
-    # min 1/2 |G_A (z_A + N x)|^2 + eps/2 |N x|^2  s.t.  the face's inequalities (and c'y bound)
-    P = GN.T @ GN + eps * np.eye(face.nullity)
-    Aeq = beq = None
-    if bound is not None:  # stay on the linear program's optimal set: c'y = its minimum
-        Aeq = (c[face.A] @ face.N)[None, :]
-        beq = np.array([bound - c @ z])
-    x, status = _qp(P, GN.T @ (GA @ z[face.A]), face.Aineq, face.bineq, Aeq, beq)
-    # Every point returned is checked: an inaccurate one (rounding in a nearly singular face)
-    # gives way to the linear stage's vertex, and that to the solver's own solution.
-    limit = max(10.0 * _residual(M, q, z0), 1e-12 * scale)
-    for y, label in ((None if x is None else face.point(x), "selected"),
-                     (z, "selected (linear stage only)")):
-        if y is not None and _residual(M, q, y) <= limit:
-            return FaceResult(y, face.nullity, float(np.abs(y - z0).max()), label)
-    return FaceResult(z0, face.nullity, 0.0, f"failed: inaccurate face point ({status})")
+            z, self.origin = best, origin
+        return z, float(c @ z)
+
+    def final_face(self, z: np.ndarray) -> tuple[_Face, np.ndarray]:
+        """The face of z (its first support) and the coordinates xc of z on it."""
+        in_A = self.supports(z)[0]
+        if not self.small:
+            return _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A), null="svd"), None
+        key = np.packbits(in_A).tobytes()
+        face, x = self.faces.get(key, (None, None))
+        if face is not None and face.z is z:  # built at z
+            return face, np.zeros(face.nullity)
+        if face is not None and key == self.origin:  # z is this face's LP minimizer
+            return face, x
+        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A))
+        return face, np.zeros(face.nullity)
+
+    def select(self, z0, G, c, eps, max_walk, scale) -> FaceResult:
+        M, q = self.M, self.q
+        z, bound = z0, None
+        if c is not None:  # stage 1, then keep c'y at its minimum
+            c = np.asarray(c, dtype=float)
+            z, bound = self.descend(z0, c, max_walk, scale)
+        face, xc = self.final_face(z)
+        if face.nullity == 0:
+            moved = float(np.abs(z - z0).max())
+            return FaceResult(z, 0, moved, "selected" if moved > 0 else "unique")
+        x, status = self.quadratic(face, xc, G, c, bound, eps)
+        # Every point returned is checked: an inaccurate one (rounding in a nearly singular
+        # face) gives way to the linear stage's point, and that to the solver's own solution.
+        limit = max(10.0 * _residual(M, q, z0), 1e-12 * scale)
+        for y, label in ((None if x is None else face.point(x), "selected"),
+                         (z, "selected (linear stage only)")):
+            if y is not None and _residual(M, q, y) <= limit:
+                return FaceResult(y, face.nullity, float(np.abs(y - z0).max()), label)
+        return FaceResult(z0, face.nullity, 0.0, f"failed: inaccurate face point ({status})")
+
+    def quadratic(self, face: _Face, xc, G, c, bound, eps):
+        """Stage 2: min 1/2 |G_A y_A|^2 + eps/2 |y_A - z_A|^2 over the face (y_A = face.z_A +
+        N x, z = the point the walk ended at, at x = xc), with c'y = bound after stage 1."""
+        q = self.q
+        GA = (np.eye(q.size) if G is None else np.asarray(G))[:, face.A]
+        GN = GA @ face.N
+        P = GN.T @ GN + eps * np.eye(face.nullity)
+        f = GN.T @ (GA @ face.z[face.A])
+        Aeq = beq = None
+        if bound is not None:  # stay on the linear program's optimal set: c'y = its minimum
+            Aeq = (c[face.A] @ face.N)[None, :]
+            beq = np.array([bound - c @ face.z])
+        if not self.small:
+            return _qp(P, f, face.Aineq, face.bineq, Aeq, beq)
+        x = small_qp(P, f - eps * xc, face.Aineq, face.bineq, Aeq, beq)
+        if x is None:
+            raise _SmallFailed
+        return x, "optimal"
 
 
 @dataclass
@@ -165,37 +244,6 @@ def face_is_point(problem: LCP, z: np.ndarray, *, z_side: np.ndarray | None = No
 
 def _residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     return float(np.max(np.abs(np.minimum(z, M @ z + q)), initial=0.0))
-
-
-class _Face:
-    """F(z) parametrized as y_A = z_A + N x (N: null space of M_AA), y_Ac = 0, Aineq x <= bineq.
-
-    A = {i : w_i = 0} (the largest face) unless the caller gives A.
-    """
-
-    def __init__(self, M: np.ndarray, q: np.ndarray, z: np.ndarray, tol: float,
-                 A: np.ndarray | None = None):
-        w = M @ z + q
-        self.z = z
-        self.A = np.flatnonzero(w <= tol) if A is None else np.asarray(A)
-        Ac = np.setdiff1d(np.arange(q.size), self.A)
-        if self.A.size == 0:
-            self.nullity = 0
-            return
-        MAA = M[np.ix_(self.A, self.A)]
-        _, sig, Vt = np.linalg.svd(MAA)
-        rank_tol = max(MAA.shape) * np.finfo(float).eps * max(sig.max(initial=0.0), 1.0) * 1e3
-        rank = int(np.sum(sig > rank_tol))
-        self.nullity = self.A.size - rank
-        self.N = Vt[rank:].T
-        # y_A = z_A + N x >= 0 and w_Ac + M_{Ac,A} N x >= 0 (w_Ac > tol > 0; z_A clipped at 0)
-        self.Aineq = np.vstack([-self.N, -(M[np.ix_(Ac, self.A)] @ self.N)])
-        self.bineq = np.concatenate([np.maximum(z[self.A], 0.0), np.maximum(w[Ac], 0.0)])
-
-    def point(self, x: np.ndarray) -> np.ndarray:
-        y = self.z.copy()
-        y[self.A] = np.maximum(self.z[self.A] + self.N @ x, 0.0)
-        return y
 
 
 def global_minimum_norm(
@@ -276,83 +324,3 @@ def global_minimum_norm(
     if x is None:
         return FaceResult(z, face.nullity, 0.0, f"selected (LP vertex; QP {status})")
     return FaceResult(face.point(x), face.nullity, 0.0, "selected")
-
-
-def _face_lp(M: np.ndarray, q: np.ndarray, A: np.ndarray, c: np.ndarray) -> np.ndarray | None:
-    """A vertex minimizing c'y over the face with support A: y_A >= 0, (M y + q)_A = 0,
-    (M y + q)_Ac >= 0, by HiGHS's simplex through its own API (scipy's linprog wrapper costs
-    more than the solve on these small sparse LPs), tight tolerances; None if it fails."""
-    import highspy
-
-    if A.size == 0:
-        return None
-    Ac = np.setdiff1d(np.arange(q.size), A)
-    K = sp.csc_matrix(np.vstack([M[np.ix_(A, A)], M[np.ix_(Ac, A)]]))
-    inf = highspy.kHighsInf
-    lp = highspy.HighsLp()
-    lp.num_col_, lp.num_row_ = A.size, K.shape[0]
-    lp.col_cost_ = np.asarray(c[A], dtype=float)
-    lp.col_lower_, lp.col_upper_ = np.zeros(A.size), np.full(A.size, inf)
-    lp.row_lower_ = np.concatenate([-q[A], -q[Ac]])
-    lp.row_upper_ = np.concatenate([-q[A], np.full(Ac.size, inf)])
-    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = K.indptr, K.indices, K.data
-    h = new_highs()
-    for key, value in (("presolve", "off"),
-                       ("primal_feasibility_tolerance", 1e-10),
-                       ("dual_feasibility_tolerance", 1e-10)):
-        h.setOptionValue(key, value)
-    h.passModel(lp)
-    h.run()
-    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
-        return None
-    y = np.zeros(q.size)
-    y[A] = np.maximum(np.asarray(h.getSolution().col_value), 0.0)
-    return y
-
-
-def _qp(P: np.ndarray, c: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray,
-        Aeq: np.ndarray | None = None, beq: np.ndarray | None = None):
-    """min 1/2 x'Px + c'x s.t. Aeq x = beq, Aineq x <= bineq, by Clarabel (interior point)."""
-    import clarabel
-
-    n = c.size
-    settings = clarabel.DefaultSettings()
-    settings.verbose = False
-    settings.tol_gap_abs = settings.tol_gap_rel = 1e-12
-    settings.tol_feas = 1e-12
-    Pu = sp.triu(sp.csc_matrix((P + P.T) / 2), format="csc")
-    if Aeq is None:
-        Aeq, beq = np.zeros((0, n)), np.zeros(0)
-    cones = [clarabel.NonnegativeConeT(bineq.size)]
-    if beq.size:
-        cones.insert(0, clarabel.ZeroConeT(beq.size))
-    solver = clarabel.DefaultSolver(
-        Pu, c, sp.csc_matrix(np.vstack([Aeq, Aineq])), np.concatenate([beq, bineq]), cones,
-        settings,
-    )
-    sol = solver.solve()
-    status = str(sol.status)
-    if "Solved" not in status:
-        return None, status
-    return _polish(P, c, Aineq, bineq, Aeq, beq, np.array(sol.x).reshape(n)), status
-
-
-def _polish(P, c, Aineq, bineq, Aeq, beq, x):
-    """Re-solve the KKT system on the interior point's active constraints, exactly (to rounding),
-    and keep the result if it is feasible and not worse: an interior-point answer is accurate
-    to ~1e-9 only, which would show in event times."""
-    scale = max(np.abs(bineq).max(initial=0.0), 1.0)
-    slack = bineq - Aineq @ x
-    act = np.flatnonzero(slack <= 1e-7 * scale)
-    Aact = np.vstack([Aeq, Aineq[act]])
-    n, k = x.size, Aact.shape[0]
-    K = np.block([[P, Aact.T], [Aact, np.zeros((k, k))]])
-    rhs = np.concatenate([-c, beq, bineq[act]])
-    sol = np.linalg.lstsq(K, rhs, rcond=None)[0]
-    y = sol[:n]
-    if np.all(Aineq @ y <= bineq + 1e-12 * scale) and np.allclose(Aeq @ y, beq, atol=1e-12 * scale):
-        f = 0.5 * y @ P @ y + c @ y
-        if f <= 0.5 * x @ P @ x + c @ x + 1e-12 * max(abs(f), 1.0):
-            return y
-    return x
