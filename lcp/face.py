@@ -97,11 +97,12 @@ class _Walk:
         self.M, self.q, self.tol, self.z_side, self.small = M, q, tol, z_side, small
         self.faces: dict[bytes, tuple[_Face, np.ndarray]] = {}  # small: face, its LP minimizer
         self.origin: bytes | None = None  # small: the face whose LP minimizer is the current z
+        self.w: np.ndarray | None = None  # M z + q at the last z given to supports()
 
     def supports(self, z: np.ndarray) -> tuple[np.ndarray, ...]:
         """The candidate faces of z: for degenerate pairs both sides (A = {w <= tol} first), or
         the side prescribed by z_side."""
-        w = self.M @ z + self.q
+        w = self.w = self.M @ z + self.q  # kept for the faces built at z
         if self.z_side is None:
             return w <= self.tol, (w <= self.tol) & (z > self.tol)
         return ((w <= self.tol) & ((z > self.tol) | self.z_side),)
@@ -110,7 +111,7 @@ class _Walk:
         """A minimizer of c'y over the face with support in_A (a vertex for the reference)."""
         if not self.small or not in_A.any():  # an empty face: no program (None)
             return _face_lp(self.M, self.q, np.flatnonzero(in_A), c)
-        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A))
+        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A), w=self.w)
         if face.nullity == 0:
             x = np.zeros(0)
         else:
@@ -151,7 +152,7 @@ class _Walk:
             return face, np.zeros(face.nullity)
         if face is not None and key == self.origin:  # z is this face's LP minimizer
             return face, x
-        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A))
+        face = _Face(self.M, self.q, z, self.tol, A=np.flatnonzero(in_A), w=self.w)
         return face, np.zeros(face.nullity)
 
     def select(self, z0, G, c, eps, max_walk, scale) -> FaceResult:

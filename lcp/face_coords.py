@@ -47,31 +47,34 @@ def null_space(MAA: np.ndarray, *, method: str = "qr") -> tuple[np.ndarray, str]
 
 def _null_space_qr(MAA: np.ndarray) -> np.ndarray | None:
     n = MAA.shape[0]
-    R, piv = sla.qr(MAA, mode="r", pivoting=True, check_finite=False)
-    diag = np.abs(np.diag(R))
+    QR, jpvt, _, _, info = sla.lapack.dgeqp3(MAA)  # LAPACK's pivoted QR: R in the upper part
+    if info != 0:
+        return None
+    piv = jpvt - 1  # Fortran's 1-based column order
+    diag = np.abs(np.diag(QR))
     # sigma_max lies between the largest column norm |R_00| and |M_AA|_F
     unit = n * np.finfo(float).eps * 1e3
-    tol_lo = unit * max(float(diag[0]) if n else 0.0, 1.0)
-    tol_hi = unit * max(float(np.linalg.norm(R)), 1.0)
+    tol_lo = unit * max(float(diag[0]), 1.0)
+    tol_hi = unit * max(float(np.linalg.norm(MAA)), 1.0)
     r = int(np.sum(diag > tol_lo))
-    if r == n:
-        return np.zeros((n, 0)) if _lower_bound_ok(R, r, tol_hi) is not None else None
-    if np.linalg.norm(np.triu(R[r:, r:])) > tol_lo / RANK_MARGIN:
-        return None
-    if r == 0:
-        return np.eye(n)
-    inv = _lower_bound_ok(R, r, tol_hi)
+    if r < n and np.linalg.norm(np.triu(QR[r:, r:])) > tol_lo / RANK_MARGIN:
+        return None  # sigma_{r+1} not proved below the threshold
+    inv = _lower_bound_ok(QR, r, tol_hi) if r else np.zeros((0, 0))
     if inv is None:
-        return None
+        return None  # sigma_r not proved above it
+    if r == n:
+        return np.zeros((n, 0))
     basis = np.zeros((n, n - r))
-    basis[piv[:r]] = -inv @ R[:r, r:]
+    basis[piv[:r]] = -inv @ QR[:r, r:]
     basis[piv[r:]] = np.eye(n - r)
     return np.linalg.qr(basis)[0]
 
 
 def _lower_bound_ok(R: np.ndarray, r: int, tol_hi: float) -> np.ndarray | None:
-    """R11^-1 if 1/|R11^-1|_F (a lower bound on sigma_r) exceeds RANK_MARGIN x tol_hi."""
+    """R11^-1 if 1/|R11^-1|_F (a lower bound on sigma_r) exceeds RANK_MARGIN x tol_hi (dtrtri
+    reads and writes the upper triangle only: R's lower part, Householder vectors, is cut)."""
     inv, info = sla.lapack.dtrtri(R[:r, :r], lower=0)
+    inv = np.triu(inv)
     if info != 0 or not np.all(np.isfinite(inv)):
         return None
     if 1.0 / np.linalg.norm(inv) <= RANK_MARGIN * tol_hi:
@@ -87,19 +90,22 @@ class _Face:
     """
 
     def __init__(self, M: np.ndarray, q: np.ndarray, z: np.ndarray, tol: float,
-                 A: np.ndarray | None = None, null: str = "qr"):
-        w = M @ z + q
+                 A: np.ndarray | None = None, null: str = "qr", w: np.ndarray | None = None):
+        w = M @ z + q if w is None else w  # w: the caller's M z + q, if at hand
         self.z = z
         self.A = np.flatnonzero(w <= tol) if A is None else np.asarray(A)
-        Ac = np.setdiff1d(np.arange(q.size), self.A)
+        in_A = np.zeros(q.size, bool)
+        in_A[self.A] = True
+        Ac = np.flatnonzero(~in_A)
         self.null_method = "none"
         if self.A.size == 0:
             self.nullity, self.N = 0, np.zeros((0, 0))
             return
-        self.N, self.null_method = null_space(M[np.ix_(self.A, self.A)], method=null)
+        MA = M[:, self.A]
+        self.N, self.null_method = null_space(MA[self.A], method=null)
         self.nullity = self.N.shape[1]
         # y_A = z_A + N x >= 0 and w_Ac + M_{Ac,A} N x >= 0 (w_Ac > tol > 0; z_A clipped at 0)
-        self.Aineq = np.vstack([-self.N, -(M[np.ix_(Ac, self.A)] @ self.N)])
+        self.Aineq = np.vstack([-self.N, -(MA[Ac] @ self.N)])
         self.bineq = np.concatenate([np.maximum(z[self.A], 0.0), np.maximum(w[Ac], 0.0)])
 
     def point(self, x: np.ndarray) -> np.ndarray:
