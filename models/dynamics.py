@@ -88,6 +88,11 @@ class Dynamics:
         return np.asarray((HM @ self.H.T).todense())
 
     @cached_property
+    def H_T(self) -> sp.csc_matrix:
+        """H^T, kept (scipy builds a new transpose on every `H.T`)."""
+        return self.H.T
+
+    @cached_property
     def q(self) -> np.ndarray:
         """Free relative accelerations H M^-1 f + u_obs' (all contact forces zero)."""
         return self.H @ (self.Minv * self.f) + self.u_obs_dot
@@ -99,7 +104,7 @@ class Dynamics:
 
     def accelerations(self, lam: np.ndarray) -> np.ndarray:
         """Generalized accelerations nu' = M^-1 (H^T lambda + f)."""
-        return self.Minv * (self.H.T @ lam + self.f)
+        return self.Minv * (self.H_T @ lam + self.f)
 
     def relative_accelerations(self, lam: np.ndarray) -> np.ndarray:
         """a = W lambda + q (computed through H, without forming W)."""

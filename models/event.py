@@ -184,7 +184,7 @@ def event_problem(system: System, state: State, dyn: Dynamics | None = None) -> 
     c = system.c
     mu = system.mu
     s = np.asarray(state.s, dtype=int).reshape(-1)
-    if s.size != c or not np.all(np.isin(s, (-1, 0, 1))):
+    if s.size != c or not np.all((s >= -1) & (s <= 1)):
         raise ValueError(f"state.s must hold one of -1, 0, +1 per contact ({c})")
     frictionless = mu == 0
     cand_mask = (s == 0) & ~frictionless
@@ -204,11 +204,13 @@ def event_problem(system: System, state: State, dyn: Dynamics | None = None) -> 
     B[c + k + np.arange(k), cand] = 2.0 * mu[cand]  # 2 mu R - tau
     B[c + k :, c : c + k] = -np.eye(k)
     b = np.concatenate([dyn.u_obs_dot[:c], dyn.u_obs_dot[c:][cand], np.zeros(k)])
-    # The Schur complement, assembled from W directly (cheaper than through the MLCP).
-    WG = dyn.W @ G
+    # The Schur complement, assembled from W directly (cheaper than through the MLCP): the
+    # rows of W G that enter (a_n, and a_t of the candidates); G has one or two entries per
+    # column (R: 1 and the slope; tau: 1; a_minus: none), so W G is two column operations.
+    Wr = dyn.W[np.concatenate([np.arange(c), c + cand])]
     M = B.copy()
-    M[:c] += WG[:c]
-    M[c : c + k] += WG[c:][cand]
+    M[: c + k, :c] += Wr[:, :c] + Wr[:, c:] * slope
+    M[: c + k, c : c + k] += Wr[:, c + cand]
     q = np.concatenate([dyn.q[:c], dyn.q[c:][cand], np.zeros(k)])
     lcp = LCP(M, q, name="event", meta={"t": state.t, "c": c, "k": k})
     return EventProblem(system, dyn, s, cand, G, lcp, B, b, state.t)
