@@ -10,7 +10,9 @@ solution). When M_AA is nonsingular F(z) = {z}. Otherwise two methods can return
 points of the same face; `face_minimum_norm` returns a point of F(z) that depends only on the
 face, not on the point a method found: lexicographically, first the minimum of a linear
 functional c'y when `c` is given (a linear program), then, among those minimizers, the unique
-minimizer of |G y|^2 + eps |y|^2 (G: a linear map, e.g. from LCP unknowns to contact forces).
+minimizer of |G y|^2 + eps |y - z'|^2 (G: a linear map, e.g. from LCP unknowns to contact
+forces; z': the point the linear stage ended at, or z; eps = 1e-10 is a tie-break, which matters
+only where G is not injective on the face).
 
 `face_minimum_norm` is local: it walks from the given solution over neighbouring faces, so two
 solutions in different parts of the solution set can lead to different points.
@@ -189,7 +191,7 @@ class _Walk:
             beq = np.array([bound - c @ face.z])
         if not self.small:
             return _qp(P, f, face.Aineq, face.bineq, Aeq, beq)
-        x = small_qp(P, f - eps * xc, face.Aineq, face.bineq, Aeq, beq)
+        x = small_qp(P, f - eps * xc, face.Aineq, face.bineq, Aeq, beq, start=xc)
         if x is None:
             raise _SmallFailed
         return x, "optimal"
