@@ -9,7 +9,8 @@ Rect 10 x 4, mu_pp = 0.1, mu_plane = 0.2, mu_wall = 0, gamma = 0.16 g, seed 1, m
 A variant is select:loop:solvers (loop C or numpy, `lcp._lemke_kernel.use_compiled`; solvers
 small or reference, `lcp.face.face_minimum_norm(..., solvers=...)`). Each repeat runs
 `models.simulate` once per variant, alternating; the table gives the median wall time of the
-whole run, of the Lemke calls and of the face selection (timed by wrapping them), and the
+whole run, its CPU time (process_time: less sensitive to other jobs on a shared machine), the
+wall time of the Lemke calls and of the face selection (timed by wrapping them), and the
 first event whose results (t, states, R, S, mu_g, to 1e-9) differ from the first variant's
 run with the same select ("-": none differs).
 """
@@ -32,7 +33,8 @@ from rigidlcp.lcp import face as lcp_face
 DEFAULT = "face-min-norm:C:small,face-min-norm:C:reference,none:C:-"
 
 
-def one_run(select: str, compiled: bool, solvers: str) -> tuple[float, float, float, object]:
+def one_run(select: str, compiled: bool, solvers: str) -> tuple[float, float, float, object,
+                                                               float]:
     import rigidlcp.models.engine.dense as dense
 
     spent = {"lemke": 0.0, "face": 0.0}
@@ -60,13 +62,13 @@ def one_run(select: str, compiled: bool, solvers: str) -> tuple[float, float, fl
     try:
         system = models.System(models.make_lattice("rect", 10, 4), mu_pp=0.1, mu_plane=0.2,
                                mu_wall=0.0, gamma=0.16)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run = models.simulate(system, seed=1, select=select)
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     finally:
         lcp.solve, dense.face_minimum_norm = solve, face
         _lemke_kernel.use_compiled(previous)
-    return wall, spent["lemke"], spent["face"], run
+    return wall, spent["lemke"], spent["face"], run, cpu
 
 
 def first_difference(a, b) -> str:
@@ -98,7 +100,7 @@ def main(argv: list[str] | None = None) -> int:
         for v in variants:
             rows[v].append(one_run(v[0], v[1] == "C", v[2]))
     header = (f"{'select':<14} {'loop':<6} {'solvers':<10} {'events':>6} {'wall s':>7} "
-              f"{'lemke s':>8} {'face s':>7} {'differs at':>10}")
+              f"{'cpu s':>6} {'lemke s':>8} {'face s':>7} {'differs at':>10}")
     print(header)
     print("-" * len(header))
     first: dict[str, object] = {}
@@ -106,7 +108,8 @@ def main(argv: list[str] | None = None) -> int:
         r = rows[v]
         base = first.setdefault(v[0], r[0][3])
         print(f"{v[0]:<14} {v[1]:<6} {v[2]:<10} {r[0][3].n_events:>6} "
-              f"{np.median([x[0] for x in r]):>7.3f} {np.median([x[1] for x in r]):>8.3f} "
+              f"{np.median([x[0] for x in r]):>7.3f} {np.median([x[4] for x in r]):>6.3f} "
+              f"{np.median([x[1] for x in r]):>8.3f} "
               f"{np.median([x[2] for x in r]):>7.3f} {first_difference(r[0][3], base):>10}")
     print(f"load average at the end {os.getloadavg()[0]:.2f} (2-core machine shared with other "
           "jobs)")
