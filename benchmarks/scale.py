@@ -3,16 +3,16 @@
     python benchmarks/scale.py [--sizes 10,20,40,70,100] [--events 1000] [--budget 600]
                                [--gamma G] [--mu-pp M] [--seed S] [--lattice rect]
 
-For each rectangular array LxL, `rigidlcp.models.engine.sparse.simulate_sparse` runs from the seeded
-random angular velocities for --events events, or to its
-steady state, or until the run's wall clock passes --budget seconds. Printed per size: disks,
-contacts, the events run and why the run stopped, the wall time, the median time per event
-(the first event, a cold start, is reported separately and left out of the median), the
-median time of one sparse LU (SuperLU, the solver's own ordering) of the same events' final
-active systems, factored in the same run outside the timed events (a sample of up to
---lu-samples events), and their ratio; then the exponent of time per event against the
-number of disks, fitted by least squares on log-log over the sizes that ran at least 10
-events. One process, one BLAS thread; the machine may be shared: say so when quoting.
+For each rectangular array LxL, `rigidlcp.models.engine.sparse.simulate_sparse` runs from the
+seeded random angular velocities for --events events, or to its steady state, or until the
+run's wall clock passes --budget seconds. Printed per size: disks, contacts, the events run and
+why the run stopped, the wall time, the median time per event (the first event, a cold start,
+is reported separately and left out of the median), the median time of the solver's sparse LU
+(lcp.state_factor.ReducedLU: SuperLU of the rows of W that the states keep) of the same events'
+final active systems, factored in the same run outside the timed events (a sample of up to
+--lu-samples events), and their ratio; then the exponent of time per event against the number
+of disks, fitted by least squares on log-log over the sizes that ran at least 10 events. One
+process, one BLAS thread; the machine may be shared: say so when quoting.
 
 Parameters: Fig. 9's (mu_plane = 0.2, mu_wall = 0, gamma = 0.16 g) except mu_pp = 0.02 by
 default. With Fig. 9's mu_pp = 0.1 the runs of arrays 60 or more disks wide stop at the first
@@ -34,8 +34,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 import numpy as np  # noqa: E402
 
 from rigidlcp import models  # noqa: E402
+from rigidlcp.lcp.state_factor import ReducedLU  # noqa: E402
 from rigidlcp.models.engine.sparse import simulate_sparse  # noqa: E402
-from rigidlcp.models.sparse_event import factorize  # noqa: E402
 
 
 class Budget(Exception):
@@ -53,9 +53,8 @@ def run_size(lattice: str, L: int, args) -> dict:
 
     def hook(k, seconds, sol, asys) -> None:
         if k in sample:
-            K = asys.matrix(sol.normal, sol.tang).tocsc()
             t = time.perf_counter()
-            factorize(K)
+            ReducedLU(asys, sol.normal, sol.tang)
             lu_times.append(time.perf_counter() - t)
 
     def progress(run) -> None:
@@ -84,7 +83,8 @@ def run_size(lattice: str, L: int, args) -> dict:
     return dict(L=L, p=system.p, c=system.c, events=n_events, status=status, wall=wall,
                 build=build, first=float(seconds[0]) if seconds.size else float("nan"),
                 median=med, lu=lu, ratio=med / lu if lu_times else float("nan"),
-                rescues=info.get("rescues", 0), fallbacks=info.get("fallbacks", 0),
+                rescues=info.get("rescues", 0), stalls=info.get("stall_rescues", 0),
+                fallbacks=info.get("fallbacks", 0),
                 factorizations=info.get("factorizations", 0), lu_samples=len(lu_times))
 
 
@@ -109,7 +109,7 @@ def main() -> int:
           f"load average {os.getloadavg()[0]:.2f} at the start; one BLAS thread")
     header = (f"{'L':>4} {'disks':>6} {'contacts':>8} {'events':>6} {'status':<13} "
               f"{'wall s':>8} {'first s':>8} {'median ms':>10} {'LU ms':>8} {'ratio':>6} "
-              f"{'refact':>6} {'rescues':>7} {'dense fb':>8}")
+              f"{'refact':>6} {'rescues':>7} {'stalls':>6} {'dense fb':>8}")
     print(header)
     print("-" * len(header))
     rows = []
@@ -119,7 +119,7 @@ def main() -> int:
         print(f"{r['L']:>4} {r['p']:>6} {r['c']:>8} {r['events']:>6} {r['status']:<13} "
               f"{r['wall']:>8.1f} {r['first']:>8.2f} {1e3 * r['median']:>10.2f} "
               f"{1e3 * r['lu']:>8.2f} {r['ratio']:>6.2f} {r['factorizations']:>6} "
-              f"{r['rescues']:>7} {r['fallbacks']:>8}", flush=True)
+              f"{r['rescues']:>7} {r['stalls']:>6} {r['fallbacks']:>8}", flush=True)
     fit = [r for r in rows if r["events"] >= 10 and np.isfinite(r["median"])]
     if len(fit) >= 2:
         x = np.log([r["p"] for r in fit])
