@@ -5,7 +5,10 @@ lcp.states, and the sparse event engine's solver, models.engine.sparse).
 block principal pivoting on every violated state while their number drops (Judice & Pires),
 else single flips (the most violated state first; Murty's least index after a cycle), the next
 violated indices when a flip makes the active system singular, with a cycle test, a local
-Lemke rescue and an iteration limit. Indices: the
+Lemke rescue and an iteration limit. Two safeguards of issue 13 for these non-P problems: a
+block step opens at most one contact per connected cluster of contacts in tension
+(`_one_per_component`), and a run of STALL steps without a new least number of violations
+calls the local rescue instead of flipping on. Indices: the
 normal state of contact alpha is alpha, its tangential state c + alpha. The sign tests and
 their relative scales follow lcp.pivoting (see `violations`).
 """
@@ -104,13 +107,25 @@ def solve_states(factor: StateFactor, cand: np.ndarray, normal: np.ndarray, tang
     states fixed: their principal pivot transform, a dense LCP of a few hundred unknowns) by
     lexicographic Lemke, and the iteration resumes from its states; up to `max_rescues`
     times, on a growing neighbourhood.
-    Status: "solved", "max_iter", or "failed"; info counts the steps of each kind.
+
+    Safeguards (issue 13): the block step at a new least number of violations opens only the
+    most violated contact of each connected cluster of T contacts with R < 0 (the other flips
+    of H are all taken; "component_steps" when that cut H); and after STALL steps without a
+    new least number of violations the local rescue runs (up to `max_rescues` such
+    "stall_rescues", besides the rescues above; a failed one lets the iteration go on). Both
+    only choose *which* states to flip: every "solved" is the same sign check, and Murty's
+    least-index rule after a cycle still decides on P-matrices, so finiteness is kept (the
+    record-improving steps are at most the initial number of violations, the stall rescues at
+    most max_rescues).
+    Status: "solved", "max_iter", or "failed"; info counts the steps of each kind and "flips",
+    the state changes made by all of them.
     """
     asys = factor.sys
     c = asys.c
     max_iter = max(1000, 20 * c) if max_iter is None else max_iter
     info = {"block_steps": 0, "independent": 0, "partial_blocks": 0, "single_flips": 0,
-            "fallback_flips": 0, "rescues": 0, "warm_start_rejected": 0}
+            "fallback_flips": 0, "rescues": 0, "warm_start_rejected": 0,
+            "component_steps": 0, "stall_rescues": 0, "flips": 0}
     try:
         factor.set_states(normal, tang)
     except SingularSystem:
@@ -123,11 +138,16 @@ def solve_states(factor: StateFactor, cand: np.ndarray, normal: np.ndarray, tang
         except SingularSystem:
             factor.refactor(np.zeros(c, dtype=bool), np.where(cand, 1, tang).astype(np.int8))
     record, tries, it = np.inf, block_tries, 0
+    since_record, stalls = 0, 0
     largest_first = single == "largest"
     seen: dict = {}
     fs0 = factor.stats["factorizations"]
     zform: EventLCP | None = None
+    prev = (factor.normal.copy(), factor.tang.copy())
     while True:
+        info["flips"] += int(np.count_nonzero(factor.normal != prev[0])
+                             + np.count_nonzero(factor.tang != prev[1]))
+        prev = (factor.normal.copy(), factor.tang.copy())
         if factor.worn:
             try:
                 factor.refactor(factor.normal, factor.tang)
@@ -149,10 +169,22 @@ def solve_states(factor: StateFactor, cand: np.ndarray, normal: np.ndarray, tang
         it += 1
         if stuck and largest_first:  # a cycle: Murty's least-index rule from here on
             largest_first, seen, stuck = False, {key: it}, False
+        since_record += 1
+        if not stuck and STALL and since_record > STALL and stalls < max_rescues:
+            since_record, stalls = 0, stalls + 1  # no new record for STALL steps
+            if zform is None:
+                zform = EventLCP(asys, factor.tang, cand)
+            info["stall_rescues"] += 1
+            if local_rescue(factor, zform, H, min_contacts=24 * 2 ** stalls, radius=1 + stalls):
+                record, tries, seen = np.inf, block_tries, {}
+                continue
         if not stuck:
             if H.size < record:
-                record, tries = H.size, block_tries
-                if _block_step(factor, new_t, H, c, info):
+                record, tries, since_record = H.size, block_tries, 0
+                Hb = _one_per_component(H, size, c, factor.normal, asys.adjacency) \
+                    if COMPONENTS else H
+                if _block_step(factor, new_t, Hb, c, info,
+                               "block_steps" if Hb.size == H.size else "component_steps"):
                     continue
                 tries = 0
             elif tries > 0 and INDEPENDENT:
@@ -182,6 +214,38 @@ def solve_states(factor: StateFactor, cand: np.ndarray, normal: np.ndarray, tang
 
 
 INDEPENDENT = True
+#: Block steps open at most one contact per connected component of the contacts to open.
+COMPONENTS = True
+#: A local rescue after this many steps without a new least number of violations (0: never).
+STALL = 10
+
+
+def _one_per_component(H: np.ndarray, size: np.ndarray, c: int, normal: np.ndarray,
+                       adjacency: sp.csr_matrix) -> np.ndarray:
+    """H (in its order) with its opening flips (T contacts with R < 0) cut to the most
+    violated one per connected component of those contacts in the contact graph; ties go to
+    the first in H. A hyperstatic cluster of closed contacts (a row of disks between two walls)
+    carries an indeterminate self-stress; with every contact closed that self-stress shows up
+    as tension on a whole connected stretch, and opening its most stretched contact releases
+    it, where opening every contact in tension cuts the cluster into pieces that the next steps
+    must close again (at 100 x 100 disks: 1813 contacts opened where 100 open in the
+    solution)."""
+    from scipy.sparse.csgraph import connected_components
+    opening = (H < c) & normal[np.minimum(H, c - 1)]
+    if opening.sum() < 2:
+        return H
+    idx = H[opening]
+    ncomp, lab = connected_components(adjacency[idx][:, idx], directed=False)
+    if ncomp == idx.size:
+        return H
+    order = np.lexsort((np.arange(idx.size), -size[opening], lab))  # most violated first
+    first = np.ones(idx.size, dtype=bool)
+    first[1:] = lab[order][1:] != lab[order][:-1]
+    keep = np.zeros(idx.size, dtype=bool)
+    keep[order[first]] = True
+    mask = ~opening
+    mask[np.flatnonzero(opening)[keep]] = True
+    return H[mask]
 
 
 def _independent(H: np.ndarray, c: int, adjacency: sp.csr_matrix) -> np.ndarray:

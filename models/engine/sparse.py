@@ -46,7 +46,7 @@ from .sparse_pivoting import StateSolution, lcp_residual, solve_states
 METHOD = "sparse-pivoting"
 #: The pivoting's counters summed over a run in run.sparse_info.
 COUNTERS = ("block_steps", "independent", "partial_blocks", "single_flips", "fallback_flips",
-            "rescues", "factorizations")
+            "rescues", "factorizations", "component_steps", "stall_rescues", "flips")
 
 
 @dataclass
