@@ -197,6 +197,12 @@ class ReducedLU:
         self.lu = factorize(WA @ self.P) if A.size else None
         d = np.abs(self.lu.U.diagonal()) if A.size else np.zeros(0)
         self.pivots = np.concatenate([d, np.ones(N - A.size)])
+        b = np.random.default_rng(0).normal(size=N)  # fixed: the same test on every run
+        #: |K^-1 b| |W| / |b| (infinity norms; at most |K^-1| |W|, and |W| >= |K|): a singular
+        #: K shows here even when rounding leaves its smallest pivot above PIVOT_RATIO (the
+        #: reduced LU's pivots can be: 1e-13 .. 5e-13 on singular systems where the whole
+        #: K's were 1e-15).
+        self.cond_bound = float(np.abs(self.solve(b)).max()) * system.wnorm / np.abs(b).max()
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """K^-1 b (b: a vector or the columns of a matrix)."""
@@ -212,6 +218,7 @@ class _FullLU:
     def __init__(self, K: sp.spmatrix):
         self.lu = factorize(K)
         self.pivots = np.abs(self.lu.U.diagonal())
+        self.cond_bound = 0.0  # not tested (as before issue 13)
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         return self.lu.solve(b)
@@ -262,6 +269,8 @@ class StateFactor:
         self.stats["factor_seconds"] += elapsed
         if d.min() <= PIVOT_RATIO * d.max():
             raise SingularSystem(f"pivot ratio {d.min() / d.max():.2e}")
+        if lu.cond_bound * PIVOT_RATIO > 1.0:
+            raise SingularSystem(f"|K^-1 b| |K| / |b| = {lu.cond_bound:.2e}")
         self.K0, self.lu = K, lu
         self.last_factor_seconds = elapsed
         self.Y = np.zeros((self.sys.N, 32))
