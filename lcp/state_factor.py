@@ -168,9 +168,10 @@ class ReducedLU:
     normals, NS tangents) in their own unknowns (R of T, S of NS): with lambda = P x + Q b,
     (W_A P) x = b_A - W_A Q b. Exact block elimination; the reduced matrix has about half the
     rows of K and SuperLU fills it about half as much (100 x 100 disks: 1.2 against 1.9
-    million entries). `solve` takes one or several right-hand sides; `pivots` are |U_ii| of
-    the reduced LU and the unit pivots of the eliminated rows. Raises RuntimeError when SuperLU
-    finds the reduced matrix exactly singular."""
+    million entries). The reduced matrix is equilibrated symmetrically by its diagonal before
+    SuperLU sees it. `solve` takes one or several right-hand sides; `pivots` are |U_ii| of
+    the equilibrated reduced LU and the unit pivots of the eliminated rows. Raises RuntimeError
+    when SuperLU finds the reduced matrix exactly singular."""
 
     def __init__(self, system: ActiveSystem, normal: np.ndarray, tang: np.ndarray):
         c, N, mu = system.c, system.N, system.mu
@@ -194,22 +195,33 @@ class ReducedLU:
         WA = system.W[A]
         self.WQ = (WA @ self.Q).tocsr()
         self.A = A
-        self.lu = factorize(WA @ self.P) if A.size else None
+        Kr = (WA @ self.P).tocsr()
+        # symmetric equilibration r_i = |Kr_ii|^-1/2 (Kr_ii > 0: W's diagonal), so that the
+        # pivot and condition tests below do not depend on the units of the contacts
+        diag = np.abs(Kr.diagonal())
+        rowmax = np.asarray(abs(Kr).max(axis=1).todense()).ravel() if A.size else diag
+        self.r = 1.0 / np.sqrt(np.where(diag > 0, diag, np.where(rowmax > 0, rowmax, 1.0)))
+        Ks = sp.diags(self.r) @ Kr @ sp.diags(self.r)
+        self.lu = factorize(Ks) if A.size else None
         d = np.abs(self.lu.U.diagonal()) if A.size else np.zeros(0)
         self.pivots = np.concatenate([d, np.ones(N - A.size)])
-        b = np.random.default_rng(0).normal(size=N)  # fixed: the same test on every run
-        #: |K^-1 b| |W| / |b| (infinity norms; at most |K^-1| |W|, and |W| >= |K|): a singular
-        #: K shows here even when rounding leaves its smallest pivot above PIVOT_RATIO (the
-        #: reduced LU's pivots can be: 1e-13 .. 5e-13 on singular systems where the whole
-        #: K's were 1e-15).
-        self.cond_bound = float(np.abs(self.solve(b)).max()) * system.wnorm / np.abs(b).max()
+        #: |Ks^-1 b| |Ks| / |b| (infinity norms, a fixed b: the same test on every run) <=
+        #: cond(Ks), Ks the equilibrated reduced matrix: a singular K shows here even when
+        #: rounding leaves its smallest pivot above PIVOT_RATIO (the reduced LU's pivots can be:
+        #: 1e-13 .. 5e-13 on singular systems where the whole K's were 1e-15).
+        self.cond_bound = 0.0
+        if A.size:
+            b = np.random.default_rng(0).normal(size=A.size)
+            norm = float(np.max(abs(Ks) @ np.ones(A.size)))
+            self.cond_bound = float(np.abs(self.lu.solve(b)).max()) * norm / np.abs(b).max()
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """K^-1 b (b: a vector or the columns of a matrix)."""
         if self.lu is None:
             return self.Q @ b
-        x = self.lu.solve(np.asarray(b[self.A] - self.WQ @ b, dtype=float))
-        return self.P @ x + self.Q @ b
+        y = np.asarray(b[self.A] - self.WQ @ b, dtype=float)
+        r = self.r if y.ndim == 1 else self.r[:, None]
+        return self.P @ (r * self.lu.solve(r * y)) + self.Q @ b
 
 
 class _FullLU:
@@ -270,7 +282,7 @@ class StateFactor:
         if d.min() <= PIVOT_RATIO * d.max():
             raise SingularSystem(f"pivot ratio {d.min() / d.max():.2e}")
         if lu.cond_bound * PIVOT_RATIO > 1.0:
-            raise SingularSystem(f"|K^-1 b| |K| / |b| = {lu.cond_bound:.2e}")
+            raise SingularSystem(f"condition number >= {lu.cond_bound:.2e}")
         self.K0, self.lu = K, lu
         self.last_factor_seconds = elapsed
         self.Y = np.zeros((self.sys.N, 32))

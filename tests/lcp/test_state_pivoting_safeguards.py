@@ -141,18 +141,18 @@ def test_hyperstatic_chains_get_the_analytic_accelerations(variant, monkeypatch)
 
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_degenerate_and_badly_scaled(variant, monkeypatch):
-    """q_n = 0 on a third of the contacts (degenerate), and the unknowns scaled by 1e-2 ..
-    1e2 (W -> S W S, q -> S q, R -> S^-1 R; entries of W spread over 1e8): the scaled answer
-    is the unscaled one mapped. (Over 1e-4 .. 1e4 the pivot-ratio test of lcp.state_factor,
-    1e-13, refuses the systems as singular with or without the safeguards: the state solver
-    does not equilibrate.)"""
+    """q_n = 0 on a third of the contacts (degenerate), and the unknowns scaled by 1e-4 ..
+    1e4 (W -> S W S, q -> S q, R -> S^-1 R; entries of W spread over 1e16): the scaled answer
+    is the unscaled one mapped. (SuperLU of the whole unscaled K refused the all-closed start
+    of this problem as singular and failed in two of the five variants; ReducedLU equilibrates
+    and solves all five.)"""
     rng = np.random.default_rng(3)
     W, q = chains(4, 9, 1e-3, rng)
     c = q.size // 2
     q[:c][rng.uniform(size=c) < 1 / 3] = 0.0
     sol, _ = run(W, q, variant, monkeypatch)
     check_solution(sol, W, q)
-    s = np.concatenate([10.0 ** rng.uniform(-2, 2, size=c), np.ones(c)])
+    s = np.concatenate([10.0 ** rng.uniform(-4, 4, size=c), np.ones(c)])
     Ws = (sp.diags(s) @ W @ sp.diags(s)).tocsr()
     sol_s, _ = run(Ws, s * q, variant, monkeypatch)
     check_solution(sol_s, Ws, s * q)
@@ -201,9 +201,9 @@ def test_reduced_lu_solves_what_the_whole_system_solves(seed):
     d = red.pivots
     cond = np.linalg.cond(K.toarray())
     refused = d.min() <= 1e-13 * d.max() or red.cond_bound > 1e13  # StateFactor's tests
-    if cond < 1e12:  # |K^-1 b| |K| / |b| <= |K^-1| |W| (infinity norms; |W| >= |K|)
-        Kinv = np.abs(np.linalg.inv(K.toarray())).sum(axis=1).max()
-        assert red.cond_bound <= Kinv * asys.wnorm * (1 + 1e-6)
+    Ks = (sp.diags(red.r) @ asys.W[red.A] @ red.P @ sp.diags(red.r)).toarray()
+    if np.linalg.cond(Ks) < 1e12:  # a lower bound of the equilibrated matrix's condition
+        assert red.cond_bound <= np.linalg.cond(Ks, np.inf) * (1 + 1e-6)
     if cond > 1e16:
         assert refused  # numerically singular systems are refused
     if refused:
