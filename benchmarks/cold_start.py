@@ -4,14 +4,13 @@ and off, alternating in one process.
 
     python benchmarks/cold_start.py [--sizes 40,70,100] [--repeats 3]
 
-Variants: "issue 13" (the defaults: the component step of lcp.state_pivoting, its stall
-rescue, lcp.state_factor.ReducedLU); "full-K LU" (REDUCED = False: SuperLU of all of K);
-"no component step" (COMPONENTS = False: a block step flips every violated state); "before"
-(both off, the solver before issue 13). The stall rescue is on in all four (the first event
-of these arrays never stalls). Parameters as benchmarks/scale.py (rect LxL, mu_pp = 0.02,
-mu_plane = 0.2, mu_wall = 0, gamma = 0.16 g, seed 1); one event
-(`simulate_sparse(..., max_events=1)`), one BLAS thread. "factorizations" counts the cold
-start's own one.
+Variants: "issue 13" (the defaults: the component step of lcp.state_pivoting and
+lcp.state_factor.ReducedLU); "full-K LU" (REDUCED = False: SuperLU of all of K); "no component
+step" (COMPONENTS = False: a block step flips every violated state); "before" (both off, the
+solver before issue 13; the event engine does not use the stall rescue). Parameters as
+benchmarks/scale.py (rect LxL, mu_pp = 0.02, mu_plane = 0.2, mu_wall = 0, gamma = 0.16 g, seed
+1); one event (`simulate_sparse(..., max_events=1)`), one BLAS thread. "factorizations" counts
+the cold start's own one.
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ def solve_states_fc2d(problem: FrictionContact2D, *, tol: float = 1e-10,
     if not (0 < tol < 1):
         raise InvalidProblem(f"tol must be in (0, 1), got {tol!r}")
     from .state_factor import ActiveSystem, StateFactor
-    from .state_pivoting import solve_states
+    from .state_pivoting import STALL, solve_states
 
     c, mu = problem.c, problem.mu
     Wb, qb = problem.blocks()
@@ -43,7 +43,7 @@ def solve_states_fc2d(problem: FrictionContact2D, *, tol: float = 1e-10,
     tang0 = np.where(cand, np.where(qb[c:] < 0, -1, 1), tang_fixed).astype(np.int8)
     factor = StateFactor(asys, np.zeros(c, dtype=bool), np.where(cand, 1, 0).astype(np.int8),
                          max_updates)
-    res = solve_states(factor, cand, normal0, tang0, tol=tol, max_iter=max_iter)
+    res = solve_states(factor, cand, normal0, tang0, tol=tol, max_iter=max_iter, stall=STALL)
     r = np.empty(2 * c)
     r[0::2], r[1::2] = res.R, res.S
     info = dict(res.info)

@@ -23,7 +23,7 @@ from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import initial_state
 from rigidlcp.models.sparse_event import sparse_delassus
 
-VARIANTS = [(True, 10), (False, 0), (True, 0), (False, 1), (True, 1)]  # (COMPONENTS, STALL)
+VARIANTS = [(True, 0), (False, 0), (True, 10), (False, 1), (True, 1)]  # (COMPONENTS, stall)
 
 
 class CountingFactor(StateFactor):
@@ -58,13 +58,12 @@ def chains(rows: int, n: int, eps: float, rng) -> tuple[sp.csr_matrix, np.ndarra
 def run(W, q, variant, monkeypatch, normal0=None):
     """solve_states from every contact closed (frictionless: tang 0, no candidate)."""
     monkeypatch.setattr(state_pivoting, "COMPONENTS", variant[0])
-    monkeypatch.setattr(state_pivoting, "STALL", variant[1])
     c = q.size // 2
     asys = ActiveSystem(W, q, np.zeros(c))
     tang = np.zeros(c, dtype=np.int8)
     factor = CountingFactor(asys, np.zeros(c, dtype=bool), tang)
     normal0 = np.ones(c, dtype=bool) if normal0 is None else normal0
-    sol = solve_states(factor, np.zeros(c, dtype=bool), normal0, tang)
+    sol = solve_states(factor, np.zeros(c, dtype=bool), normal0, tang, stall=variant[1])
     return sol, factor
 
 
@@ -160,18 +159,17 @@ def test_degenerate_and_badly_scaled(variant, monkeypatch):
 
 
 def test_the_iteration_stops_within_its_limit(monkeypatch):
-    """STALL = 1 (a rescue after every step without a new record) and a tiny iteration limit:
+    """stall = 1 (a rescue after every step without a new record) and a tiny iteration limit:
     the call returns a status, never loops."""
     rng = np.random.default_rng(11)
     W, q = chains(8, 15, 1e-8, rng)
-    monkeypatch.setattr(state_pivoting, "STALL", 1)
     c = q.size // 2
     asys = ActiveSystem(W, q, np.zeros(c))
     tang = np.zeros(c, dtype=np.int8)
     for max_iter in (1, 3, 1000):
         factor = StateFactor(asys, np.zeros(c, dtype=bool), tang)
         sol = solve_states(factor, np.zeros(c, dtype=bool), np.ones(c, dtype=bool), tang,
-                           max_iter=max_iter)
+                           max_iter=max_iter, stall=1)
         assert sol.status in ("solved", "max_iter", "failed")
         assert sol.iterations <= max_iter
         assert sol.info["stall_rescues"] <= 8
