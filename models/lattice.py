@@ -161,11 +161,11 @@ def _build(name: str, lx: int, ly: int, r: float, rows: list, full: list[bool]) 
         if full[m]:
             add(ids[-1], RIGHT_WALL, (1.0, 0.0), "wall")
         if m + 1 < len(index):  # contacts with the row above: every pair at distance 2r
-            for a in ids:
-                for b in index[m + 1]:
-                    d = x[b] - x[a]
-                    if abs(np.hypot(*d) - 2 * r) <= 1e-9 * r:
-                        add(a, b, tuple(d / (2 * r)), "pp")
+            above = index[m + 1]
+            d = x[above][None, :, :] - x[ids][:, None, :]  # d[a, b] = x_b - x_a
+            touching = np.abs(np.hypot(d[..., 0], d[..., 1]) - 2 * r) <= 1e-9 * r
+            for a, b in np.argwhere(touching):  # a (this row) outer, b (the row above) inner
+                add(ids[a], above[b], tuple(d[a, b] / (2 * r)), "pp")
     n = np.array(normals, dtype=float)
     t = np.column_stack([-n[:, 1], n[:, 0]])  # n rotated by +90 degrees
     return Lattice(
