@@ -556,20 +556,335 @@ static PyObject *py_set_fma(PyObject *self, PyObject *arg)
     return PyBool_FromLong(use_fma);
 }
 
-/* solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k problems of size n
- * (Ms: k n n C-contiguous, qs: k n; the data must be finite) by the same steps as lemke()
- * (q >= 0: z = 0 and no pivot; else setup + run). Writes z (k n, the original units, as
- * `_Lemke.point`), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
- * (solved) leaves a usable z: the caller solves the others again by lemke() for their
- * evidence (ray, restart after cycling). */
+/* ------------------------------------------------------------------ one whole problem */
+/* The equilibration of lcp/scaling.py's `ruiz`, done here for a balanced M (every row and
+ * column maximum of |M| at least 1/BALANCED of the largest entry: `ruiz` then makes no sweep
+ * and only changes the unit of q: r = 1/s, c = s, s the power of 2 nearest |q|_inf). */
+#define BALANCED 16.0
+#define NEEDS_RUIZ 4 /* mode 1 and M not balanced (or s not decided here): equilibrate in numpy */
+#define NOT_FINITE 5 /* the equilibrated data are not finite: lemke() would refuse them */
+
+/* The power of 2 nearest x > 0 in the log sense, numpy's exp2(round(log2(x))) in
+ * lcp/scaling.py's `_pow2`, read from the bits of x = (1 + f) 2^e: 2^e if 1 + f < sqrt 2, else
+ * 2^(e + 1). Returns 0 (the caller then leaves it to numpy) when x is not a positive normal
+ * number, when 1 + f is within 1e-9 of sqrt 2 (where the last bit of a computed log2 could
+ * decide the rounding) or when 2^-e would not be a normal number. */
+static double pow2_near(double x)
+{
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    int be = (int)((u >> 52) & 0x7FF);
+    if (be == 0 || be == 0x7FF || (u >> 63)) return 0.0;
+    double f = (double)(u & 0xFFFFFFFFFFFFFULL) / 4503599627370496.0; /* 2^52: exact */
+    double gap = f - 0.41421356237309504880;                           /* sqrt 2 - 1 */
+    if (gap < 1e-9 && gap > -1e-9) return 0.0;
+    int k = be - 1023 + (gap > 0);
+    if (k < -1000 || k > 1000) return 0.0;
+    uint64_t v = (uint64_t)(k + 1023) << 52;
+    double s;
+    memcpy(&s, &v, sizeof s);
+    return s;
+}
+
+/* Mode 1: is M (finite) balanced? Then *rs = 1/s, *cs = s (or 1, 1 when q = 0) and 0 is
+ * returned; NEEDS_RUIZ otherwise, NOT_FINITE if M or q has a NaN or an infinity. colmax:
+ * scratch of n doubles. */
+static int balanced_units(idx n, const double *M, const double *q, double *colmax, double *rs,
+                          double *cs)
+{
+    double top = 0.0, rmin = 1.0 / 0.0, acc = 0.0;
+    for (idx j = 0; j < n; j++) colmax[j] = 0.0;
+    for (idx i = 0; i < n; i++) {
+        const double *Mi = M + i * n;
+        double rm = 0.0;
+        for (idx j = 0; j < n; j++) {
+            double a = Mi[j] < 0 ? -Mi[j] : Mi[j];
+            acc += a - a;
+            if (a > rm) rm = a;
+            if (a > colmax[j]) colmax[j] = a;
+        }
+        if (rm > top) top = rm;
+        if (rm < rmin) rmin = rm;
+    }
+    double qmax = 0.0;
+    for (idx i = 0; i < n; i++) {
+        double a = q[i] < 0 ? -q[i] : q[i];
+        acc += a - a;
+        if (a > qmax) qmax = a;
+    }
+    if (acc != 0.0) return NOT_FINITE; /* NaN: some entry is not finite */
+    double cmin = 1.0 / 0.0;
+    for (idx j = 0; j < n; j++)
+        if (colmax[j] < cmin) cmin = colmax[j];
+    if (!(top > 0 && rmin >= top / BALANCED && cmin >= top / BALANCED)) return NEEDS_RUIZ;
+    *rs = *cs = 1.0;
+    if (qmax > 0) {
+        double s = pow2_near(qmax);
+        if (s == 0.0) return NEEDS_RUIZ;
+        *rs = 1.0 / s;
+        *cs = 1.0 * s;
+    }
+    return 0;
+}
+
+/* T = [M~ / mu, d / delta, q~ / nu] (as `fill`) for the equilibrated data M~ = (M r) c and
+ * q~ = q r, rounded as numpy rounds scaling.py's M * r[:, None] * c[None, :] and q * r; r and c
+ * are the arrays r, c or, when NULL, the numbers rs, cs; d NULL means ones. Also max|M| and
+ * max|q| of the data given. Returns NOT_FINITE when M~ or q~ is not finite, else 0. */
+typedef struct {
+    double mu, nu, delta, qmin, mmax, qmax;
+} Scales;
+
+static int fill_scaled(idx n, double *T, const double *M, const double *q, const double *d,
+                       const double *r, const double *c, double rs, double cs, Scales *S)
+{
+    double mu = 0.0, nu = 0.0, acc = 0.0, mmax = 0.0, qmax = 0.0, qmin = 1.0 / 0.0;
+    for (idx i = 0; i < n; i++) {
+        double ri = r ? r[i] : rs;
+        const double *Mi = M + i * n;
+        for (idx j = 0; j < n; j++) {
+            double m = Mi[j], v = (m * ri) * (c ? c[j] : cs);
+            double a = v < 0 ? -v : v, am = m < 0 ? -m : m;
+            acc += a - a;
+            if (a > mu) mu = a;
+            if (am > mmax) mmax = am;
+            T[i + n * j] = v;
+        }
+    }
+    for (idx i = 0; i < n; i++) {
+        double v = q[i] * (r ? r[i] : rs), a = v < 0 ? -v : v, aq = q[i] < 0 ? -q[i] : q[i];
+        acc += a - a;
+        if (a > nu) nu = a;
+        if (v < qmin) qmin = v;
+        if (aq > qmax) qmax = aq;
+        T[i + n * (n + 1)] = v;
+    }
+    if (acc != 0.0) return NOT_FINITE;
+    if (mu == 0.0) mu = 1.0;
+    double delta = -1.0 / 0.0;
+    for (idx i = 0; i < n; i++) {
+        double di = d ? d[i] : 1.0;
+        if (di > delta) delta = di;
+    }
+    for (idx k = 0; k < n * n; k++) T[k] = T[k] / mu;
+    for (idx i = 0; i < n; i++) {
+        T[i + n * n] = (d ? d[i] : 1.0) / delta;
+        T[i + n * (n + 1)] = T[i + n * (n + 1)] / nu;
+    }
+    S->mu = mu;
+    S->nu = nu;
+    S->delta = delta;
+    S->qmin = qmin;
+    S->mmax = mmax;
+    S->qmax = qmax;
+    return 0;
+}
+
+/* One LCP by the steps of lemke() on the data `solve` gives it (mode 0: as they are; 1: the
+ * equilibration of a balanced M done here; 2: the factors r, c of `ruiz` given): q~ >= 0 gives
+ * z = 0 and no pivot, else the dictionary and the pivot loop; z in the original units (as
+ * `_Lemke.point`, then `Equilibration.z_back`: c_j z~_j) and bz[j] = z_j basic. Returns the
+ * code of `run` (0..3), NEEDS_RUIZ, NOT_FINITE or -1 (out of memory); *zmax = max|z| and
+ * *mmax, *qmax (of M and q as given) when solved. */
+static int solve_problem(Lemke *L, double *T, const double *M, const double *q, const double *d,
+                         const double *r, const double *c, int mode, long long max_iter,
+                         double *z, int8_t *bz, long long *pivots, double bound[3])
+{
+    const idx n = L->n;
+    double rs = 1.0, cs = 1.0;
+    *pivots = 0;
+    memset(z, 0, n * sizeof(double));
+    memset(bz, 0, n);
+    if (mode != 2) r = c = NULL;
+    if (mode == 1) {
+        int code = balanced_units(n, M, q, L->theta, &rs, &cs);
+        if (code) return code;
+    }
+    Scales S;
+    if (fill_scaled(n, T, M, q, d, r, c, rs, cs, &S)) return NOT_FINITE;
+    bound[0] = S.mmax;
+    bound[1] = S.qmax;
+    bound[2] = 0.0;
+    if (S.qmin >= 0) return 0; /* z = 0 solves it */
+    L->T = T;
+    for (idx i = 0; i < n; i++) {
+        L->basic[i] = i;
+        L->row_of[i] = i;
+        L->slot_of[i] = -1;
+    }
+    for (idx j = 0; j <= n; j++) {
+        L->nonbasic[j] = n + j;
+        L->row_of[n + j] = -1;
+        L->slot_of[n + j] = j;
+    }
+    idx s;
+    int64_t entering;
+    int code = run(L, max_iter, NULL, 0, pivots, &s, &entering);
+    if (code != 0) return code;
+    const double *beta = T + n * (n + 1);
+    double scale = S.nu / S.mu, zmax = 0.0;
+    for (idx i = 0; i < n; i++) {
+        int64_t b = L->basic[i];
+        if (b >= n && b < 2 * n) {
+            double cj = c ? c[b - n] : cs, v = cj * (beta[i] * scale);
+            z[b - n] = v;
+            bz[b - n] = 1;
+            if ((v < 0 ? -v : v) > zmax) zmax = v < 0 ? -v : v;
+        }
+    }
+    bound[2] = zmax;
+    return 0;
+}
+
+/* Scratch of one problem of size n: T, the int64 bookkeeping and the Lemke buffers. */
+typedef struct {
+    Lemke L;
+    double *T;
+    int64_t *ints;
+    int8_t *bz;
+} Work;
+
+static void work_free(Work *w)
+{
+    free(w->T);
+    free(w->ints);
+    free(w->bz);
+    free(w->L.rows);
+    free(w->L.alpha);
+    free(w->L.V);
+}
+
+static int work_init(Work *w, idx n, double tol)
+{
+    Lemke *L = &w->L;
+    w->T = (double *)malloc((size_t)n * (n + 2) * sizeof(double));
+    w->ints = (int64_t *)malloc((6 * n + 3) * sizeof(int64_t));
+    w->bz = (int8_t *)malloc(n);
+    L->rows = (idx *)malloc(4 * n * sizeof(idx));
+    L->alpha = (double *)malloc((4 * n + 2) * sizeof(double));
+    L->V = (double *)malloc((size_t)n * n * sizeof(double));
+    if (!(w->T && w->ints && w->bz && L->rows && L->alpha && L->V)) {
+        work_free(w);
+        return -1;
+    }
+    L->n = n;
+    L->T = w->T;
+    L->tol = tol;
+    L->basic = w->ints;
+    L->nonbasic = w->ints + n;
+    L->row_of = w->ints + 2 * n + 1;
+    L->slot_of = w->ints + 4 * n + 2;
+    L->cand = L->rows + n;
+    L->wj = L->rows + 2 * n;
+    L->pos = L->rows + 3 * n;
+    L->theta = L->alpha + n;
+    L->col = L->alpha + 2 * n;
+    L->row = L->alpha + 3 * n;
+    return 0;
+}
+
+/* An optional float64 vector of length n (None: NULL). */
+static int opt_vector(PyObject *obj, Py_buffer *view, const char *name, idx n, const double **out)
+{
+    *out = NULL;
+    view->obj = NULL;
+    if (obj == Py_None) return 0;
+    if (get_buffer(obj, view, name, 'd', n, 0) < 0) return -1;
+    *out = (const double *)view->buf;
+    return 0;
+}
+
+static void release(Py_buffer *v)
+{
+    if (v->obj) PyBuffer_Release(v);
+}
+
+/* solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one LCP
+ * as lcp.solve gives it to lemke() by default, on its equilibrated data: r = c = None for the
+ * balanced case done here (code NEEDS_RUIZ when M is not balanced), or the factors of `ruiz`;
+ * d None for ones. M n x n C-contiguous, q, r, c, d, z float64 of length n; basis int64 of
+ * length n receives the sorted indices of the basic z's (the first nbasis entries). bounds =
+ * (max|M|, max|q|, max|z|) of the data given and the answer (when code 0). */
+static PyObject *py_solve_eq(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *or_, *oc, *od, *oz, *ob;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOdLOO", &oM, &oq, &or_, &oc, &od, &tol, &max_iter, &oz,
+                          &ob))
+        return NULL;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if ((or_ == Py_None) != (oc == Py_None)) {
+        PyErr_SetString(PyExc_ValueError, "r and c: both None or both given");
+        return NULL;
+    }
+    Py_buffer vM = {0}, vq = {0}, vr = {0}, vc = {0}, vd = {0}, vz = {0}, vb = {0};
+    const double *r, *c, *d;
+    PyObject *result = NULL;
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto done;
+    if (opt_vector(or_, &vr, "r", n, &r) < 0 || opt_vector(oc, &vc, "c", n, &c) < 0 ||
+        opt_vector(od, &vd, "d", n, &d) < 0)
+        goto done;
+    if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
+    if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
+    Work w;
+    if (work_init(&w, n, tol) < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    long long pivots = 0;
+    double bound[3] = {0.0, 0.0, 0.0};
+    int code;
+    Py_BEGIN_ALLOW_THREADS
+    code = solve_problem(&w.L, w.T, (const double *)vM.buf, (const double *)vq.buf, d, r, c,
+                         r ? 2 : 1, max_iter, (double *)vz.buf, w.bz, &pivots, bound);
+    Py_END_ALLOW_THREADS
+    idx nb = 0;
+    int64_t *basis = (int64_t *)vb.buf;
+    for (idx j = 0; j < n; j++)
+        if (w.bz[j]) basis[nb++] = j;
+    work_free(&w);
+    if (code < 0)
+        PyErr_NoMemory();
+    else
+        result = Py_BuildValue("iLn(ddd)", code, pivots, nb, bound[0], bound[1], bound[2]);
+done:
+    release(&vb);
+    release(&vz);
+    release(&vd);
+    release(&vc);
+    release(&vr);
+    release(&vM);
+    release(&vq);
+    return result;
+}
+
+/* solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode): k problems of size n
+ * (Ms: k n n C-contiguous, qs: k n; finite) by the steps of lemke() (q >= 0: z = 0 and no
+ * pivot; else setup + run), on the data as given (mode 0) or equilibrated here when balanced
+ * (mode 1, as `solve_eq` with r = c = None: code NEEDS_RUIZ for the others). Writes z (k n,
+ * the original units), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
+ * (solved) leaves a usable z: the caller solves the others again one by one. */
 static PyObject *py_solve_batch(PyObject *self, PyObject *args)
 {
     PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op;
     double tol;
     long long max_iter;
+    int mode = 0;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOdLOOOO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc, &op))
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO|i", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
+                          &op, &mode))
         return NULL;
+    if (mode != 0 && mode != 1) {
+        PyErr_SetString(PyExc_ValueError, "mode: 0 or 1");
+        return NULL;
+    }
     Py_buffer vd, vc, vp, vM, vq, vZ, vB;
     idx n = PyObject_Length(od), k = PyObject_Length(oc);
     if (n < 1 || k < 0) {
@@ -587,88 +902,30 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "basic_z: expected k n int8 values");
         goto b7;
     }
-    Lemke L;
-    int64_t *ints = (int64_t *)malloc((6 * n + 3) * sizeof(int64_t));
-    double *T = (double *)malloc((size_t)n * (n + 2) * sizeof(double));
-    L.rows = (idx *)malloc(4 * n * sizeof(idx));
-    L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
-    L.V = (double *)malloc((size_t)n * n * sizeof(double));
-    int failed = !(ints && T && L.rows && L.alpha && L.V);
+    Work w;
+    int failed = work_init(&w, n, tol) < 0;
     if (!failed) {
         const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
                      *d = (const double *)vd.buf;
         double *Z = (double *)vZ.buf;
         int8_t *B = (int8_t *)vB.buf;
         int64_t *codes = (int64_t *)vc.buf, *piv = (int64_t *)vp.buf;
-        L.n = n;
-        L.T = T;
-        L.tol = tol;
-        L.basic = ints;
-        L.nonbasic = ints + n;
-        L.row_of = ints + 2 * n + 1;
-        L.slot_of = ints + 4 * n + 2;
-        L.cand = L.rows + n;
-        L.wj = L.rows + 2 * n;
-        L.pos = L.rows + 3 * n;
-        L.theta = L.alpha + n;
-        L.col = L.alpha + 2 * n;
-        L.row = L.alpha + 3 * n;
         Py_BEGIN_ALLOW_THREADS
-        for (idx p = 0; p < k && !failed; p++) {
-            const double *q = qs + p * n;
-            double *z = Z + p * n;
-            int8_t *bz = B + p * n;
-            memset(z, 0, n * sizeof(double));
-            memset(bz, 0, n);
-            double qmin = q[0];
-            for (idx i = 1; i < n; i++)
-                if (q[i] < qmin) qmin = q[i];
-            if (qmin >= 0) {
-                codes[p] = 0;
-                piv[p] = 0;
-                continue;
-            }
-            double mu, nu, delta;
-            fill(n, T, Ms + p * n * n, q, d, &mu, &nu, &delta);
-            for (idx i = 0; i < n; i++) {
-                L.basic[i] = i;
-                L.row_of[i] = i;
-                L.slot_of[i] = -1;
-            }
-            for (idx j = 0; j <= n; j++) {
-                L.nonbasic[j] = n + j;
-                L.row_of[n + j] = -1;
-                L.slot_of[n + j] = j;
-            }
+        for (idx p = 0; p < k; p++) {
             long long pivots = 0;
-            idx s;
-            int64_t entering;
-            int code = run(&L, max_iter, NULL, 0, &pivots, &s, &entering);
+            double bound[3];
+            int code = solve_problem(&w.L, w.T, Ms + p * n * n, qs + p * n, d, NULL, NULL, mode,
+                                     max_iter, Z + p * n, B + p * n, &pivots, bound);
             if (code < 0) {
                 failed = 1;
                 break;
             }
             codes[p] = code;
             piv[p] = pivots;
-            if (code == 0) {
-                const double *beta = T + n * (n + 1);
-                double scale = nu / mu;
-                for (idx i = 0; i < n; i++) {
-                    int64_t b = L.basic[i];
-                    if (b >= n && b < 2 * n) {
-                        z[b - n] = beta[i] * scale;
-                        bz[b - n] = 1;
-                    }
-                }
-            }
         }
         Py_END_ALLOW_THREADS
+        work_free(&w);
     }
-    free(ints);
-    free(T);
-    free(L.rows);
-    free(L.alpha);
-    free(L.V);
     PyBuffer_Release(&vB);
     PyBuffer_Release(&vZ);
     PyBuffer_Release(&vq);
@@ -695,9 +952,92 @@ b1:
     return NULL;
 }
 
+/* ------------------------------------------------------------------ the acceptance measure */
+/* lcp_measure(M, q, z, w, rows) -> (residual, scaled residual, z_s, w_s), or None: the part of
+ * lcp/residual.py's `lcp_measure` that needs no summation, for w = M z + q and rows = the row
+ * sums of |M| computed by numpy (their rounding is numpy's). Every operation is the one the
+ * numpy code does, on finite numbers (max, |.|, min, one division and one product and sum each:
+ * the same roundings, no fused multiply-add: setup.py builds with -ffp-contract=off). None when
+ * an input is not a finite float64 array of the right length or a scale is not finite: the
+ * numpy code then measures. */
+static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *oz, *ow, *orows;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &oM, &oq, &oz, &ow, &orows)) return NULL;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        PyErr_Clear();
+        Py_RETURN_NONE;
+    }
+    Py_buffer v[5];
+    PyObject *objs[5] = {oM, oq, oz, ow, orows};
+    idx sizes[5] = {n * n, n, n, n, n};
+    int got = 0;
+    for (; got < 5; got++) {
+        if (PyObject_GetBuffer(objs[got], &v[got], PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) break;
+        const char *f = v[got].format ? v[got].format : "B";
+        if (*f == '<' || *f == '=' || *f == '@') f++;
+        if (v[got].itemsize != 8 || f[0] != 'd' || f[1] != 0 || v[got].len / 8 != sizes[got]) {
+            PyBuffer_Release(&v[got]);
+            break;
+        }
+    }
+    PyObject *result = NULL;
+    if (got == 5) {
+        const double *M = (const double *)v[0].buf, *q = (const double *)v[1].buf,
+                     *z = (const double *)v[2].buf, *w = (const double *)v[3].buf,
+                     *rows = (const double *)v[4].buf;
+        double acc = 0.0, mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
+        for (idx k = 0; k < n * n; k++) {
+            double a = M[k] < 0 ? -M[k] : M[k];
+            acc += a - a;
+            if (a > mmax) mmax = a;
+        }
+        for (idx i = 0; i < n; i++) {
+            double aq = q[i] < 0 ? -q[i] : q[i], az = z[i] < 0 ? -z[i] : z[i];
+            acc += (aq - aq) + (az - az) + (w[i] - w[i]) + (rows[i] - rows[i]);
+            if (aq > qmax) qmax = aq;
+            if (az > zmax) zmax = az;
+            if (rows[i] > norm) norm = rows[i];
+        }
+        /* residual.py: zs = max(zmax, qmax / mmax if mmax > 0 else 0.0); 1 if 0;
+         * ws = qmax + norm_inf(M) * zs; 1 if not > 0 */
+        double ratio = mmax > 0 ? qmax / mmax : 0.0;
+        double zs = ratio > zmax ? ratio : zmax;
+        if (zs == 0.0) zs = 1.0;
+        double prod = norm * zs;
+        double ws = qmax + prod;
+        if (!(ws > 0)) ws = 1.0;
+        acc += (zs - zs) + (ws - ws);
+        if (acc == 0.0) {
+            double scaled = 0.0, raw = 0.0;
+            for (idx i = 0; i < n; i++) {
+                double a = z[i] / zs, b = w[i] / ws, m = a < b ? a : b;
+                m = m < 0 ? -m : m;
+                if (m > scaled) scaled = m;
+                double m2 = z[i] < w[i] ? z[i] : w[i];
+                m2 = m2 < 0 ? -m2 : m2;
+                if (m2 > raw) raw = m2;
+            }
+            result = Py_BuildValue("dddd", raw, scaled, zs, ws);
+        }
+    }
+    for (int i = 0; i < got; i++) PyBuffer_Release(&v[i]);
+    PyErr_Clear();
+    if (result) return result;
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
-     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots): k LCPs by Lemke."},
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0): k LCPs by "
+     "Lemke."},
+    {"solve_eq", py_solve_eq, METH_VARARGS,
+     "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
+     "LCP by Lemke on its equilibrated data."},
+    {"lcp_measure", py_lcp_measure, METH_VARARGS,
+     "lcp_measure(M, q, z, w, rows) -> (residual, scaled, z_s, w_s) or None."},
     {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
     {"setup", py_setup, METH_VARARGS,

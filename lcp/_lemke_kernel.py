@@ -29,6 +29,10 @@ COMPILED = _lemke_c is not None
 _use = COMPILED and os.environ.get("RIGIDLCP_NO_KERNEL", "") in ("", "0")
 
 SOLVED, CYCLING, MAX_ITER, RAY = 0, 1, 2, 3
+#: Codes of `solve_eq` / `solve_batch(..., equilibrate=True)` besides those of the loop: M is
+#: not balanced (run lcp.scaling.ruiz and pass its factors), the equilibrated data are not
+#: finite (lemke() refuses them: leave it to the general path).
+NEEDS_RUIZ, NOT_FINITE = 4, 5
 
 
 def enabled() -> bool:
@@ -112,11 +116,37 @@ def plain_finite(M, q) -> tuple[bool, float]:
 
 
 def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_iter: int,
-                Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray) -> None:
+                Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray,
+                equilibrate: bool = False) -> None:
     """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
     z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
-    leaves a z; the others are to be solved again one by one for their evidence."""
-    _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots)
+    leaves a z; the others are to be solved again one by one for their evidence.
+    equilibrate: each problem on its equilibrated data, as `solve_eq` with r = c = None (code
+    NEEDS_RUIZ for a problem whose M is not balanced); z in the original units."""
+    _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots,
+                         int(bool(equilibrate)))
+
+
+def solve_eq(M: np.ndarray, q: np.ndarray, r: np.ndarray | None, c: np.ndarray | None,
+             tol: float, max_iter: int, z: np.ndarray, basis: np.ndarray
+             ) -> tuple[int, int, int, tuple[float, float, float]]:
+    """One LCP by Lemke (covering vector ones) on its Ruiz-equilibrated data, as `lcp.solve`
+    runs it by default (lcp.scaling.ruiz, then lemke(), then z mapped back), in one C call with
+    the same roundings: r = c = None when M is balanced (`ruiz` then only changes the unit of q,
+    done in C; code NEEDS_RUIZ otherwise), else the factors of `ruiz` (Eq. 1 of lcp.scaling:
+    M~ = diag(r) M diag(c), q~ = r q, z = c z~). M: n x n, q, r, c, z: n, C-contiguous float64;
+    basis: int64 of length n. Returns (code, pivots, m, (max|M|, max|q|, max|z|)): on SOLVED,
+    z holds the answer (0 when q~ >= 0, with no pivot) and basis[:m] the basic z's, sorted."""
+    return _lemke_c.solve_eq(M, q, r, c, None, float(tol), int(max_iter), z, basis)
+
+
+def measure(M: np.ndarray, q: np.ndarray, z: np.ndarray, w: np.ndarray, rows: np.ndarray
+            ) -> tuple[float, float, float, float] | None:
+    """The summation-free part of lcp.residual's measure in C: (max|min(z, w)|, scaled
+    residual, z_s, w_s) from w = M z + q and the row sums of |M| (both computed by numpy); None
+    when not compiled (or switched off), or when an input is not a finite float64 C-contiguous
+    array of the right size (the numpy code measures then)."""
+    return _lemke_c.lcp_measure(M, q, z, w, rows) if _use else None
 
 
 def solve_one(M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float, max_iter: int):

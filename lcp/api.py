@@ -129,6 +129,11 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
+    if (type(problem) is LCP and method == "lemke" and not options
+            and (equilibrate is None or equilibrate is True)):
+        sol = _fast_lemke()(problem)  # the same answer, when the first attempt is accepted
+        if sol is not None:
+            return sol
     friction = not isinstance(problem, (LCP, MLCP))
     if friction:  # imported only then: lcp.friction loads scipy.sparse
         from .friction import FrictionContact2D
@@ -162,6 +167,20 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     sol = solve_checked(run, method, on, bool(repair), options)
     sol.method = method
     return sol
+
+
+_FAST = None
+
+
+def _fast_lemke():
+    """lcp.fast_lemke.solve_lemke (imported on first use: it imports lemke, which imports this
+    module)."""
+    global _FAST
+    if _FAST is None:
+        from .fast_lemke import solve_lemke
+
+        _FAST = solve_lemke
+    return _FAST
 
 
 _LOADED = False

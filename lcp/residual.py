@@ -23,6 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import rigidlcp.lcp._lemke_kernel as _kernel
+
 #: Tolerance on the scaled residuals below which an answer is a solution (verify.certify's
 #: default `tol`).
 TOL = 1e-8
@@ -31,13 +33,17 @@ TOL = 1e-8
 def scales(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> tuple[float, float]:
     """(z_s, w_s): the solution scale max(|z|_inf, |q|_inf/|M|_max) and the w scale
     |q|_inf + ||M||_inf z_s (||.||_inf the max row sum of |M|)."""
+    return _scales(M, q, z, norm_inf(M))
+
+
+def _scales(M: np.ndarray, q: np.ndarray, z: np.ndarray, norm: float) -> tuple[float, float]:
     mmax = float(np.max(np.abs(M))) if M.size else 0.0
     qmax = float(np.max(np.abs(q))) if q.size else 0.0
     zmax = float(np.max(np.abs(z))) if z.size else 0.0
     zs = max(zmax, qmax / mmax if mmax > 0 else 0.0)
     if zs == 0.0:
         zs = 1.0  # z = 0, q = 0: any unit is as good
-    ws = qmax + norm_inf(M) * zs if M.size else qmax
+    ws = qmax + norm * zs if M.size else qmax
     return zs, (ws if ws > 0 else 1.0)  # M = 0 and q = 0: w = 0 exactly
 
 
@@ -53,6 +59,28 @@ def scaled_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
     zs, ws = scales(M, q, z)
     w = M @ z + q
     return float(np.max(np.abs(np.minimum(z / zs, w / ws))))
+
+
+def lcp_measure(M: np.ndarray, q: np.ndarray, z: np.ndarray
+                ) -> tuple[np.ndarray, float, float, float, float]:
+    """(w, max|min(z, w)|, scaled residual, z_s, w_s) of z on the LCP (M, q), w = M z + q: what
+    `check` measures on an LCP (`check` calls it), the scaled residual of the module docstring.
+
+    w and the row sums of |M| are computed by numpy; the rest (maxima, the scales, the minima)
+    involves no sum and is computed in C when the extension is built (lcp/_lemke_kernel.py's
+    `measure`: the same operations, hence the same numbers; tests/lcp/test_residual.py compares
+    the two), else by the numpy code below. No error state is set here: `check` ignores
+    overflow of a diverged z, and `lcp.solve`'s fast path calls it only where nothing can
+    overflow."""
+    w = M @ z + q
+    rows = np.add.reduce(np.abs(M), axis=1)  # np.sum(np.abs(M), axis=1), as norm_inf
+    got = _kernel.measure(M, q, z, w, rows) if z.size else None
+    if got is not None:
+        return (w, *got)
+    zs, ws = _scales(M, q, z, float(np.max(rows)) if M.size else 0.0)
+    scaled = float(np.max(np.abs(np.minimum(z / zs, w / ws)))) if z.size else 0.0
+    raw = float(np.max(np.abs(np.minimum(z, w)))) if z.size else 0.0
+    return w, raw, scaled, zs, ws
 
 
 @dataclass
@@ -88,31 +116,29 @@ def check(problem, z: np.ndarray, u: np.ndarray | None = None, tol: float = TOL,
 
 def _check(problem, z: np.ndarray, u, tol: float, lcp_form) -> Check:
     if hasattr(problem, "M"):  # an LCP
-        M, q = problem.M, problem.q
-        w = M @ z + q
-        zs, ws = scales(M, q, z)
-        eq = eq_scaled = 0.0
-    else:
-        if u is None:
-            u = problem.recover_u(z)
-        w, eq = problem.residuals(u, z)
-        eq_scale = (float(np.max(np.abs(problem.a)))
-                    + norm_inf(problem.A) * float(np.max(np.abs(u), initial=0.0))
-                    + norm_inf(problem.C) * float(np.max(np.abs(z), initial=0.0)))
-        eq_scaled = eq / eq_scale if eq_scale > 0 else eq
-        if lcp_form is None:
-            try:
-                lcp_form = problem.to_lcp()
-            except ValueError:  # NotApplicable: A singular, no Schur reduction
-                lcp_form = None
-        if lcp_form is not None:
-            zs, ws = scales(lcp_form.M, lcp_form.q, z)
-        else:  # no Schur reduction (A singular): the scales of the full system
-            un = float(np.max(np.abs(u), initial=0.0))
-            vn = float(np.max(np.abs(z), initial=0.0))
-            bn = float(np.max(np.abs(problem.b), initial=0.0))
-            zs = max(vn, bn / max(norm_inf(problem.B), 1e-300), 1e-300)
-            ws = max(bn + norm_inf(problem.D) * un + norm_inf(problem.B) * vn, 1e-300)
+        w, raw, scaled, zs, ws = lcp_measure(problem.M, problem.q, z)
+        return Check(w=w, residual=raw, scaled_residual=scaled, eq_residual=0.0,
+                     scaled_eq_residual=0.0, z_scale=zs, w_scale=ws, tol=tol, u=u)
+    if u is None:
+        u = problem.recover_u(z)
+    w, eq = problem.residuals(u, z)
+    eq_scale = (float(np.max(np.abs(problem.a)))
+                + norm_inf(problem.A) * float(np.max(np.abs(u), initial=0.0))
+                + norm_inf(problem.C) * float(np.max(np.abs(z), initial=0.0)))
+    eq_scaled = eq / eq_scale if eq_scale > 0 else eq
+    if lcp_form is None:
+        try:
+            lcp_form = problem.to_lcp()
+        except ValueError:  # NotApplicable: A singular, no Schur reduction
+            lcp_form = None
+    if lcp_form is not None:
+        zs, ws = scales(lcp_form.M, lcp_form.q, z)
+    else:  # no Schur reduction (A singular): the scales of the full system
+        un = float(np.max(np.abs(u), initial=0.0))
+        vn = float(np.max(np.abs(z), initial=0.0))
+        bn = float(np.max(np.abs(problem.b), initial=0.0))
+        zs = max(vn, bn / max(norm_inf(problem.B), 1e-300), 1e-300)
+        ws = max(bn + norm_inf(problem.D) * un + norm_inf(problem.B) * vn, 1e-300)
     scaled = float(np.max(np.abs(np.minimum(z / zs, w / ws)))) if z.size else 0.0
     raw = float(np.max(np.abs(np.minimum(z, w)))) if z.size else 0.0
     return Check(w=w, residual=raw, scaled_residual=scaled, eq_residual=float(eq),

@@ -1,0 +1,79 @@
+"""The fast path of `lcp.solve` for its most common call: `solve(problem)` or
+`solve(problem, "lemke")` on an `lcp.LCP`, default options, the compiled kernel built.
+
+The general path (lcp.api.solve -> lcp.trust.solve_checked) runs, for such a call,
+
+    eq = ruiz(M, q)                    lcp.scaling: Ruiz equilibration (lemke's default)
+    sol = lemke(eq.M, eq.q)            the pivots, in C (lcp/_lemke_c.c)
+    z = eq.z_back(sol.z)               the user's units
+    check(problem, z).accepted         lcp.residual: the one acceptance test
+
+and returns the answer when it is "solved" and accepted. `solve_lemke` does these same steps
+with the same roundings, but the first three in one C call (`_lemke_kernel.solve_eq`: the
+equilibration of a balanced M -- `ruiz` then makes no sweep and only changes the unit of q --
+is done there; otherwise `ruiz` runs in numpy and its factors are passed), and the check by
+`lcp.residual.lcp_measure`, the function `check` itself uses on an LCP. So it returns the same
+Solution (z, w, pivots, basis, residuals, message, info) as the general path, bit for bit
+(tests/lcp/test_fast_lemke.py), and None in every other case -- data that are not plain finite
+float64 arrays, a ray, a pivot limit, a cycle, an answer that fails the acceptance test, or
+numbers large enough for the check to overflow -- where the caller then runs the general path
+from the start (which raises the same typed errors, repairs, proves infeasibility).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+import rigidlcp.lcp._lemke_kernel as _kernel
+
+from . import api
+from .lemke import DEFAULT_TOL
+from .lemke import lemke as _lemke
+from .residual import TOL, lcp_measure
+from .scaling import ruiz
+from .solution import Solution
+
+_Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it gives it
+#: Above this bound on |M z + q| and the row sums of |M|, numpy's part of the check could
+#: overflow (and warn): the general path measures under np.errstate instead.
+_SAFE = 1e300
+
+
+def applies() -> bool:
+    """Is "lemke" the built-in method, equilibrated by default, with the compiled kernel on?"""
+    info = api._REGISTRY.get("lemke")
+    return (info is not None and info.func is _lemke and info.equilibrate
+            and _kernel.enabled())
+
+
+def solve_lemke(problem) -> Solution | None:
+    """`lcp.solve(problem, "lemke")` for an lcp.LCP when its first attempt is accepted (the
+    Solution the general path would return), else None (see the module docstring)."""
+    M, q = problem.M, problem.q
+    if not (applies() and type(M) is np.ndarray and type(q) is np.ndarray
+            and M.dtype == np.float64 and q.dtype == np.float64 and q.ndim == 1
+            and M.shape == (q.size, q.size) and q.size and M.flags.c_contiguous
+            and q.flags.c_contiguous):
+        return None
+    n = q.size
+    z = np.empty(n)
+    basis = np.empty(n, dtype=np.intp)
+    max_iter = 1000 + 100 * n  # lemke()'s default
+    try:
+        code, pivots, m, bounds = _kernel.solve_eq(M, q, None, None, DEFAULT_TOL, max_iter,
+                                                   z, basis)
+        if code == _kernel.NEEDS_RUIZ:
+            eq = ruiz(M, q)
+            code, pivots, m, bounds = _kernel.solve_eq(M, q, eq.r, eq.c, DEFAULT_TOL,
+                                                       max_iter, z, basis)
+    except (ValueError, BufferError):  # e.g. read-only arrays: the general path copes
+        return None
+    mmax, qmax, zmax = bounds
+    if code != _kernel.SOLVED or not n * mmax * (zmax + 1.0) + qmax < _SAFE:
+        return None
+    w, raw, scaled, _, _ = lcp_measure(M, q, z)
+    if not scaled <= TOL:  # lcp.residual.Check.accepted, with no equality part
+        return None
+    return Solution(z=z, w=w, status="solved", method="lemke", iterations=pivots, residual=raw,
+                    eq_residual=0.0, scaled_residual=scaled, basis=basis[:m].copy(),
+                    message="" if pivots else _Q_NONNEGATIVE, info={"equilibrated": True})
