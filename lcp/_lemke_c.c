@@ -278,7 +278,9 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
     uint64_t seed = 0x5EEDULL, *keys = (uint64_t *)malloc((2 * n + 1) * sizeof(uint64_t));
     HashSet seen;
     if (!keys) return -1;
-    if (hs_init(&seen, 1024) < 0) {
+    size_t cap = 64; /* grows as needed: start small, a small problem takes few pivots */
+    while (cap < 1024 && cap < (size_t)(8 * n)) cap *= 2;
+    if (hs_init(&seen, cap) < 0) {
         free(keys);
         return -1;
     }
@@ -736,37 +738,38 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     return 0;
 }
 
-/* Scratch of one problem of size n: T, the int64 bookkeeping and the Lemke buffers. */
+/* Scratch of one problem of size n: T, the int64 bookkeeping and the Lemke buffers, in one
+ * block: `stack` (of STACK_WORDS 8-byte words) when it is large enough, else malloc'd. */
 typedef struct {
     Lemke L;
     double *T;
     int64_t *ints;
     int8_t *bz;
+    void *heap;
 } Work;
 
-static void work_free(Work *w)
-{
-    free(w->T);
-    free(w->ints);
-    free(w->bz);
-    free(w->L.rows);
-    free(w->L.alpha);
-    free(w->L.V);
-}
+#define STACK_WORDS 2048 /* 16 kB: enough for n <= 28 */
 
-static int work_init(Work *w, idx n, double tol)
+static void work_free(Work *w) { free(w->heap); }
+
+static int work_init(Work *w, idx n, double tol, uint64_t *stack)
 {
     Lemke *L = &w->L;
-    w->T = (double *)malloc((size_t)n * (n + 2) * sizeof(double));
-    w->ints = (int64_t *)malloc((6 * n + 3) * sizeof(int64_t));
-    w->bz = (int8_t *)malloc(n);
-    L->rows = (idx *)malloc(4 * n * sizeof(idx));
-    L->alpha = (double *)malloc((4 * n + 2) * sizeof(double));
-    L->V = (double *)malloc((size_t)n * n * sizeof(double));
-    if (!(w->T && w->ints && w->bz && L->rows && L->alpha && L->V)) {
-        work_free(w);
-        return -1;
+    /* T n(n + 2), V n n, alpha 4n + 2, ints 6n + 3, rows 4n, bz n bytes: all 8-byte words */
+    size_t words = (size_t)n * (n + 2) + (size_t)n * n + (4 * n + 2) + (6 * n + 3) + 4 * n +
+                   (n + 7) / 8;
+    uint64_t *block = stack;
+    w->heap = NULL;
+    if (!stack || words > STACK_WORDS) {
+        block = w->heap = malloc(words * 8);
+        if (!block) return -1;
     }
+    w->T = (double *)block;
+    L->V = w->T + n * (n + 2);
+    L->alpha = L->V + n * n;
+    w->ints = (int64_t *)(L->alpha + 4 * n + 2);
+    L->rows = (idx *)(w->ints + 6 * n + 3);
+    w->bz = (int8_t *)(L->rows + 4 * n);
     L->n = n;
     L->T = w->T;
     L->tol = tol;
@@ -834,7 +837,8 @@ static PyObject *py_solve_eq(PyObject *self, PyObject *args)
     if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
     Work w;
-    if (work_init(&w, n, tol) < 0) {
+    uint64_t stack[STACK_WORDS];
+    if (work_init(&w, n, tol, stack) < 0) {
         PyErr_NoMemory();
         goto done;
     }
@@ -903,7 +907,7 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         goto b7;
     }
     Work w;
-    int failed = work_init(&w, n, tol) < 0;
+    int failed = work_init(&w, n, tol, NULL) < 0;
     if (!failed) {
         const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
                      *d = (const double *)vd.buf;
@@ -953,29 +957,82 @@ b1:
 }
 
 /* ------------------------------------------------------------------ the acceptance measure */
-/* lcp_measure(M, q, z, w, rows) -> (residual, scaled residual, z_s, w_s), or None: the part of
- * lcp/residual.py's `lcp_measure` that needs no summation, for w = M z + q and rows = the row
- * sums of |M| computed by numpy (their rounding is numpy's). Every operation is the one the
- * numpy code does, on finite numbers (max, |.|, min, one division and one product and sum each:
- * the same roundings, no fused multiply-add: setup.py builds with -ffp-contract=off). None when
- * an input is not a finite float64 array of the right length or a scale is not finite: the
- * numpy code then measures. */
+/* sum_j |a_j| in numpy's order: its pairwise summation (numpy's `pairwise_sum`, used by
+ * np.add.reduce over a contiguous axis, started from the identity 0): a plain loop below 8
+ * terms, eight interleaved partial sums up to 128, halves (at a multiple of 8) above. The
+ * Python side checks once, on a probe, that numpy sums so (lcp/_lemke_kernel.py). */
+static double pairwise_abs(const double *a, idx n)
+{
+#define ABS(x) ((x) < 0 ? -(x) : (x))
+    if (n < 8) {
+        double res = 0.0;
+        for (idx i = 0; i < n; i++) res += ABS(a[i]);
+        return res;
+    }
+    if (n <= 128) {
+        double r[8];
+        for (int j = 0; j < 8; j++) r[j] = ABS(a[j]);
+        idx i;
+        for (i = 8; i < n - (n % 8); i += 8)
+            for (int j = 0; j < 8; j++) r[j] += ABS(a[i + j]);
+        double res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
+        for (; i < n; i++) res += ABS(a[i]);
+        return res;
+    }
+    idx n2 = n / 2;
+    n2 -= n2 % 8;
+    return pairwise_abs(a, n2) + pairwise_abs(a + n2, n - n2);
+#undef ABS
+}
+
+/* abs_row_sums(M, out): out[i] = 0 + sum_j |M_ij| summed as numpy's np.add.reduce(np.abs(M),
+ * axis=1) (M m x n C-contiguous float64, out m float64): the probe of lcp/_lemke_kernel.py. */
+static PyObject *py_abs_row_sums(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oout;
+    idx n;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOn", &oM, &oout, &n)) return NULL;
+    idx m = PyObject_Length(oout);
+    if (m < 1 || n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "empty");
+        return NULL;
+    }
+    Py_buffer vM, vo;
+    if (get_buffer(oout, &vo, "out", 'd', m, 0) < 0) return NULL;
+    if (get_buffer(oM, &vM, "M", 'd', m * n, 0) < 0) {
+        PyBuffer_Release(&vo);
+        return NULL;
+    }
+    for (idx i = 0; i < m; i++)
+        ((double *)vo.buf)[i] = 0.0 + pairwise_abs((const double *)vM.buf + i * n, n);
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vo);
+    Py_RETURN_NONE;
+}
+
+/* lcp_measure(M, q, z, Mz) -> (residual, scaled residual, z_s, w_s), or None: lcp/residual.py's
+ * `lcp_measure` after numpy's M.dot(z): w = Mz + q (written into Mz), the row sums of |M| in
+ * numpy's order, and the rest -- maxima, the scales, the minima -- by the operations the numpy
+ * code does, on finite numbers (the same roundings; no fused multiply-add: setup.py builds with
+ * -ffp-contract=off). None, with Mz untouched, when an input is not a float64 C-contiguous
+ * array of the right length or a number is not finite: the numpy code measures then. */
 static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
 {
-    PyObject *oM, *oq, *oz, *ow, *orows;
+    PyObject *objs[4];
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOO", &oM, &oq, &oz, &ow, &orows)) return NULL;
-    idx n = PyObject_Length(oq);
+    if (!PyArg_ParseTuple(args, "OOOO", &objs[0], &objs[1], &objs[2], &objs[3])) return NULL;
+    idx n = PyObject_Length(objs[1]);
     if (n < 1) {
         PyErr_Clear();
         Py_RETURN_NONE;
     }
-    Py_buffer v[5];
-    PyObject *objs[5] = {oM, oq, oz, ow, orows};
-    idx sizes[5] = {n * n, n, n, n, n};
+    Py_buffer v[4];
+    idx sizes[4] = {n * n, n, n, n};
     int got = 0;
-    for (; got < 5; got++) {
-        if (PyObject_GetBuffer(objs[got], &v[got], PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) break;
+    for (; got < 4; got++) {
+        int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS | (got == 3 ? PyBUF_WRITABLE : 0);
+        if (PyObject_GetBuffer(objs[got], &v[got], flags) < 0) break;
         const char *f = v[got].format ? v[got].format : "B";
         if (*f == '<' || *f == '=' || *f == '@') f++;
         if (v[got].itemsize != 8 || f[0] != 'd' || f[1] != 0 || v[got].len / 8 != sizes[got]) {
@@ -984,25 +1041,27 @@ static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
         }
     }
     PyObject *result = NULL;
-    if (got == 5) {
+    if (got == 4) {
         const double *M = (const double *)v[0].buf, *q = (const double *)v[1].buf,
-                     *z = (const double *)v[2].buf, *w = (const double *)v[3].buf,
-                     *rows = (const double *)v[4].buf;
+                     *z = (const double *)v[2].buf;
+        double *w = (double *)v[3].buf; /* M z on entry, M z + q on success */
         double acc = 0.0, mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
-        for (idx k = 0; k < n * n; k++) {
-            double a = M[k] < 0 ? -M[k] : M[k];
-            acc += a - a;
-            if (a > mmax) mmax = a;
-        }
         for (idx i = 0; i < n; i++) {
-            double aq = q[i] < 0 ? -q[i] : q[i], az = z[i] < 0 ? -z[i] : z[i];
-            acc += (aq - aq) + (az - az) + (w[i] - w[i]) + (rows[i] - rows[i]);
+            const double *Mi = M + i * n;
+            for (idx j = 0; j < n; j++) {
+                double a = Mi[j] < 0 ? -Mi[j] : Mi[j];
+                acc += a - a;
+                if (a > mmax) mmax = a;
+            }
+            double row = 0.0 + pairwise_abs(Mi, n);
+            if (row > norm) norm = row;
+            double aq = q[i] < 0 ? -q[i] : q[i], az = z[i] < 0 ? -z[i] : z[i], wi = w[i] + q[i];
+            acc += (aq - aq) + (az - az) + (wi - wi) + (row - row);
             if (aq > qmax) qmax = aq;
             if (az > zmax) zmax = az;
-            if (rows[i] > norm) norm = rows[i];
         }
-        /* residual.py: zs = max(zmax, qmax / mmax if mmax > 0 else 0.0); 1 if 0;
-         * ws = qmax + norm_inf(M) * zs; 1 if not > 0 */
+        /* residual.py: zs = max(zmax, qmax / mmax if mmax > 0 else 0.0), 1 if 0;
+         * ws = qmax + norm_inf(M) * zs, 1 if not > 0 */
         double ratio = mmax > 0 ? qmax / mmax : 0.0;
         double zs = ratio > zmax ? ratio : zmax;
         if (zs == 0.0) zs = 1.0;
@@ -1013,10 +1072,12 @@ static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
         if (acc == 0.0) {
             double scaled = 0.0, raw = 0.0;
             for (idx i = 0; i < n; i++) {
-                double a = z[i] / zs, b = w[i] / ws, m = a < b ? a : b;
+                double wi = w[i] + q[i];
+                w[i] = wi;
+                double a = z[i] / zs, b = wi / ws, m = a < b ? a : b;
                 m = m < 0 ? -m : m;
                 if (m > scaled) scaled = m;
-                double m2 = z[i] < w[i] ? z[i] : w[i];
+                double m2 = z[i] < wi ? z[i] : wi;
                 m2 = m2 < 0 ? -m2 : m2;
                 if (m2 > raw) raw = m2;
             }
@@ -1037,7 +1098,9 @@ static PyMethodDef methods[] = {
      "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
      "LCP by Lemke on its equilibrated data."},
     {"lcp_measure", py_lcp_measure, METH_VARARGS,
-     "lcp_measure(M, q, z, w, rows) -> (residual, scaled, z_s, w_s) or None."},
+     "lcp_measure(M, q, z, Mz) -> (residual, scaled, z_s, w_s) or None; Mz becomes M z + q."},
+    {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
+     "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
     {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
     {"setup", py_setup, METH_VARARGS,

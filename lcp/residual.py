@@ -66,17 +66,18 @@ def lcp_measure(M: np.ndarray, q: np.ndarray, z: np.ndarray
     """(w, max|min(z, w)|, scaled residual, z_s, w_s) of z on the LCP (M, q), w = M z + q: what
     `check` measures on an LCP (`check` calls it), the scaled residual of the module docstring.
 
-    w and the row sums of |M| are computed by numpy; the rest (maxima, the scales, the minima)
-    involves no sum and is computed in C when the extension is built (lcp/_lemke_kernel.py's
-    `measure`: the same operations, hence the same numbers; tests/lcp/test_residual.py compares
-    the two), else by the numpy code below. No error state is set here: `check` ignores
-    overflow of a diverged z, and `lcp.solve`'s fast path calls it only where nothing can
-    overflow."""
-    w = M @ z + q
-    rows = np.add.reduce(np.abs(M), axis=1)  # np.sum(np.abs(M), axis=1), as norm_inf
-    got = _kernel.measure(M, q, z, w, rows) if z.size else None
-    if got is not None:
+    M z is computed by numpy (BLAS); the rest -- w = M z + q, the row sums of |M| (summed in
+    numpy's order), maxima, scales and minima -- in C when the extension is built
+    (lcp/_lemke_kernel.py's `measure`: the same operations in the same order, hence the same
+    numbers; tests/lcp/test_fast_lemke.py compares the two), else by the numpy code below. No
+    error state is set here: `check` ignores overflow of a diverged z, and `lcp.solve`'s fast
+    path calls it only where nothing can overflow."""
+    w = M.dot(z)  # M @ z: the same BLAS call (gemv)
+    got = _kernel.measure(M, q, z, w) if z.size else None
+    if got is not None:  # w is now M z + q
         return (w, *got)
+    w = w + q
+    rows = np.add.reduce(np.abs(M), axis=1)  # np.sum(np.abs(M), axis=1), as norm_inf
     zs, ws = _scales(M, q, z, float(np.max(rows)) if M.size else 0.0)
     scaled = float(np.max(np.abs(np.minimum(z / zs, w / ws)))) if z.size else 0.0
     raw = float(np.max(np.abs(np.minimum(z, w)))) if z.size else 0.0
