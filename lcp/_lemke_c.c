@@ -18,6 +18,8 @@
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <float.h>
+#include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -327,8 +329,7 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
         s = (idx)L->slot_of[entering];
         const double *a = T + n * s;
         double amin = a[0];
-        for (idx i = 1; i < n; i++)
-            if (a[i] < amin) amin = a[i];
+        for (idx i = 1; i < n; i++) amin = a[i] < amin ? a[i] : amin; /* minsd: no branch */
         amax = -amin;
         double thr = amax > 1.0 ? L->tol * amax : L->tol;
         if (amax <= thr) {
@@ -594,30 +595,32 @@ static double pow2_near(double x)
 static int balanced_units(idx n, const double *M, const double *q, double *colmax, double *rs,
                           double *cs)
 {
-    double top = 0.0, rmin = 1.0 / 0.0, acc = 0.0;
+    /* Branch-free maxima (x > m ? x : m) and finiteness test (|x| <= DBL_MAX is false for
+     * inf and NaN): random data would defeat the branch predictor. */
+    double top = 0.0, rmin = DBL_MAX;
+    int finite = 1;
     for (idx j = 0; j < n; j++) colmax[j] = 0.0;
     for (idx i = 0; i < n; i++) {
         const double *Mi = M + i * n;
         double rm = 0.0;
         for (idx j = 0; j < n; j++) {
-            double a = Mi[j] < 0 ? -Mi[j] : Mi[j];
-            acc += a - a;
-            if (a > rm) rm = a;
-            if (a > colmax[j]) colmax[j] = a;
+            double a = fabs(Mi[j]), cm = colmax[j];
+            finite &= a <= DBL_MAX;
+            rm = a > rm ? a : rm;
+            colmax[j] = a > cm ? a : cm;
         }
-        if (rm > top) top = rm;
-        if (rm < rmin) rmin = rm;
+        top = rm > top ? rm : top;
+        rmin = rm < rmin ? rm : rmin;
     }
     double qmax = 0.0;
     for (idx i = 0; i < n; i++) {
-        double a = q[i] < 0 ? -q[i] : q[i];
-        acc += a - a;
-        if (a > qmax) qmax = a;
+        double a = fabs(q[i]);
+        finite &= a <= DBL_MAX;
+        qmax = a > qmax ? a : qmax;
     }
-    if (acc != 0.0) return NOT_FINITE; /* NaN: some entry is not finite */
-    double cmin = 1.0 / 0.0;
-    for (idx j = 0; j < n; j++)
-        if (colmax[j] < cmin) cmin = colmax[j];
+    if (!finite) return NOT_FINITE;
+    double cmin = DBL_MAX;
+    for (idx j = 0; j < n; j++) cmin = colmax[j] < cmin ? colmax[j] : cmin;
     if (!(top > 0 && rmin >= top / BALANCED && cmin >= top / BALANCED)) return NEEDS_RUIZ;
     *rs = *cs = 1.0;
     if (qmax > 0) {
@@ -640,28 +643,29 @@ typedef struct {
 static int fill_scaled(idx n, double *T, const double *M, const double *q, const double *d,
                        const double *r, const double *c, double rs, double cs, Scales *S)
 {
-    double mu = 0.0, nu = 0.0, acc = 0.0, mmax = 0.0, qmax = 0.0, qmin = 1.0 / 0.0;
+    double mu = 0.0, nu = 0.0, mmax = 0.0, qmax = 0.0, qmin = DBL_MAX;
+    int finite = 1; /* branch-free, as in balanced_units */
     for (idx i = 0; i < n; i++) {
         double ri = r ? r[i] : rs;
         const double *Mi = M + i * n;
         for (idx j = 0; j < n; j++) {
             double m = Mi[j], v = (m * ri) * (c ? c[j] : cs);
-            double a = v < 0 ? -v : v, am = m < 0 ? -m : m;
-            acc += a - a;
-            if (a > mu) mu = a;
-            if (am > mmax) mmax = am;
+            double a = fabs(v), am = fabs(m);
+            finite &= a <= DBL_MAX;
+            mu = a > mu ? a : mu;
+            mmax = am > mmax ? am : mmax;
             T[i + n * j] = v;
         }
     }
     for (idx i = 0; i < n; i++) {
-        double v = q[i] * (r ? r[i] : rs), a = v < 0 ? -v : v, aq = q[i] < 0 ? -q[i] : q[i];
-        acc += a - a;
-        if (a > nu) nu = a;
-        if (v < qmin) qmin = v;
-        if (aq > qmax) qmax = aq;
+        double v = q[i] * (r ? r[i] : rs), a = fabs(v), aq = fabs(q[i]);
+        finite &= a <= DBL_MAX;
+        nu = a > nu ? a : nu;
+        qmin = v < qmin ? v : qmin;
+        qmax = aq > qmax ? aq : qmax;
         T[i + n * (n + 1)] = v;
     }
-    if (acc != 0.0) return NOT_FINITE;
+    if (!finite) return NOT_FINITE;
     if (mu == 0.0) mu = 1.0;
     double delta = -1.0 / 0.0;
     for (idx i = 0; i < n; i++) {
@@ -963,7 +967,7 @@ b1:
  * Python side checks once, on a probe, that numpy sums so (lcp/_lemke_kernel.py). */
 static double pairwise_abs(const double *a, idx n)
 {
-#define ABS(x) ((x) < 0 ? -(x) : (x))
+#define ABS(x) fabs(x)
     if (n < 8) {
         double res = 0.0;
         for (idx i = 0; i < n; i++) res += ABS(a[i]);
@@ -1017,6 +1021,81 @@ static PyObject *py_abs_row_sums(PyObject *self, PyObject *args)
  * code does, on finite numbers (the same roundings; no fused multiply-add: setup.py builds with
  * -ffp-contract=off). None, with Mz untouched, when an input is not a float64 C-contiguous
  * array of the right length or a number is not finite: the numpy code measures then. */
+/* One LCP's measure (see lcp_measure below): 0 and w = Mz + q written, or -1 (nothing written)
+ * when a number is not finite. */
+static int measure_one(idx n, const double *M, const double *q, const double *z, double *w,
+                       double out[4])
+{
+    double mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
+    int finite = 1; /* branch-free maxima and finiteness test, as in balanced_units */
+    for (idx i = 0; i < n; i++) {
+        const double *Mi = M + i * n;
+        for (idx j = 0; j < n; j++) {
+            double a = fabs(Mi[j]);
+            finite &= a <= DBL_MAX;
+            mmax = a > mmax ? a : mmax;
+        }
+        double row = 0.0 + pairwise_abs(Mi, n);
+        norm = row > norm ? row : norm;
+        double aq = fabs(q[i]), az = fabs(z[i]), wi = fabs(w[i] + q[i]);
+        finite &= (aq <= DBL_MAX) & (az <= DBL_MAX) & (wi <= DBL_MAX) & (row <= DBL_MAX);
+        qmax = aq > qmax ? aq : qmax;
+        zmax = az > zmax ? az : zmax;
+    }
+    /* residual.py: zs = max(zmax, qmax / mmax if mmax > 0 else 0.0), 1 if 0;
+     * ws = qmax + norm_inf(M) * zs, 1 if not > 0 */
+    double ratio = mmax > 0 ? qmax / mmax : 0.0;
+    double zs = ratio > zmax ? ratio : zmax;
+    if (zs == 0.0) zs = 1.0;
+    double prod = norm * zs;
+    double ws = qmax + prod;
+    if (!(ws > 0)) ws = 1.0;
+    if (!(finite && zs <= DBL_MAX && ws <= DBL_MAX)) return -1;
+    double scaled = 0.0, raw = 0.0;
+    for (idx i = 0; i < n; i++) {
+        double wi = w[i] + q[i];
+        w[i] = wi;
+        double a = z[i] / zs, b = wi / ws, m = fabs(a < b ? a : b);
+        scaled = m > scaled ? m : scaled;
+        double m2 = fabs(z[i] < wi ? z[i] : wi);
+        raw = m2 > raw ? m2 : raw;
+    }
+    out[0] = raw;
+    out[1] = scaled;
+    out[2] = zs;
+    out[3] = ws;
+    return 0;
+}
+
+/* float64 C-contiguous buffers of the given sizes (objs[i], writable where asked), all or none:
+ * the number acquired (< count: some failed, those released, no error set). */
+static int get_doubles(PyObject **objs, Py_buffer *v, const idx *sizes, const int *writable,
+                       int count)
+{
+    for (int i = 0; i < count; i++) {
+        int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS | (writable[i] ? PyBUF_WRITABLE : 0);
+        int ok = PyObject_GetBuffer(objs[i], &v[i], flags) == 0;
+        if (ok) {
+            const char *f = v[i].format ? v[i].format : "B";
+            if (*f == '<' || *f == '=' || *f == '@') f++;
+            ok = v[i].itemsize == 8 && f[0] == 'd' && f[1] == 0 && v[i].len / 8 == sizes[i];
+            if (!ok) PyBuffer_Release(&v[i]);
+        }
+        if (!ok) {
+            for (int j = 0; j < i; j++) PyBuffer_Release(&v[j]);
+            PyErr_Clear();
+            return i;
+        }
+    }
+    return count;
+}
+
+/* lcp_measure(M, q, z, Mz) -> (residual, scaled residual, z_s, w_s), or None: lcp/residual.py's
+ * `lcp_measure` after numpy's M.dot(z): w = Mz + q (written into Mz), the row sums of |M| in
+ * numpy's order, and the rest -- maxima, the scales, the minima -- by the operations the numpy
+ * code does, on finite numbers (the same roundings; no fused multiply-add: setup.py builds with
+ * -ffp-contract=off). None, with Mz untouched, when an input is not a float64 C-contiguous
+ * array of the right length or a number is not finite: the numpy code measures then. */
 static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
 {
     PyObject *objs[4];
@@ -1029,65 +1108,45 @@ static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
     }
     Py_buffer v[4];
     idx sizes[4] = {n * n, n, n, n};
-    int got = 0;
-    for (; got < 4; got++) {
-        int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS | (got == 3 ? PyBUF_WRITABLE : 0);
-        if (PyObject_GetBuffer(objs[got], &v[got], flags) < 0) break;
-        const char *f = v[got].format ? v[got].format : "B";
-        if (*f == '<' || *f == '=' || *f == '@') f++;
-        if (v[got].itemsize != 8 || f[0] != 'd' || f[1] != 0 || v[got].len / 8 != sizes[got]) {
-            PyBuffer_Release(&v[got]);
-            break;
-        }
+    int writable[4] = {0, 0, 0, 1};
+    if (get_doubles(objs, v, sizes, writable, 4) < 4) Py_RETURN_NONE;
+    double out[4];
+    int ok = measure_one(n, (const double *)v[0].buf, (const double *)v[1].buf,
+                         (const double *)v[2].buf, (double *)v[3].buf, out) == 0;
+    for (int i = 0; i < 4; i++) PyBuffer_Release(&v[i]);
+    if (!ok) Py_RETURN_NONE;
+    return Py_BuildValue("dddd", out[0], out[1], out[2], out[3]);
+}
+
+/* lcp_measure_batch(Ms, qs, Z, MZ, out) -> bool: `lcp_measure` of k problems (Ms k n n, qs, Z,
+ * MZ k n, out k 4 float64, C-contiguous): row p of out receives (residual, scaled, z_s, w_s)
+ * and MZ[p] becomes w = M z + q, or out[p] is NaN (MZ[p] untouched) when a number is not
+ * finite. False when the arrays are not as described. */
+static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
+{
+    PyObject *objs[5];
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
+        return NULL;
+    idx k = PyObject_Length(objs[1]), n = 0;
+    Py_buffer vz;
+    if (k >= 1 && PyObject_GetBuffer(objs[2], &vz, PyBUF_ND) == 0) {
+        if (vz.ndim == 2) n = vz.shape[1];
+        PyBuffer_Release(&vz);
     }
-    PyObject *result = NULL;
-    if (got == 4) {
-        const double *M = (const double *)v[0].buf, *q = (const double *)v[1].buf,
-                     *z = (const double *)v[2].buf;
-        double *w = (double *)v[3].buf; /* M z on entry, M z + q on success */
-        double acc = 0.0, mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
-        for (idx i = 0; i < n; i++) {
-            const double *Mi = M + i * n;
-            for (idx j = 0; j < n; j++) {
-                double a = Mi[j] < 0 ? -Mi[j] : Mi[j];
-                acc += a - a;
-                if (a > mmax) mmax = a;
-            }
-            double row = 0.0 + pairwise_abs(Mi, n);
-            if (row > norm) norm = row;
-            double aq = q[i] < 0 ? -q[i] : q[i], az = z[i] < 0 ? -z[i] : z[i], wi = w[i] + q[i];
-            acc += (aq - aq) + (az - az) + (wi - wi) + (row - row);
-            if (aq > qmax) qmax = aq;
-            if (az > zmax) zmax = az;
-        }
-        /* residual.py: zs = max(zmax, qmax / mmax if mmax > 0 else 0.0), 1 if 0;
-         * ws = qmax + norm_inf(M) * zs, 1 if not > 0 */
-        double ratio = mmax > 0 ? qmax / mmax : 0.0;
-        double zs = ratio > zmax ? ratio : zmax;
-        if (zs == 0.0) zs = 1.0;
-        double prod = norm * zs;
-        double ws = qmax + prod;
-        if (!(ws > 0)) ws = 1.0;
-        acc += (zs - zs) + (ws - ws);
-        if (acc == 0.0) {
-            double scaled = 0.0, raw = 0.0;
-            for (idx i = 0; i < n; i++) {
-                double wi = w[i] + q[i];
-                w[i] = wi;
-                double a = z[i] / zs, b = wi / ws, m = a < b ? a : b;
-                m = m < 0 ? -m : m;
-                if (m > scaled) scaled = m;
-                double m2 = z[i] < wi ? z[i] : wi;
-                m2 = m2 < 0 ? -m2 : m2;
-                if (m2 > raw) raw = m2;
-            }
-            result = Py_BuildValue("dddd", raw, scaled, zs, ws);
-        }
-    }
-    for (int i = 0; i < got; i++) PyBuffer_Release(&v[i]);
     PyErr_Clear();
-    if (result) return result;
-    Py_RETURN_NONE;
+    Py_buffer v[5];
+    idx sizes[5] = {k * n * n, k * n, k * n, k * n, 4 * k};
+    int writable[5] = {0, 0, 0, 1, 1};
+    if (n < 1 || get_doubles(objs, v, sizes, writable, 5) < 5) Py_RETURN_FALSE;
+    const double *Ms = (const double *)v[0].buf, *qs = (const double *)v[1].buf,
+                 *Z = (const double *)v[2].buf;
+    double *W = (double *)v[3].buf, *out = (double *)v[4].buf;
+    for (idx p = 0; p < k; p++)
+        if (measure_one(n, Ms + p * n * n, qs + p * n, Z + p * n, W + p * n, out + 4 * p) < 0)
+            for (int j = 0; j < 4; j++) out[4 * p + j] = 0.0 / 0.0;
+    for (int i = 0; i < 5; i++) PyBuffer_Release(&v[i]);
+    Py_RETURN_TRUE;
 }
 
 static PyMethodDef methods[] = {
@@ -1099,6 +1158,8 @@ static PyMethodDef methods[] = {
      "LCP by Lemke on its equilibrated data."},
     {"lcp_measure", py_lcp_measure, METH_VARARGS,
      "lcp_measure(M, q, z, Mz) -> (residual, scaled, z_s, w_s) or None; Mz becomes M z + q."},
+    {"lcp_measure_batch", py_lcp_measure_batch, METH_VARARGS,
+     "lcp_measure_batch(Ms, qs, Z, MZ, out) -> bool: lcp_measure of k problems."},
     {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
      "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
     {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},

@@ -152,6 +152,17 @@ def measure(M: np.ndarray, q: np.ndarray, z: np.ndarray, Mz: np.ndarray
     return _lemke_c.lcp_measure(M, q, z, Mz)
 
 
+def measure_batch(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, MZ: np.ndarray
+                  ) -> np.ndarray | None:
+    """`measure` of k problems at once (Ms: k x n x n, qs, Z, MZ: k x n): a k x 4 array of
+    (residual, scaled residual, z_s, w_s), NaN in the rows of problems not measured (MZ[p]
+    untouched there; the others become w = M z + q); None where `measure` gives None for all."""
+    if not _use or not (_sums_ok if _sums_ok is not None else sums_as_numpy()):
+        return None
+    out = np.empty((qs.shape[0], 4))
+    return out if _lemke_c.lcp_measure_batch(Ms, qs, Z, MZ, out) else None
+
+
 _sums_ok: bool | None = None
 
 

@@ -24,7 +24,7 @@ import rigidlcp.lcp._lemke_kernel as _kernel
 
 from .api import check_options, get_method, solve
 from .problem import LCP, MLCP, InvalidProblem
-from .solution import Solution
+from .solution import Solution, solved_lcp
 
 
 def solve_many(
@@ -55,13 +55,16 @@ def solve_many(
     out: list[Solution | None] = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
-        if not isinstance(p, LCP):  # MLCP (u, reductions) or friction problem: one by one
+        if not isinstance(p, LCP) or not p.M.flags.c_contiguous:
+            # MLCP (u, reductions), friction problem, or an M in Fortran order (numpy's M z
+            # rounds otherwise than on the stacked C-ordered copy): one by one
             out[i] = solve(p, method, **options)
         else:
-            groups.setdefault(p.n, []).append(i)
+            groups.setdefault(p.q.size, []).append(i)
     for idx in groups.values():  # LCPs are validated at construction: stack them as they are
-        Ms = np.stack([problems[i].M for i in idx])
-        qs = np.stack([problems[i].q for i in idx])
+        n = problems[idx[0]].q.size
+        Ms = np.concatenate([problems[i].M for i in idx]).reshape(len(idx), n, n)
+        qs = np.concatenate([problems[i].q for i in idx]).reshape(len(idx), n)
         sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]])
         for i, sol in zip(idx, sols):
             out[i] = sol
@@ -97,24 +100,20 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     from .scaling import ruiz
 
     k, n = qs.shape
-    on = get_method(method).equilibrate
+    info = get_method(method)
+    on = info.equilibrate
+    if method == "lemke" and k and _kernel.enabled() and info.func is _builtin_lemke():
+        return _lemke_batch(Ms, qs, on, options, problem_of)
     eqs = [ruiz(Ms[i], qs[i]) for i in range(k)] if on else None
     Mr = np.stack([e.M for e in eqs]) if eqs else Ms
     qr = np.stack([e.q for e in eqs]) if eqs else qs
-    if method == "lemke" and _kernel.enabled() and k:
-        sols = _lemke_batch(Mr, qr, options, problem_of)
-    else:
-        func = get_method(method).func
-        sols = []
-        for i in range(k):
-            sol = func(Mr[i], qr[i], **options)
-            sol.method = method
-            sols.append(sol)
+    sols = []
+    for i in range(k):
+        sol = info.func(Mr[i], qr[i], **options)
+        sol.method = method
+        sols.append(sol)
     out = []
     for i, sol in enumerate(sols):
-        if sol.info.get("equilibrated") is not None:  # already the answer of `solve`
-            out.append(sol)
-            continue
         z = np.asarray(sol.z, dtype=float)
         if sol.status == "solved" and z.shape == (n,) and np.isfinite(z).all():
             z = eqs[i].z_back(z) if eqs else z
@@ -129,8 +128,22 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     return out
 
 
-def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, options: dict, problem_of) -> list[Solution]:
+def _builtin_lemke():
+    from .lemke import lemke
+
+    return lemke
+
+
+def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of
+                 ) -> list[Solution]:
+    """`solve`'s first attempt for every problem in C (lcp.fast_lemke's steps: the
+    equilibration of a balanced M, Lemke, z back; `_kernel.solve_batch`), then its check,
+    lcp.residual's measure, for all at once (`_kernel.measure_batch`: M z by numpy, the rest in
+    C, the same numbers as `check`). A problem not solved or not accepted there -- a ray, a
+    limit, a cycle, an M that is not balanced, an answer that fails the test -- is solved by
+    `solve` itself, which answers it as a single call does."""
     from .lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
+    from .residual import TOL
 
     k, n = qs.shape
     d = _covering_vector(options.get("d"), n)
@@ -140,18 +153,23 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, options: dict, problem_of) -> l
     basic = np.empty((k, n), dtype=np.int8)
     codes = np.empty(k, dtype=np.int64)
     pivots = np.empty(k, dtype=np.int64)
-    _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots)
-    # What `solve` does to each answer, for all at once: w = M z + q recomputed, the residual.
-    W = np.einsum("kij,kj->ki", Ms, Z) + qs
-    res = np.abs(np.minimum(Z, W)).max(axis=1).tolist()
-    rows, cols = np.nonzero(basic)
-    bases = np.split(cols, np.cumsum(np.bincount(rows, minlength=k))[:-1])
+    _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots,
+                        equilibrate=on)
+    with np.errstate(all="ignore"):  # as `check`: an overflow is measured, never accepted
+        W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
+    measured = _kernel.measure_batch(Ms, qs, Z, W)
+    if measured is None:  # not compiled as numpy sums: measure one by one
+        return [solve(problem_of(i), "lemke", **options) for i in range(k)]
+    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[ends[i - 1]:ends[i]]
+    ends = [0, *np.cumsum(np.bincount(rows, minlength=k)).tolist()]
     sols: list[Solution] = []
-    for i, (code, piv, z, w) in enumerate(zip(codes.tolist(), pivots.tolist(), Z, W)):
-        if code == _kernel.SOLVED:
-            sols.append(Solution(z=z, w=w, status="solved", method="lemke", iterations=piv,
-                                 residual=res[i], basis=bases[i],
-                                 message="" if piv else "q >= 0: z = 0 solves the LCP"))
-        else:  # a ray, a pivot limit or a cycle: the single call gives its evidence
+    for i, (code, piv, raw, scaled, z, w) in enumerate(zip(
+            codes.tolist(), pivots.tolist(), measured[:, 0].tolist(),
+            measured[:, 1].tolist(), Z, W)):
+        if code == _kernel.SOLVED and scaled <= TOL:
+            sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, cols[ends[i]:ends[i + 1]],
+                                   "" if piv else "q >= 0: z = 0 solves the LCP",
+                                   {"equilibrated": on}))
+        else:  # see the docstring: the single call gives the answer and its evidence
             sols.append(solve(problem_of(i), "lemke", **options))
     return sols

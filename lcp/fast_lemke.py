@@ -31,7 +31,7 @@ from .lemke import DEFAULT_TOL
 from .lemke import lemke as _lemke
 from .residual import TOL, lcp_measure
 from .scaling import ruiz
-from .solution import Solution
+from .solution import Solution, solved_lcp
 
 _Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it gives it
 #: Above this bound on |M z + q| and the row sums of |M|, numpy's part of the check could
@@ -47,7 +47,6 @@ def applies() -> bool:
 
 
 _F64 = np.dtype(np.float64)
-_new = object.__new__
 
 
 def solve_lemke(problem) -> Solution | None:
@@ -77,13 +76,5 @@ def solve_lemke(problem) -> Solution | None:
     w, raw, scaled, _, _ = lcp_measure(M, q, z)
     if not scaled <= TOL:  # lcp.residual.Check.accepted, with no equality part
         return None
-    # Solution(z=z, w=w, ..., info={...}) with its fields set directly, in their order (the
-    # dataclass's __init__ would set the same; half the cost. The test compares vars()).
-    sol = _new(Solution)
-    sol.__dict__ = {
-        "z": z, "w": w, "status": "solved", "method": "lemke", "iterations": pivots,
-        "residual": raw, "eq_residual": 0.0, "scaled_residual": scaled, "basis": basis[:m],
-        "u": None, "message": "" if pivots else _Q_NONNEGATIVE,
-        "info": {"equilibrated": True},
-    }
-    return sol
+    return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis[:m],
+                      "" if pivots else _Q_NONNEGATIVE, {"equilibrated": True})
