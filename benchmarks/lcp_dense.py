@@ -11,10 +11,12 @@ When /usr/bin/python3 can import siconos.numerics (Debian's python3-siconos), Si
 lexicographic Lemke (lcp_lexicolemke, SICONOS_LCP_LEMKE) solves the same problems in a
 subprocess (benchmarks/_siconos_lemke.py; matrices passed as .npy files; only the solve call is
 timed), interleaved run by run with rigidlcp's `lemke` so that both see the same machine load,
-and a second table gives the time ratio rigidlcp/Siconos and both pivot counts.
+and a second table gives the time ratio rigidlcp/Siconos and both pivot counts (for lemke, and
+for the other methods named by --against).
 
     python benchmarks/lcp_dense.py [--sizes 10,50,100,200,500,1000] [--repeats 5] [--seed 0]
                                    [--methods lemke,...] [--inner 1|N|auto]
+                                   [--against lemke,pivoting]
 """
 
 from __future__ import annotations
@@ -110,7 +112,7 @@ def inner_calls(n: int, inner: str) -> int:
 
 
 def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[str] | None,
-        use_siconos: bool, inner: str = "1") -> None:
+        use_siconos: bool, inner: str = "1", against: tuple[str, ...] = ("lemke",)) -> None:
     infos = [m for m in lcp.methods() if methods is None or m.name in methods]
     siconos = Siconos() if use_siconos else None
     print("Dense LCP benchmark: M = A A^T + 0.1 I, q ~ N(0, 1), A standard normal, "
@@ -159,18 +161,18 @@ def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[
                     too_slow[name] = n
                 else:
                     times = []
-                    k = inner_calls(n, inner) if name == "lemke" else 1
+                    k = inner_calls(n, inner) if name in against else 1
                     for _ in range(repeats):
                         t, c, sol = _time_solve(problem, name, k)
                         times.append(t)
                         cpus.append(c)
-                        if name == "lemke" and siconos is not None and siconos.available:
+                        if name in against and siconos is not None and siconos.available:
                             sic.append(siconos.solve(M_path, q_path, 1000 + 100 * n, k))
                 note = "  (1 run: over budget)" if len(times) == 1 and repeats > 1 else ""
                 print(f"{n:>5}  {name:<12} {sol.status:<13} {sol.iterations:>7} "
                       f"{1e3 * np.median(times):>12.3f} {sol.residual:>9.1e}{note}")
                 if sic:
-                    pairs.append({"n": n, "ours": times, "ours_cpu": cpus,
+                    pairs.append({"n": n, "method": name, "ours": times, "ours_cpu": cpus,
                                   "pivots": sol.iterations,
                                   "siconos": [s["time"] for s in sic],
                                   "siconos_cpu": [s["cpu"] for s in sic],
@@ -191,22 +193,24 @@ def _report_siconos(siconos: Siconos | None, pairs: list[dict], use_siconos: boo
     if siconos is None or not (siconos.available or pairs):
         print(f"Siconos comparison skipped: {siconos.reason if siconos else 'disabled'}.")
         return
-    print(f"rigidlcp lemke vs Siconos lcp_lexicolemke (python3-siconos {siconos.version}, "
+    print(f"rigidlcp vs Siconos lcp_lexicolemke (python3-siconos {siconos.version}, "
           f"{SYSTEM_PYTHON} subprocess, solve call only), runs interleaved, medians")
-    print("Siconos counts the pivots after the first one (z0 entering); rigidlcp counts all, "
-          "so equal paths show rigidlcp = Siconos + 1.")
+    print("Siconos counts the pivots after the first one (z0 entering); rigidlcp's lemke counts "
+          "all, so equal paths show lemke = Siconos + 1 (pivoting counts its own iterations).")
     print("Wall time: medians and ratio = rigidlcp/Siconos; best = min/min over the runs. CPU: the")
     print("same with process CPU time (less sensitive to other jobs on the machine).")
-    header = (f"{'n':>5} {'rigidlcp [ms]':>14} {'Siconos [ms]':>13} {'ratio':>6} {'best':>6} "
-              f"{'CPU ratio':>9} {'pivots':>7} {'Siconos+1':>9} {'info':>5} {'Siconos res':>11}")
+    header = (f"{'n':>5} {'method':<9} {'rigidlcp [ms]':>14} {'Siconos [ms]':>13} {'ratio':>6} "
+              f"{'best':>6} {'CPU ratio':>9} {'pivots':>7} {'Siconos+1':>9} {'info':>5} "
+              f"{'Siconos res':>11}")
     print(header)
     print("-" * len(header))
     for p in pairs:
         ours, theirs = float(np.median(p["ours"])), float(np.median(p["siconos"]))
         best = min(p["ours"]) / min(p["siconos"])
         cpu = float(np.median(p["ours_cpu"])) / max(float(np.median(p["siconos_cpu"])), 1e-9)
-        print(f"{p['n']:>5} {1e3 * ours:>14.3f} {1e3 * theirs:>13.3f} {ours / theirs:>6.2f} "
-              f"{best:>6.2f} {cpu:>9.2f} {p['pivots']:>7} {p['sic_pivots'] + 1:>9} "
+        print(f"{p['n']:>5} {p['method']:<9} {1e3 * ours:>14.3f} {1e3 * theirs:>13.3f} "
+              f"{ours / theirs:>6.2f} {best:>6.2f} {cpu:>9.2f} {p['pivots']:>7} "
+              f"{p['sic_pivots'] + 1:>9} "
               f"{p['sic_info']:>5} {p['sic_residual']:>11.1e}")
     print()
 
@@ -221,6 +225,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="seconds per solve above which a method is not run at larger n")
     parser.add_argument("--methods", default=None, help="comma-separated subset of methods")
     parser.add_argument("--no-siconos", action="store_true", help="do not run Siconos")
+    parser.add_argument("--against", default="lemke",
+                        help="comma-separated methods timed against Siconos, interleaved "
+                        "(default: %(default)s; e.g. lemke,pivoting)")
     parser.add_argument("--inner", default="1",
                         help="lemke (and Siconos) calls per timed sample, their mean reported: "
                         "an integer or 'auto' (about 20000 / n^2); default 1")
@@ -229,7 +236,8 @@ def main(argv: list[str] | None = None) -> int:
     if not sizes or min(sizes) < 1 or args.repeats < 1:
         parser.error("--sizes must be positive integers and --repeats >= 1")
     methods = args.methods.split(",") if args.methods else None
-    run(sizes, args.repeats, args.seed, args.budget, methods, not args.no_siconos, args.inner)
+    run(sizes, args.repeats, args.seed, args.budget, methods, not args.no_siconos, args.inner,
+        tuple(args.against.split(",")))
     return 0
 
 
