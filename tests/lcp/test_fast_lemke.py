@@ -22,7 +22,7 @@ from rigidlcp.lcp.solution import Solution, solved_lcp
 
 from .test_lemke import degenerate_integer_lcps
 
-compiled = pytest.mark.skipif(not kernel.COMPILED, reason="the C extension is not built")
+compiled = pytest.mark.skipif(not kernel.enabled(), reason="the C extension is not built or is off")
 
 
 def same(x, y) -> bool:
