@@ -14,6 +14,12 @@
  *   3: secondary ray (slot s of the unblocked entering variable). trace: None or an int64
  *   buffer of length 2 k; the (row, slot) of the first k pivots are written there.
  *
+ * Also, for lcp.solve's fast path (lcp/fast_lemke.py) and lcp.solve_many: solve_eq / solve_batch
+ * run a whole LCP from the user's data -- the equilibration of lcp/scaling.py for a balanced M
+ * (or with the factors of `ruiz` given), the dictionary, the pivots, z in the user's units --
+ * and lcp_measure / lcp_measure_batch compute lcp/residual.py's acceptance measure after
+ * numpy's M z, with numpy's roundings (the same numbers; see the comments there).
+ *
  * Only the buffer protocol is used (no numpy headers), so the build needs a C compiler only.
  */
 #define PY_SSIZE_T_CLEAN
