@@ -83,4 +83,8 @@ def ruiz(M: np.ndarray, q: np.ndarray, sweeps: int = SWEEPS) -> Equilibration:
         # A change of unit s of z and w together: R w / s = (R M C)(C^-1 z / s) + R q / s.
         s = float(_pow2(np.array(qmax)))
         r, c = r / s, c * s
-    return Equilibration(M=M * r[:, None] * c[None, :], q=q * r, r=r, c=c)
+    with np.errstate(over="ignore"):
+        Mt = M * r[:, None] * c[None, :]
+    if not np.isfinite(Mt).all():  # M r overflowed before c brought it back (|q| << |M|):
+        Mt = M * (r[:, None] * c[None, :])  # the product of the factors first, still exact
+    return Equilibration(M=Mt, q=q * r, r=r, c=c)

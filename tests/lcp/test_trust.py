@@ -77,6 +77,20 @@ def test_ruiz_equilibration_maps_solutions_back_exactly():
     np.testing.assert_array_equal(e.M, (r[:, None] * M * c[None, :]) * e.r[:, None] * e.c)
 
 
+@pytest.mark.parametrize("method", ["lemke", "pivoting", "enumerate"])
+def test_a_tiny_q_beside_a_huge_balanced_m_is_solved_not_refused(method):
+    """|M| ~ 1e160, |q| ~ 1e-150: the unit change of q (r ~ 1e150, c ~ 1e-150) once overflowed
+    M r to inf before c brought it back, and a valid LCP was refused as containing NaN or Inf.
+    The solution is z = -M^-1 q = [0.2, 0.6] 1e-310 (M = [[2, 1], [1, 3]] 1e160, both z_i > 0)."""
+    M = np.array([[2.0, 1.0], [1.0, 3.0]]) * 1e160
+    q = np.array([-1.0, -2.0]) * 1e-150
+    eq = ruiz(M, q)
+    assert np.isfinite(eq.M).all() and 0.5 <= np.abs(eq.q).max() <= 2.0
+    sol = lcp.solve(lcp.LCP(M, q), method)
+    assert sol.status == "solved"
+    assert np.allclose(sol.z / 1e-310, [0.2, 0.6], rtol=1e-9)
+
+
 @settings(max_examples=80)
 @given(st.integers(2, 30), SEEDS, st.sampled_from(["lemke", "pivoting", "enumerate", "pgs"]),
        st.sampled_from(["P", "ill-P", "scaled", "random", "integer"]))
