@@ -1,8 +1,9 @@
-"""Build hook for the one optional C extension (everything else is in pyproject.toml).
+"""Build hook for the optional C extensions (everything else is in pyproject.toml).
 
-rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c). It is `optional`: when no
-C compiler is available, `pip install` still succeeds and lcp/_lemke_kernel.py runs the same
-loop in numpy (docs/performance.md says why a C extension and what it gains).
+rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c), rigidlcp.lcp._pivot_c the
+block steps of method `pivoting` for lcp.solve's fast path (lcp/_pivot_c.c). Both are
+`optional`: when no C compiler is available, `pip install` still succeeds and the numpy code
+runs instead (docs/performance.md says why a C extension and what it gains).
 
 The C code must round as numpy does (same pivots, same z, same residuals, bit for bit), so a
 compiler that can fuse a * b + c into one fused multiply-add (GCC and Clang do by default where
@@ -25,6 +26,7 @@ class BuildExt(build_ext):
 setup(
     ext_modules=[
         Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True),
+        Extension("rigidlcp.lcp._pivot_c", sources=["lcp/_pivot_c.c"], optional=True),
     ],
     cmdclass={"build_ext": BuildExt},
 )

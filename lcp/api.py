@@ -129,9 +129,9 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
-    if (type(problem) is LCP and method == "lemke" and not options
+    if (type(problem) is LCP and method in _FAST_METHODS and not options
             and (equilibrate is None or equilibrate is True)):
-        sol = _fast_lemke()(problem)  # the same answer, when the first attempt is accepted
+        sol = _fast(method)(problem)  # the same answer, when the first attempt is accepted
         if sol is not None:
             return sol
     friction = not isinstance(problem, (LCP, MLCP))
@@ -170,17 +170,27 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
 
 
 _FAST = None
+_FAST_PIVOTING = None
+#: Methods with a fast path for a plain LCP and default options (lcp.fast_lemke,
+#: lcp.fast_pivoting): the same Solution as the general path, or None to run it.
+_FAST_METHODS = ("lemke", "pivoting")
 
 
-def _fast_lemke():
-    """lcp.fast_lemke.solve_lemke (imported on first use: it imports lemke, which imports this
-    module)."""
-    global _FAST
-    if _FAST is None:
-        from .fast_lemke import solve_lemke
+def _fast(method: str):
+    """lcp.fast_lemke.solve_lemke or lcp.fast_pivoting.solve_pivoting (imported on first use:
+    they import the method's module, which imports this module)."""
+    global _FAST, _FAST_PIVOTING
+    if method == "lemke":
+        if _FAST is None:
+            from .fast_lemke import solve_lemke
 
-        _FAST = solve_lemke
-    return _FAST
+            _FAST = solve_lemke
+        return _FAST
+    if _FAST_PIVOTING is None:
+        from .fast_pivoting import solve_pivoting
+
+        _FAST_PIVOTING = solve_pivoting
+    return _FAST_PIVOTING
 
 
 _LOADED = False
