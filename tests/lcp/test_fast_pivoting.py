@@ -1,0 +1,232 @@
+"""The fast path of `lcp.solve(problem, "pivoting")` (lcp/fast_pivoting.py, lcp/_pivot_c.c)
+gives exactly what the general path gives -- the same Solution, field for field and bit for
+bit -- on random, PSD, P-matrix, badly scaled and degenerate integer problems, and declines
+(None: the general path runs from the start) on everything else: a singular start, a single
+or exchange pivot, bad data, options, Fortran order, no compiled kernel."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rigidlcp import lcp
+from rigidlcp.lcp import _lemke_kernel as kernel
+from rigidlcp.lcp import api, fast_pivoting
+from rigidlcp.lcp.solution import Solution
+
+from .test_fast_lemke import outcome, same
+from .test_lemke import degenerate_integer_lcps
+
+compiled = pytest.mark.skipif(not fast_pivoting.applies(),
+                              reason="the C extension is not built, is off, or scipy's BLAS "
+                              "does not round as numpy's")
+
+
+def general(problem, **kw):
+    """lcp.solve(problem, "pivoting") without the fast path (lcp.trust.solve_checked)."""
+    saved = api._FAST_PIVOTING
+    api._FAST_PIVOTING = lambda p: None
+    try:
+        return lcp.solve(problem, "pivoting", **kw)
+    finally:
+        api._FAST_PIVOTING = saved
+
+
+def assert_same_answer(problem, plain: bool = True) -> Solution | None:
+    """Both paths answer alike; the fast path's own answer, when it gives one, is the general
+    path's, and on plain data (C-contiguous finite float64) it declines only where the general
+    path needed more than block steps."""
+    fast, slow = outcome(lambda p: lcp.solve(p, "pivoting"), problem), outcome(general, problem)
+    if isinstance(slow, Exception):
+        assert type(fast) is type(slow) and str(fast) == str(slow)
+        return None
+    assert list(vars(fast)) == list(vars(slow))
+    for key in vars(slow):
+        assert same(getattr(fast, key), getattr(slow, key)), key
+    own = fast_pivoting.solve_pivoting(problem)
+    if own is not None:
+        for key in vars(slow):
+            assert same(getattr(own, key), getattr(slow, key)), key
+    elif plain and slow.status == "solved" and set(slow.info) == {
+            "block_steps", "single_pivots", "exchange_pivots", "flips", "equilibrated"}:
+        # declined although only block steps were made: only when the general path needed
+        # a single pivot (counted in info) or its check failed and it repaired the answer
+        assert slow.info["single_pivots"] + slow.info["exchange_pivots"] > 0
+    return own
+
+
+@st.composite
+def problems(draw, max_n: int = 30):
+    """Random, PSD, P-matrix (non-symmetric, diagonally dominant or triangular), badly scaled
+    (rows, columns and q over many decades) and extreme problems."""
+    n = draw(st.integers(1, max_n))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    kind = draw(st.sampled_from(["general", "psd", "p-dominant", "p-triangular", "scaled",
+                                 "extreme", "q>=0"]))
+    A = rng.standard_normal((n, n))
+    q = rng.standard_normal(n)
+    if kind == "general":
+        M = A
+    elif kind == "psd":
+        M = A @ A.T + 0.1 * np.eye(n)
+    elif kind == "p-dominant":
+        M = A + np.diag(np.abs(A).sum(axis=1) + 0.1)
+    elif kind == "p-triangular":
+        M = np.triu(A, 1) + np.diag(np.exp(rng.uniform(-3, 3, n)))
+    elif kind == "scaled":
+        D = np.exp(rng.uniform(-20, 20, n))
+        M = D[:, None] * (A @ A.T + np.eye(n)) * D[None, :]
+        q = q * np.exp(rng.uniform(-20, 20))
+    elif kind == "extreme":
+        M = (A @ A.T + np.eye(n)) * 10.0 ** rng.uniform(-150, 150)
+        q = q * 10.0 ** rng.uniform(-150, 150)
+    else:
+        M, q = A, np.abs(q)
+    return M, q
+
+
+@compiled
+@settings(max_examples=300, deadline=None)
+@given(problems())
+def test_fast_path_gives_the_general_answer(problem):
+    assert_same_answer(lcp.LCP(*problem))
+
+
+@compiled
+@settings(max_examples=300, deadline=None)
+@given(degenerate_integer_lcps(max_n=6))
+def test_fast_path_gives_the_general_answer_on_degenerate_problems(problem):
+    """Ties, singular bases, infeasible problems, q >= 0: as the general path answers."""
+    assert_same_answer(lcp.LCP(*problem))
+
+
+@compiled
+def test_fast_path_is_taken_on_most_plain_problems():
+    """Not a vacuous equality: the C path answers most P-matrix and PSD problems of the sizes
+    the benchmarks use (the same answer as the general path, checked above)."""
+    rng = np.random.default_rng(5)
+    taken = 0
+    for k in range(40):
+        n = (1, 2, 10, 50, 100)[k % 5]
+        A = rng.standard_normal((n, n))
+        M = A @ A.T + 0.1 * np.eye(n) if k % 2 else A + np.diag(np.abs(A).sum(axis=1))
+        P = lcp.LCP(M, rng.standard_normal(n))
+        taken += assert_same_answer(P) is not None
+    assert taken >= 30
+
+
+@compiled
+def test_declines_what_needs_the_python_method():
+    singular_start = lcp.LCP(np.ones((2, 2)), -np.ones(2))  # M_aa singular at alpha = {q < 0}
+    assert fast_pivoting.solve_pivoting(singular_start) is None
+    assert "warm_start_rejected" in general(singular_start).info
+    assert_same_answer(singular_start)
+    infeasible = lcp.LCP(np.array([[1.0, -1.0], [-1.0, 1.0]]), np.array([-1.0, -1.0]))
+    assert fast_pivoting.solve_pivoting(infeasible) is None
+    assert lcp.solve(infeasible, "pivoting").status == "infeasible"
+    rng = np.random.default_rng(11)
+    single = 0
+    for _ in range(300):  # problems where block steps cycle and single pivots take over
+        n = int(rng.integers(2, 9))
+        P = lcp.LCP(rng.standard_normal((n, n)), rng.standard_normal(n))
+        slow = general(P)
+        if slow.info.get("single_pivots", 0) + slow.info.get("exchange_pivots", 0):
+            single += 1
+            assert fast_pivoting.solve_pivoting(P) is None
+            assert_same_answer(P)
+    assert single > 0
+
+
+@compiled
+def test_options_fortran_order_and_no_kernel_take_the_general_path(monkeypatch):
+    rng = np.random.default_rng(4)
+    A = rng.standard_normal((6, 6))
+    P = lcp.LCP(A @ A.T + np.eye(6), rng.standard_normal(6))
+    calls = []
+    real = fast_pivoting.solve_pivoting
+    monkeypatch.setattr(api, "_FAST_PIVOTING", lambda p: calls.append(p) or real(p))
+    lcp.solve(P, "pivoting")
+    lcp.solve(P, "pivoting", equilibrate=True)
+    assert len(calls) == 2
+    for kw in ({"max_iter": 50}, {"equilibrate": False}, {"tol": 1e-9}, {"block_tries": 1},
+               {"active": [0, 1]}):
+        assert lcp.solve(P, "pivoting", **kw).status == "solved"
+    assert len(calls) == 2
+    fortran = lcp.LCP(np.asfortranarray(P.M), P.q)
+    assert fast_pivoting.solve_pivoting(fortran) is None
+    assert_same_answer(fortran, plain=False)
+    previous = kernel.use_compiled(False)  # as RIGIDLCP_NO_KERNEL=1
+    try:
+        assert fast_pivoting.solve_pivoting(P) is None
+        assert same(lcp.solve(P, "pivoting").z, general(P).z)
+    finally:
+        kernel.use_compiled(previous)
+
+
+@compiled
+def test_a_method_registered_as_pivoting_replaces_the_fast_path():
+    info = api._REGISTRY["pivoting"]
+
+    @api.register("pivoting", accepts="any", description="test double", equilibrate=True)
+    def double(M, q):
+        return Solution(z=np.zeros(q.size), w=q.copy(), status="solved", method="pivoting")
+
+    try:
+        assert fast_pivoting.solve_pivoting(lcp.LCP(np.eye(2), np.ones(2))) is None
+    finally:
+        api._REGISTRY["pivoting"] = info
+
+
+@compiled
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the general path's ruiz on inf
+@pytest.mark.parametrize("where", ["M", "q"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_bad_numbers_after_construction_raise_as_the_general_path(where, bad):
+    P = lcp.LCP(np.eye(3) + 0.5, -np.ones(3))
+    getattr(P, where)[(1, 2) if where == "M" else 1] = bad
+    assert fast_pivoting.solve_pivoting(P) is None
+    fast, slow = outcome(lambda p: lcp.solve(p, "pivoting"), P), outcome(general, P)
+    assert type(fast) is type(slow) and str(fast) == str(slow)
+
+
+@compiled
+@pytest.mark.parametrize("M, q", [
+    (np.ones(9), -np.ones(3)),                      # M a vector
+    (np.ones((3, 4)), -np.ones(3)),                 # not square
+    (np.ones((3, 3)), -np.ones(4)),                 # q of another size
+    (np.ones((3, 3), dtype=np.float32), -np.ones(3)),
+    (np.ones((3, 3)).tolist(), -np.ones(3)),        # not an array
+    (np.ones((0, 0)), np.ones(0)),                  # empty
+])
+def test_wrong_shapes_or_types_forced_in_take_the_general_path(M, q):
+    P = lcp.LCP(np.eye(3), -np.ones(3))
+    object.__setattr__(P, "M", M)
+    object.__setattr__(P, "q", q)
+    assert fast_pivoting.solve_pivoting(P) is None
+    fast, slow = outcome(lambda p: lcp.solve(p, "pivoting"), P), outcome(general, P)
+    assert type(fast) is type(slow)
+    if isinstance(slow, Exception):
+        assert str(fast) == str(slow)
+
+
+@compiled
+def test_numbers_that_could_overflow_the_check_take_the_general_path():
+    P = lcp.LCP(np.full((3, 3), 1e307) + np.eye(3) * 1e307, -np.ones(3) * 1e307)
+    assert fast_pivoting.solve_pivoting(P) is None
+    assert_same_answer(P, plain=False)
+
+
+@compiled
+@pytest.mark.parametrize("n", [1, 2, 3, 7, 8, 9, 16, 33, 64, 65, 130, 257])
+def test_c_matrix_vector_product_is_numpys(n):
+    """The C code's product (scipy's dgemv 'T' on the rows, 0 + ddot at n = 1) is numpy's
+    A @ x, bit for bit, on data over many decades (the probe of fast_pivoting, on other
+    numbers)."""
+    rng = np.random.default_rng(n)
+    A = rng.standard_normal((n, n)) * np.exp2(rng.integers(-40, 40, (n, n)))
+    x = rng.standard_normal(n) * np.exp2(rng.integers(-40, 40, n))
+    y = np.empty(n)
+    fast_pivoting._pivot_c.matvec(A, x, y)
+    assert y.tobytes() == (A @ x).tobytes()
