@@ -132,6 +132,18 @@ typedef struct {
     int *iwork;
 } Ctx;
 
+/* float(np.max(np.sum(np.abs(A), axis=0))) for A m x m C-contiguous (m >= 1): numpy adds the
+ * rows in order (a reduction over the outer axis); t: scratch of m. */
+static double col_abs_max(int m, const double *A, double *t)
+{
+    double anorm = 0.0;
+    for (int j = 0; j < m; j++) t[j] = 0.0;
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++) t[j] += fabs(A[i * m + j]);
+    for (int j = 0; j < m; j++) anorm = t[j] > anorm ? t[j] : anorm;
+    return anorm;
+}
+
 /* _Basis.__init__ for the index set B->alpha: 1 when M_aa is singular by pivoting.py's test. */
 static int factor(const Ctx *C, Basis *B)
 {
@@ -141,16 +153,13 @@ static int factor(const Ctx *C, Basis *B)
         if (B->alpha[i]) B->a[m++] = i;
     B->m = m;
     if (!m) return 0;
-    double anorm = 0.0;
-    for (int j = 0; j < m; j++) C->t[j] = 0.0;
     for (int i = 0; i < m; i++)
         for (int j = 0; j < m; j++) {
             double v = C->M[B->a[i] * n + B->a[j]];
             B->Maa[i * m + j] = v;
             B->lu[i + j * m] = v;
-            C->t[j] += fabs(v); /* np.sum(np.abs(Maa), axis=0): rows added in order */
         }
-    for (int j = 0; j < m; j++) anorm = C->t[j] > anorm ? C->t[j] : anorm;
+    double anorm = col_abs_max(m, B->Maa, C->t);
     int info = 0;
     getrf(&m, &m, B->lu, &m, B->ipiv, &info);
     for (int i = 0; i < m; i++)
@@ -449,6 +458,33 @@ static PyObject *py_matvec(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* col_abs_max(A) -> float(np.max(np.sum(np.abs(A), axis=0))) by `col_abs_max` (the probe). */
+static PyObject *py_col_abs_max(PyObject *self, PyObject *arg)
+{
+    (void)self;
+    Py_buffer v;
+    if (PyObject_GetBuffer(arg, &v, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
+        return NULL;
+    const char *f = v.format ? v.format : "B";
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+    if (v.ndim != 2 || v.shape[0] != v.shape[1] || v.shape[0] < 1 || v.shape[0] > 46000 ||
+        v.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
+        PyBuffer_Release(&v);
+        PyErr_SetString(PyExc_ValueError, "A: a square float64 C-contiguous matrix");
+        return NULL;
+    }
+    int m = (int)v.shape[0];
+    double *t = malloc(sizeof(double) * m);
+    if (!t) {
+        PyBuffer_Release(&v);
+        return PyErr_NoMemory();
+    }
+    double r = col_abs_max(m, v.buf, t);
+    free(t);
+    PyBuffer_Release(&v);
+    return PyFloat_FromDouble(r);
+}
+
 static void *pointer(PyObject *cap)
 {
     if (!PyCapsule_CheckExact(cap)) {
@@ -482,6 +518,8 @@ static PyMethodDef methods[] = {
      "solve(M, q, r, c, tol, block_tries, max_iter, z, basis) -> (code, it, nbasis, flips, "
      "bounds): pivoting's block steps on the equilibrated data."},
     {"matvec", py_matvec, METH_VARARGS, "matvec(A, x, y): y = A x as numpy's matmul."},
+    {"col_abs_max", py_col_abs_max, METH_O,
+     "col_abs_max(A) -> the largest column sum of |A|, as numpy sums it."},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_pivot_c",

@@ -14,13 +14,14 @@ the block steps with scipy's own LAPACK dgetrf / dgecon / dgetrs and BLAS dgemv,
 lcp.pivoting's numpy code calls them; z mapped back) and checks the answer with
 `lcp.residual.lcp_measure`, as `check` does. So it returns the same Solution as the general
 path, bit for bit (tests/lcp/test_fast_pivoting.py), and None in every other case -- data that
-are not plain finite float64 arrays, a singular starting basis, a single or exchange pivot, an
-answer that fails the acceptance test, numbers large enough for the check to overflow -- where
-the caller runs the general path from the start.
+are not plain finite float64 arrays, n > MAX_N = 260, a singular starting basis, a single or
+exchange pivot, an answer that fails the acceptance test, numbers large enough for the check
+to overflow -- where the caller runs the general path from the start.
 
 numpy links its own BLAS, scipy another: the fast path is used only if scipy's dgemv (the C
 code's matrix-vector product) rounds as numpy's matmul on a probe of sizes 1..260 with entries
-over many binary orders (`_gemv_as_numpy`, run once).
+over many binary orders (`_gemv_as_numpy`, run once; it checks the column sums of |M_aa| of
+the condition estimate likewise).
 """
 
 from __future__ import annotations
@@ -47,21 +48,26 @@ _TOL, _BLOCK_TRIES = 1e-10, 3
 #: could overflow; the general path measures under np.errstate instead.
 _SAFE = 1e300
 _F64 = np.dtype(np.float64)
+#: The largest n the probe checks (and the fast path takes): beyond it the BLAS kernels could
+#: block or split work among threads in ways the probe has not seen.
+MAX_N = 260
 _ready: bool | None = None
 
 
 def _gemv_as_numpy() -> bool:
     """Does _pivot_c's matrix-vector product (scipy's dgemv, or 0 + ddot at size 1) give
-    numpy's A @ x, bit for bit, on C-contiguous A? Checked once on sizes 1..40 and some larger
-    ones (blocking and threading of the BLAS kernels), entries over 60 binary orders."""
-    for n in (*range(1, 41), 63, 64, 65, 100, 127, 128, 129, 200, 260):
+    numpy's A @ x, bit for bit, on C-contiguous A, and its largest column sum of |A| numpy's
+    np.max(np.sum(np.abs(A), axis=0))? Checked once on sizes 1..40 and larger ones up to MAX_N
+    (blocking and threading of the BLAS kernels), entries over 60 binary orders."""
+    for n in (*range(1, 41), 63, 64, 65, 100, 127, 128, 129, 200, MAX_N):
         k = np.arange(n * n + n, dtype=float)
         v = np.exp2((k * 7919 % 61) - 30.0) * (1.0 + (k * 31 % 17) / 17.0)
         v[1::3] *= -1.0
         A, x = v[: n * n].reshape(n, n), v[n * n:]
         y = np.empty(n)
         _pivot_c.matvec(A, x, y)
-        if y.tobytes() != (A @ x).tobytes():
+        if (y.tobytes() != (A @ x).tobytes()
+                or _pivot_c.col_abs_max(A) != float(np.max(np.sum(np.abs(A), axis=0)))):
             return False
     return True
 
@@ -93,7 +99,7 @@ def solve_pivoting(problem) -> Solution | None:
     answer is accepted (the Solution the general path would return), else None."""
     M, q = problem.M, problem.q
     if not (type(M) is np.ndarray and type(q) is np.ndarray and M.dtype is _F64
-            and q.dtype is _F64 and q.ndim == 1 and q.size > 0
+            and q.dtype is _F64 and q.ndim == 1 and 0 < q.size <= MAX_N
             and M.shape == (q.size, q.size) and applies()):
         return None
     n = q.size

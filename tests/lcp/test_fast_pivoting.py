@@ -230,3 +230,21 @@ def test_c_matrix_vector_product_is_numpys(n):
     y = np.empty(n)
     fast_pivoting._pivot_c.matvec(A, x, y)
     assert y.tobytes() == (A @ x).tobytes()
+
+
+@compiled
+@pytest.mark.parametrize("n", [1, 2, 5, 8, 9, 17, 130])
+def test_c_column_sums_are_numpys(n):
+    """The 1-norm of M_aa given to the condition estimate: numpy's column sums of |A| (rows
+    added in order), bit for bit, on terms over 80 binary orders."""
+    rng = np.random.default_rng(100 + n)
+    A = rng.standard_normal((n, n)) * np.exp2(rng.integers(-40, 40, (n, n)))
+    assert fast_pivoting._pivot_c.col_abs_max(A) == float(np.max(np.sum(np.abs(A), axis=0)))
+
+
+@compiled
+def test_sizes_beyond_the_probe_take_the_general_path():
+    n = fast_pivoting.MAX_N + 1
+    P = lcp.LCP(np.eye(n) * 2.0 + 0.01, -np.ones(n))
+    assert fast_pivoting.solve_pivoting(P) is None
+    assert lcp.solve(P, "pivoting").status == "solved"
