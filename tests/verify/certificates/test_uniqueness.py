@@ -205,3 +205,45 @@ def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
     res = uq.milp_search(ISSUE_M, ISSUE_Q, z, "values", ISSUE_M, retries=10)
     assert res.status == "unknown", res.message
     assert res.info["unproved_cuts"] >= 1
+
+
+#: Drawn by the deep hypothesis profile for test_milp_finds_the_planted_second_block: a 5 x 5
+#: P-matrix block (planted z = (0.1, 0, 0.1, 0.1, 0.1)) beside TWO_M. HiGHS's MIP presolve, at
+#: mip_feasibility_tolerance 1e-9, called the "values" MILP (L = M) infeasible although the
+#: solution with the 2 x 2 block at (1, 0) instead of (0, 1) satisfies it to 2e-16 (scipy
+#: 1.15.0 and 1.17.1; presolve off, or the default tolerance, finds it): a false "none".
+PRESOLVE_M = np.array([[3.856, -1.0, 0.756, -1.0, -1.0], [0.426, 3.9599, -0.83, -1.0, -1.0],
+                       [-0.998, -0.808, 2.582, 0.198, 0.478], [-1.0, -0.96, 0.128, 3.5912, -1.0],
+                       [-1.0, -1.0, -0.664, 0.878, 3.642]])
+PRESOLVE_Q = np.array([-0.2612, 0.3404, -0.226, -0.17192, -0.2856])
+
+
+@pytest.mark.parametrize("target", ["values", "pattern"])
+def test_milp_does_not_trust_a_presolve_infeasible(target):
+    M, q = with_two_solution_block(PRESOLVE_M, PRESOLVE_Q)
+    z = np.array([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 1.0])
+    assert is_solution(M, q, z)
+    res = milp_search(M, q, z, target, M if target == "values" else None, time_limit=20)
+    assert res.status == "found", res.message
+    assert is_solution(M, q, res.other)
+    assert np.max(np.abs(res.other[5:] - z[5:])) > 0.1
+
+
+def test_milp_none_needs_two_infeasible_answers(monkeypatch):
+    """"none" needs HiGHS's "infeasible" with and without presolve; with no time left for the
+    second run, the answer is "unknown"."""
+    import rigidlcp.verify.certificates.uniqueness as uq
+
+    M, q = np.eye(2), np.array([-1.0, 1.0])  # P-matrix: one solution, z = (1, 0)
+    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern")
+    assert res.status == "none" and res.info["milp_runs"] == 2, res.message
+    real = uq.milp
+
+    def slow(*a, **k):  # the first run uses up the whole budget
+        out = real(*a, **k)
+        monkeypatch.setattr(uq.time, "perf_counter", lambda: 1e12)
+        return out
+
+    monkeypatch.setattr(uq, "milp", slow)
+    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern")
+    assert res.status == "unknown" and res.info["milp_runs"] == 1, res.message
