@@ -12,8 +12,10 @@ binaries y (y_i = 1: zeta_i may be positive and w'_i = 0), these exact big-M con
 MILP that is infeasible if no solution has |z|_1 >= S and no nonzero d >= 0 solves LCP(M, 0)
 (theta = 0 is allowed: the closure of the large solutions). A point with theta > 0 gives a
 solution z = zeta / theta, verified by its residual. HiGHS's tolerances can only let
-spurious points in (y within 1e-9 of an integer), never cut real ones out, so an
-"infeasible" answer is sound up to the LP tolerances, as milp_search's "none" is.
+spurious points in (y within 1e-9 of an integer), never cut real ones out; its MIP
+presolve did cut one out once (uniqueness.confirmed_milp), so "infeasible" counts only when
+HiGHS gives it with and without presolve, as milp_search's "none": HiGHS's verdict, not a
+checked certificate.
 
 Then |z|_inf <= |z|_1 < S for every solution, and a "none" of milp_search in the box U >= S is a
 global verdict.
@@ -26,9 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import Bounds, LinearConstraint, milp
+from scipy.optimize import Bounds, LinearConstraint
 
-from .uniqueness import quiet_highs, scaled_residual
+from .uniqueness import confirmed_milp, scaled_residual
 
 _HIGHS = {"mip_feasibility_tolerance": 1e-9, "primal_feasibility_tolerance": 1e-9}
 
@@ -79,11 +81,13 @@ def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float
     hi.append(1.0)
     ub = np.r_[np.ones(n), 1.0 / S, np.ones(n)]
     integrality = np.r_[np.zeros(n + 1), np.ones(n)]
-    with quiet_highs():
-        out = milp(np.zeros(N), integrality=integrality, bounds=Bounds(np.zeros(N), ub),
-                   constraints=LinearConstraint(A.tocsr(), np.array(lo), np.array(hi)),
-                   options={"time_limit": float(time_limit), **_HIGHS})
+    out, runs = confirmed_milp(np.zeros(N), integrality,
+                      LinearConstraint(A.tocsr(), np.array(lo), np.array(hi)), time_limit,
+                      bounds=Bounds(np.zeros(N), ub), options=_HIGHS)
     secs = time.perf_counter() - t0
+    if out.status == 2 and runs < 2:
+        return NormBound(None, S, secs, "MILP infeasible with presolve; no time left to ask "
+                         "it again without: undecided")
     if out.status == 2:
         return NormBound(True, S, secs, f"no solution with |z|_1 >= {S:.3g} (MILP infeasible, "
                          f"{secs:.2f} s)")

@@ -214,8 +214,8 @@ def milp_search(
     MILP's binaries may pick one that rounding made look satisfied); the cut is *proved* only
     if all their LPs are infeasible, and an infeasible MILP after an unproved cut answers
     "unknown", never "none" (a false "unique" is the worst answer a verifier can give).
-    "none" rests on HiGHS's "infeasible", given twice, with and without presolve (`_milp`):
-    the MILP solver's verdict, not a certificate this module checks.
+    "none" rests on HiGHS's "infeasible", given twice, with and without presolve
+    (`confirmed_milp`): the MILP solver's verdict, not a certificate this module checks.
     """
     t0 = time.perf_counter()
     M = np.asarray(M, dtype=float)
@@ -318,7 +318,8 @@ def milp_search(
             res.message = f"time limit {time_limit:g} s reached"
             break
         A = sp.csr_matrix(np.array(rows))
-        out, runs = _milp(c, integrality, LinearConstraint(A, np.array(lo), np.array(hi)), left)
+        cons = LinearConstraint(A, np.array(lo), np.array(hi))
+        out, runs = confirmed_milp(c, integrality, cons, left)
         res.info = {"milp_status": int(out.status), "milp_message": str(out.message),
                     "binaries": N - n, "rejected_bases": rejected, "milp_runs": runs}
         if out.x is None:
@@ -369,11 +370,12 @@ def milp_search(
     return res
 
 
-def _milp(c, integrality, constraints, seconds: float):
+def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, options=None):
     """(HiGHS's answer, runs). An "infeasible" answer is asked again with presolve off, and
     stands only if that run agrees (runs = 2): HiGHS's MIP presolve, at our feasibility
     tolerance 1e-9, called a feasible model infeasible (scipy 1.15.0 to 1.17.1; the model of
-    test_uniqueness.PRESOLVE_M), which made milp_search answer a false "none"."""
+    test_uniqueness.PRESOLVE_M), which made milp_search answer a false "none". Default bounds
+    [0, 1] and options _HIGHS_MILP."""
     t0 = time.perf_counter()
     runs = 0
     for presolve in (True, False):
@@ -381,9 +383,10 @@ def _milp(c, integrality, constraints, seconds: float):
         if runs and left <= 0:
             break
         with quiet_highs():
-            out = milp(c, integrality=integrality, bounds=Bounds(0.0, 1.0),
-                       constraints=constraints, options={"time_limit": float(left),
-                                                        "presolve": presolve, **_HIGHS_MILP})
+            out = milp(c, integrality=integrality, constraints=constraints,
+                       bounds=Bounds(0.0, 1.0) if bounds is None else bounds,
+                       options={"time_limit": float(left), "presolve": presolve,
+                                **(_HIGHS_MILP if options is None else options)})
         runs += 1
         if out.status != 2:
             break
