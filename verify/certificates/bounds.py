@@ -12,9 +12,9 @@ binaries y (y_i = 1: zeta_i may be positive and w'_i = 0), these exact big-M con
 MILP that is infeasible if no solution has |z|_1 >= S and no nonzero d >= 0 solves LCP(M, 0)
 (theta = 0 is allowed: the closure of the large solutions). A point with theta > 0 gives a
 solution z = zeta / theta, verified by its residual. HiGHS's tolerances can only let
-spurious points in (y within 1e-9 of an integer), never cut real ones out; its MIP
-presolve did cut one out once (uniqueness.confirmed_milp), so "infeasible" counts only when
-HiGHS gives it with and without presolve, as milp_search's "none": HiGHS's verdict, not a
+spurious points in (y within 1e-9 of an integer), never cut real ones out; HiGHS did cut
+one out once (uniqueness.confirmed_milp), so "infeasible" counts only when HiGHS gives it
+at these tolerances and at its defaults, as milp_search's "none": HiGHS's verdict, not a
 checked certificate.
 
 Then |z|_inf <= |z|_1 < S for every solution, and a "none" of milp_search in the box U >= S is a
@@ -86,8 +86,8 @@ def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float
                       bounds=Bounds(np.zeros(N), ub), options=_HIGHS)
     secs = time.perf_counter() - t0
     if out.status == 2 and runs < 2:
-        return NormBound(None, S, secs, "MILP infeasible with presolve; no time left to ask "
-                         "it again without: undecided")
+        return NormBound(None, S, secs, "MILP infeasible at tolerance 1e-9; no time left to "
+                         "confirm it at HiGHS's defaults: undecided")
     if out.status == 2:
         return NormBound(True, S, secs, f"no solution with |z|_1 >= {S:.3g} (MILP infeasible, "
                          f"{secs:.2f} s)")

@@ -214,7 +214,7 @@ def milp_search(
     MILP's binaries may pick one that rounding made look satisfied); the cut is *proved* only
     if all their LPs are infeasible, and an infeasible MILP after an unproved cut answers
     "unknown", never "none" (a false "unique" is the worst answer a verifier can give).
-    "none" rests on HiGHS's "infeasible", given twice, with and without presolve
+    "none" rests on HiGHS's "infeasible", given twice, at our tolerances and at its own
     (`confirmed_milp`): the MILP solver's verdict, not a certificate this module checks.
     """
     t0 = time.perf_counter()
@@ -324,8 +324,8 @@ def milp_search(
                     "binaries": N - n, "rejected_bases": rejected, "milp_runs": runs}
         if out.x is None:
             if out.status == 2 and runs < 2:
-                res.message = ("MILP infeasible with presolve; no time left to ask it again "
-                               "without: unknown")
+                res.message = ("MILP infeasible at tolerance 1e-9; no time left to confirm "
+                               "it at HiGHS's defaults: unknown")
             elif out.status == 2 and unproved:  # a cut that was not proved may hide a solution
                 res.message = (f"MILP infeasible after {rejected} bases were cut, {unproved} of "
                                "them without proof that they hold no other solution: unknown")
@@ -371,22 +371,23 @@ def milp_search(
 
 
 def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, options=None):
-    """(HiGHS's answer, runs). An "infeasible" answer is asked again with presolve off, and
-    stands only if that run agrees (runs = 2): HiGHS's MIP presolve, at our feasibility
-    tolerance 1e-9, called a feasible model infeasible (scipy 1.15.0 to 1.17.1; the model of
-    test_uniqueness.PRESOLVE_M), which made milp_search answer a false "none". Default bounds
-    [0, 1] and options _HIGHS_MILP."""
+    """(HiGHS's answer, runs). An "infeasible" answer is asked again with HiGHS's default
+    tolerances and no presolve (a relaxation of the tight model: any point it returns is still
+    polished and verified), and stands only if that run agrees (runs = 2). At
+    mip_feasibility_tolerance 1e-9 HiGHS called a feasible model infeasible (the model of
+    test_uniqueness.PRESOLVE_M: scipy 1.15.0 with or without presolve, 1.17.1 with it), which
+    made milp_search answer a false "none". Default bounds [0, 1], options _HIGHS_MILP."""
     t0 = time.perf_counter()
     runs = 0
-    for presolve in (True, False):
+    for tight in (True, False):
         left = seconds - (time.perf_counter() - t0)
         if runs and left <= 0:
             break
+        opts = (_HIGHS_MILP if options is None else options) if tight else {"presolve": False}
         with quiet_highs():
             out = milp(c, integrality=integrality, constraints=constraints,
                        bounds=Bounds(0.0, 1.0) if bounds is None else bounds,
-                       options={"time_limit": float(left), "presolve": presolve,
-                                **(_HIGHS_MILP if options is None else options)})
+                       options={"time_limit": float(left), **opts})
         runs += 1
         if out.status != 2:
             break

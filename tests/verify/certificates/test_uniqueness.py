@@ -208,10 +208,11 @@ def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
 
 
 #: Drawn by the deep hypothesis profile for test_milp_finds_the_planted_second_block: a 5 x 5
-#: P-matrix block (planted z = (0.1, 0, 0.1, 0.1, 0.1)) beside TWO_M. HiGHS's MIP presolve, at
-#: mip_feasibility_tolerance 1e-9, called the "values" MILP (L = M) infeasible although the
-#: solution with the 2 x 2 block at (1, 0) instead of (0, 1) satisfies it to 2e-16 (scipy
-#: 1.15.0 and 1.17.1; presolve off, or the default tolerance, finds it): a false "none".
+#: P-matrix block (planted z = (0.1, 0, 0.1, 0.1, 0.1)) beside TWO_M. At
+#: mip_feasibility_tolerance 1e-9 HiGHS called the "values" MILP (L = M) infeasible although
+#: the solution with the 2 x 2 block at (1, 0) instead of (0, 1) satisfies it to 2e-16 (scipy
+#: 1.17.1 with presolve, 1.15.0 with or without; HiGHS's default tolerance finds it): a false
+#: "none".
 PRESOLVE_M = np.array([[3.856, -1.0, 0.756, -1.0, -1.0], [0.426, 3.9599, -0.83, -1.0, -1.0],
                        [-0.998, -0.808, 2.582, 0.198, 0.478], [-1.0, -0.96, 0.128, 3.5912, -1.0],
                        [-1.0, -1.0, -0.664, 0.878, 3.642]])
@@ -219,7 +220,7 @@ PRESOLVE_Q = np.array([-0.2612, 0.3404, -0.226, -0.17192, -0.2856])
 
 
 @pytest.mark.parametrize("target", ["values", "pattern"])
-def test_milp_does_not_trust_a_presolve_infeasible(target):
+def test_milp_does_not_trust_a_single_infeasible(target):
     M, q = with_two_solution_block(PRESOLVE_M, PRESOLVE_Q)
     z = np.array([0.1, 0.0, 0.1, 0.1, 0.1, 0.0, 1.0])
     assert is_solution(M, q, z)
@@ -230,8 +231,8 @@ def test_milp_does_not_trust_a_presolve_infeasible(target):
 
 
 def test_milp_none_needs_two_infeasible_answers(monkeypatch):
-    """"none" needs HiGHS's "infeasible" with and without presolve; with no time left for the
-    second run, the answer is "unknown"."""
+    """"none" needs HiGHS's "infeasible" at our tolerances and at its defaults; with no time
+    left for the second run, the answer is "unknown"."""
     import rigidlcp.verify.certificates.uniqueness as uq
 
     M, q = np.eye(2), np.array([-1.0, 1.0])  # P-matrix: one solution, z = (1, 0)
