@@ -14,7 +14,7 @@ MILP that is infeasible if no solution has |z|_1 >= S and no nonzero d >= 0 solv
 solution z = zeta / theta, verified by its residual. HiGHS's tolerances can only let
 spurious points in (y within 1e-9 of an integer), never cut real ones out; HiGHS did cut
 one out once (uniqueness.confirmed_milp), so "infeasible" counts only when HiGHS gives it
-at these tolerances and at its defaults, as milp_search's "none": HiGHS's verdict, not a
+at 1e-9 and again at 1e-8, as milp_search's "none": HiGHS's verdict, not a
 checked certificate.
 
 Then |z|_inf <= |z|_1 < S for every solution, and a "none" of milp_search in the box U >= S is a
@@ -87,7 +87,7 @@ def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float
     secs = time.perf_counter() - t0
     if out.status == 2 and runs < 2:
         return NormBound(None, S, secs, "MILP infeasible at tolerance 1e-9; no time left to "
-                         "confirm it at HiGHS's defaults: undecided")
+                         "confirm it at 1e-8: undecided")
     if out.status == 2:
         return NormBound(True, S, secs, f"no solution with |z|_1 >= {S:.3g} (MILP infeasible, "
                          f"{secs:.2f} s)")

@@ -370,13 +370,13 @@ class _Stages:
                 s2 = milp_search(self.M, self.q, self.z, "values", L, delta=1e-2, bound=U,
                                  time_limit=left)  # a clearly different one, if any
                 s = s2 if s2.status == "found" else s
-            rejected = int(s.info.get("rejected_bases", 0))
+            unproved = int(s.info.get("unproved_cuts", 0))  # cuts proved empty by LP are sound
             self.out.log.append(f"milp {v.name}: {s.status}, {s.message}")
             scope = f"0 <= z <= {U:.3g} (box), margin {s.delta:g}"
             w = None if s.other is None else self.witness(s.other, L, "milp")
             if s.status == "found" and w is not None:
                 self.decide(v, OTHER, "milp (c2)", f"MILP: {s.message}", t, w, scope=scope)
-            elif s.status == "none" and rejected == 0:
+            elif s.status == "none" and unproved == 0:
                 prior = f"; {v.reason}" if v.reason else ""
                 left = max(time_limit - (time.perf_counter() - t), 0.5)
                 nb = no_solution_beyond(self.M, self.q, U, time_limit=left)
@@ -386,7 +386,7 @@ class _Stages:
                 self.decide(v, UNIQUE, "milp (c2)", f"MILP infeasible: {s.message}{prior}", t,
                             scope=scope)
             else:
-                why = (f"MILP cut {rejected} unconfirmed bases (a 'none' after cuts is not a "
+                why = (f"MILP cut {unproved} unconfirmed bases (a 'none' after cuts is not a "
                        "proof)" if s.status == "none" else s.message)
                 self.decide(v, UNKNOWN, "milp (c2)",
                             f"tried: face LPs, {len(self.seen)} other solutions seen, MILP: "

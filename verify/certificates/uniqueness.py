@@ -214,8 +214,8 @@ def milp_search(
     MILP's binaries may pick one that rounding made look satisfied); the cut is *proved* only
     if all their LPs are infeasible, and an infeasible MILP after an unproved cut answers
     "unknown", never "none" (a false "unique" is the worst answer a verifier can give).
-    "none" rests on HiGHS's "infeasible", given twice, at our tolerances and at its own
-    (`confirmed_milp`): the MILP solver's verdict, not a certificate this module checks.
+    "none" rests on HiGHS's "infeasible", given twice, at two tolerances (`confirmed_milp`):
+    the MILP solver's verdict, not a certificate this module checks.
     """
     t0 = time.perf_counter()
     M = np.asarray(M, dtype=float)
@@ -325,7 +325,7 @@ def milp_search(
         if out.x is None:
             if out.status == 2 and runs < 2:
                 res.message = ("MILP infeasible at tolerance 1e-9; no time left to confirm "
-                               "it at HiGHS's defaults: unknown")
+                               "it at 1e-8: unknown")
             elif out.status == 2 and unproved:  # a cut that was not proved may hide a solution
                 res.message = (f"MILP infeasible after {rejected} bases were cut, {unproved} of "
                                "them without proof that they hold no other solution: unknown")
@@ -371,19 +371,19 @@ def milp_search(
 
 
 def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, options=None):
-    """(HiGHS's answer, runs). An "infeasible" answer is asked again with HiGHS's default
-    tolerances and no presolve (a relaxation of the tight model: any point it returns is still
-    polished and verified), and stands only if that run agrees (runs = 2). At
-    mip_feasibility_tolerance 1e-9 HiGHS called a feasible model infeasible (the model of
-    test_uniqueness.PRESOLVE_M: scipy 1.15.0 with or without presolve, 1.17.1 with it), which
-    made milp_search answer a false "none". Default bounds [0, 1], options _HIGHS_MILP."""
+    """(HiGHS's answer, runs). "Infeasible" is asked again without presolve at 10 times the
+    mip_feasibility_tolerance (a relaxation; its points are polished), and stands only if that
+    run agrees (runs = 2): at 1e-9 HiGHS called test_uniqueness.PRESOLVE_M infeasible (scipy
+    1.15.0, 1.17.1 with presolve; 1e-8 finds the point; 1e-6 lets in spurious points)."""
     t0 = time.perf_counter()
     runs = 0
     for tight in (True, False):
         left = seconds - (time.perf_counter() - t0)
         if runs and left <= 0:
             break
-        opts = (_HIGHS_MILP if options is None else options) if tight else {"presolve": False}
+        opts = dict(_HIGHS_MILP if options is None else options)
+        if not tight:
+            opts.update(presolve=False, mip_feasibility_tolerance=1e-8)
         with quiet_highs():
             out = milp(c, integrality=integrality, constraints=constraints,
                        bounds=Bounds(0.0, 1.0) if bounds is None else bounds,

@@ -211,7 +211,7 @@ def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
 #: P-matrix block (planted z = (0.1, 0, 0.1, 0.1, 0.1)) beside TWO_M. At
 #: mip_feasibility_tolerance 1e-9 HiGHS called the "values" MILP (L = M) infeasible although
 #: the solution with the 2 x 2 block at (1, 0) instead of (0, 1) satisfies it to 2e-16 (scipy
-#: 1.17.1 with presolve, 1.15.0 with or without; HiGHS's default tolerance finds it): a false
+#: 1.17.1 with presolve, 1.15.0 with or without; at 1e-8 HiGHS finds it): a false
 #: "none".
 PRESOLVE_M = np.array([[3.856, -1.0, 0.756, -1.0, -1.0], [0.426, 3.9599, -0.83, -1.0, -1.0],
                        [-0.998, -0.808, 2.582, 0.198, 0.478], [-1.0, -0.96, 0.128, 3.5912, -1.0],
@@ -231,7 +231,7 @@ def test_milp_does_not_trust_a_single_infeasible(target):
 
 
 def test_milp_none_needs_two_infeasible_answers(monkeypatch):
-    """"none" needs HiGHS's "infeasible" at our tolerances and at its defaults; with no time
+    """"none" needs HiGHS's "infeasible" at 1e-9 and again at 1e-8; with no time
     left for the second run, the answer is "unknown"."""
     import rigidlcp.verify.certificates.uniqueness as uq
 
