@@ -85,6 +85,12 @@ def test_python_blocks_run(path: Path, tmp_path, monkeypatch):
         (tmp_path / data).symlink_to(ROOT / data, target_is_directory=True)
     monkeypatch.chdir(tmp_path)
     monkeypatch.setenv("MPLBACKEND", "Agg")
+    # Blocks may register methods (docs/bench.md registers "mine", whose body is `...`): they
+    # go into a copy of the registry, dropped after the test, so that later tests that run
+    # every registered method do not meet them (they did, in pytest 7.1's collection order).
+    from rigidlcp.lcp import api
+    api._load_builtin_methods()
+    monkeypatch.setattr(api, "_REGISTRY", dict(api._REGISTRY))
     namespace: dict = {"__name__": f"docs_{path.stem}"}
     ran = 0
     for line, c, why in code:
