@@ -144,10 +144,10 @@ def measure(M: np.ndarray, q: np.ndarray, z: np.ndarray, Mz: np.ndarray
             ) -> tuple[float, float, float, float] | None:
     """lcp.residual's measure after numpy's Mz = M.dot(z), in C: Mz becomes w = M z + q, and
     (max|min(z, w)|, scaled residual, z_s, w_s) is returned, the row sums of |M| summed in
-    numpy's order (checked once on a probe: `sums_as_numpy`). None -- Mz untouched -- when not
-    compiled or switched off, when numpy sums otherwise, or when an input is not a finite
-    float64 C-contiguous array of the right size (the numpy code measures then)."""
-    if not _use or not (_sums_ok if _sums_ok is not None else sums_as_numpy()):
+    numpy's order (checked once on a probe: `sums_verified_upto`). None -- Mz untouched -- when
+    not compiled or switched off, when rows are longer than the probe verified, or when an
+    input is not a finite float64 C-contiguous array of the right size (numpy measures then)."""
+    if not _use or M.shape[-1] > sums_verified_upto():
         return None
     return _lemke_c.lcp_measure(M, q, z, Mz)
 
@@ -157,31 +157,44 @@ def measure_batch(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, MZ: np.ndarray
     """`measure` of k problems at once (Ms: k x n x n, qs, Z, MZ: k x n): a k x 4 array of
     (residual, scaled residual, z_s, w_s), NaN in the rows of problems not measured (MZ[p]
     untouched there; the others become w = M z + q); None where `measure` gives None for all."""
-    if not _use or not (_sums_ok if _sums_ok is not None else sums_as_numpy()):
+    if not _use or qs.shape[-1] > sums_verified_upto():
         return None
     out = np.empty((qs.shape[0], 4))
     return out if _lemke_c.lcp_measure_batch(Ms, qs, Z, MZ, out) else None
 
 
-_sums_ok: bool | None = None
+#: Row lengths the probe tries, in increasing order.
+PROBE_SIZES = (*range(1, 20), 31, 64, 100, 127, 128, 129, 200, 255, 300, 1000, 4099, 10007)
+_sums_upto: int | None = None
+
+
+def sums_verified_upto() -> int:
+    """The longest row for which the C row sum of |M| is known to round as numpy's
+    np.add.reduce(np.abs(M), axis=1): rows of the lengths PROBE_SIZES, whose terms span 120
+    binary orders of magnitude with varied mantissas and signs (any other order of summation
+    shows), are summed both ways in increasing length until one differs; the last length that
+    agreed is remembered (0: none). numpy's pairwise order for very long rows differs between
+    its versions (numpy 1.24-2.2 differ from 2.3+ at 10007), so `measure` uses C only up to
+    this length. (No numpy.random: importing it would cost more than the probe.)"""
+    global _sums_upto
+    if _sums_upto is None:
+        upto = 0
+        for n in PROBE_SIZES:
+            k = np.arange(2 * n).reshape(2, n)
+            P = np.exp2((k * 7919 % 241 - 120).astype(float)) * (1.0 + (k * 31 % 17) / 17.0)
+            P[:, 1::3] *= -1.0
+            out = np.empty(2)
+            _lemke_c.abs_row_sums(P, out, n)
+            if not np.array_equal(out, np.add.reduce(np.abs(P), axis=1)):
+                break
+            upto = n
+        _sums_upto = upto
+    return _sums_upto
 
 
 def sums_as_numpy() -> bool:
-    """Does the C row sum of |M| round as numpy's np.add.reduce(np.abs(M), axis=1)? Checked
-    once, on rows of lengths 1..10007 whose terms span 120 binary orders of magnitude with
-    varied mantissas and signs (any other order of summation shows), and remembered. (No
-    numpy.random: importing it would cost more than the probe.)"""
-    global _sums_ok
-    ok = True
-    for n in (*range(1, 20), 31, 64, 100, 127, 128, 129, 200, 255, 300, 1000, 4099, 10007):
-        k = np.arange(2 * n).reshape(2, n)
-        P = np.exp2((k * 7919 % 241 - 120).astype(float)) * (1.0 + (k * 31 % 17) / 17.0)
-        P[:, 1::3] *= -1.0
-        out = np.empty(2)
-        _lemke_c.abs_row_sums(P, out, n)
-        ok = ok and np.array_equal(out, np.add.reduce(np.abs(P), axis=1))
-    _sums_ok = ok
-    return ok
+    """Whether the C row sums round as numpy's at every probed length (`sums_verified_upto`)."""
+    return sums_verified_upto() >= PROBE_SIZES[-1]
 
 
 def solve_one(M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float, max_iter: int):
