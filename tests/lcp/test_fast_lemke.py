@@ -66,18 +66,23 @@ def assert_same_answer(problem):
 
 
 @st.composite
-def random_lcps(draw, max_n: int = 12):
-    """Random, PSD, badly scaled (rows, columns and q over many decades) and extreme
-    problems."""
+def random_lcps(draw, max_n: int = 12,
+                kinds: tuple[str, ...] = ("general", "psd", "scaled", "extreme", "q>=0")):
+    """Random, PSD, P-matrix (non-symmetric: diagonally dominant or triangular), badly scaled
+    (rows, columns and q over many decades) and extreme problems (of the given kinds)."""
     n = draw(st.integers(1, max_n))
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
-    kind = draw(st.sampled_from(["general", "psd", "scaled", "extreme", "q>=0"]))
+    kind = draw(st.sampled_from(kinds))
     A = rng.standard_normal((n, n))
     q = rng.standard_normal(n)
     if kind == "general":
         M = A
     elif kind == "psd":
         M = A @ A.T + 0.1 * np.eye(n)
+    elif kind == "p-dominant":
+        M = A + np.diag(np.abs(A).sum(axis=1) + 0.1)
+    elif kind == "p-triangular":
+        M = np.triu(A, 1) + np.diag(np.exp(rng.uniform(-3, 3, n)))
     elif kind == "scaled":
         D = np.exp(rng.uniform(-20, 20, n))
         M = D[:, None] * (A @ A.T + np.eye(n)) * D[None, :]

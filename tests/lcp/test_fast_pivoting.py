@@ -9,14 +9,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
 from rigidlcp.lcp import api, fast_pivoting
 from rigidlcp.lcp.solution import Solution
 
-from .test_fast_lemke import outcome, same
+from .test_fast_lemke import outcome, random_lcps, same
 from .test_lemke import degenerate_integer_lcps
 
 compiled = pytest.mark.skipif(not fast_pivoting.applies(),
@@ -57,34 +56,11 @@ def assert_same_answer(problem, plain: bool = True) -> Solution | None:
     return own
 
 
-@st.composite
-def problems(draw, max_n: int = 30):
+def problems(max_n: int = 30):
     """Random, PSD, P-matrix (non-symmetric, diagonally dominant or triangular), badly scaled
     (rows, columns and q over many decades) and extreme problems."""
-    n = draw(st.integers(1, max_n))
-    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
-    kind = draw(st.sampled_from(["general", "psd", "p-dominant", "p-triangular", "scaled",
-                                 "extreme", "q>=0"]))
-    A = rng.standard_normal((n, n))
-    q = rng.standard_normal(n)
-    if kind == "general":
-        M = A
-    elif kind == "psd":
-        M = A @ A.T + 0.1 * np.eye(n)
-    elif kind == "p-dominant":
-        M = A + np.diag(np.abs(A).sum(axis=1) + 0.1)
-    elif kind == "p-triangular":
-        M = np.triu(A, 1) + np.diag(np.exp(rng.uniform(-3, 3, n)))
-    elif kind == "scaled":
-        D = np.exp(rng.uniform(-20, 20, n))
-        M = D[:, None] * (A @ A.T + np.eye(n)) * D[None, :]
-        q = q * np.exp(rng.uniform(-20, 20))
-    elif kind == "extreme":
-        M = (A @ A.T + np.eye(n)) * 10.0 ** rng.uniform(-150, 150)
-        q = q * 10.0 ** rng.uniform(-150, 150)
-    else:
-        M, q = A, np.abs(q)
-    return M, q
+    return random_lcps(max_n, kinds=("general", "psd", "p-dominant", "p-triangular", "scaled",
+                                     "extreme", "q>=0"))
 
 
 @compiled
