@@ -35,6 +35,18 @@ def test_lemke_solve_loads_only_lemke():
         assert "scipy.linalg" not in mods
 
 
+def test_a_dense_run_loads_no_sparse_lu_and_no_qp_stack():
+    """models.simulate on the dense backend (the README's job): no sparse LU, no HiGHS MILP
+    machinery, no cvxpy/Clarabel/OSQP, no plotting."""
+    mods = loaded_after("from rigidlcp import models\n"
+                        "s = models.System(models.make_lattice('rect', 4, 2))\n"
+                        "models.simulate(s, seed=1, max_events=5)")
+    assert "rigidlcp.models.engine.dense" in mods
+    assert not {"scipy.sparse.linalg", "rigidlcp.lcp.state_factor",
+                "rigidlcp.models.engine.sparse"} & mods
+    assert not {m for m in mods if m.startswith(HEAVY)}
+
+
 def test_cli_parser_loads_no_scipy():
     mods = loaded_after("import importlib\n"
                         "importlib.import_module('rigidlcp.cli.main').build_parser()")

@@ -14,7 +14,6 @@ from rigidlcp.models.system import System
 from .dense import DenseBackend
 from .loop import Limits, run_events
 from .records import Run
-from .sparse import SparseBackend
 
 
 def simulate(
@@ -60,6 +59,9 @@ def simulate(
                              "use select='none'")
         if dump_dir is not None:
             raise ValueError("method 'sparse-pivoting' does not dump problems (dump_dir)")
+        # imported here: a dense run needs no sparse LU (scipy.sparse.linalg, ~0.1 s to load)
+        from .sparse import SparseBackend
+
         backend = SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback)
     else:
         backend = DenseBackend(system, dyn, method=method, fallback=fallback, select=select,
