@@ -88,13 +88,11 @@ static int hs_add(HashSet *h, int64_t key)
 }
 
 /* ------------------------------------------------------------------ the rank-one update */
-/* T[:, c] += col * row[c] for every c with row[c] != 0. OpenBLAS's optimized ?ger kernels
- * (Haswell and later: chosen at run time on CPUs with AVX2 and FMA) compute each entry as one
- * fused multiply-add; the numpy loop of lemke.py calls them. `use_fma` (on when the CPU has
- * AVX2 and FMA, see fma_available; set_fma overrides it) picks the same rounding, so that
- * both loops see the same numbers and take the same pivots (a test checks it against dger). */
-static int use_fma = -1; /* -1: not decided yet */
-
+/* T[:, c] += col * row[c] for every c with row[c] != 0, each entry rounded twice (the product,
+ * then the sum: no fused multiply-add, -ffp-contract=off), as the numpy loop of lemke.py does
+ * with np.multiply and np.add. So both loops see the same numbers and take the same pivots on
+ * every CPU, whatever BLAS kernel the machine has (OpenBLAS's ?ger kernels fuse some entries
+ * and not others: Haswell's fuses blocks of 16 rows and rounds the remainder twice). */
 static void update_plain(double *T, const double *col, const double *row, idx n, idx m)
 {
     for (idx c = 0; c < m; c++) {
@@ -106,43 +104,23 @@ static void update_plain(double *T, const double *col, const double *row, idx n,
 }
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-#define HAVE_FMA_TARGET 1
-__attribute__((target("fma"))) static void update_fma(double *T, const double *col,
-                                                      const double *row, idx n, idx m)
+#define HAVE_AVX2_CLONE 1
+/* The same loop vectorized 4 wide: each lane rounds the product and the sum as the scalar
+ * loop does (AVX2 without FMA), so the numbers are the same, only sooner. */
+__attribute__((target("avx2"))) static void update_avx2(double *T, const double *col,
+                                                       const double *row, idx n, idx m)
 {
     for (idx c = 0; c < m; c++) {
         double rc = row[c];
         if (rc == 0.0) continue;
         double *Tc = T + n * c;
-        for (idx i = 0; i < n; i++) Tc[i] = __builtin_fma(col[i], rc, Tc[i]);
+        for (idx i = 0; i < n; i++) Tc[i] += col[i] * rc;
     }
 }
-#elif defined(__FP_FAST_FMA) || defined(__aarch64__)
-#define HAVE_FMA_TARGET 1
-static void update_fma(double *T, const double *col, const double *row, idx n, idx m)
-{
-    for (idx c = 0; c < m; c++) {
-        double rc = row[c];
-        if (rc == 0.0) continue;
-        double *Tc = T + n * c;
-        for (idx i = 0; i < n; i++) Tc[i] = __builtin_fma(col[i], rc, Tc[i]);
-    }
-}
+static int use_avx2 = -1; /* -1: not decided yet */
 #else
-#define HAVE_FMA_TARGET 0
+#define HAVE_AVX2_CLONE 0
 #endif
-
-static int fma_available(void)
-{
-#if HAVE_FMA_TARGET && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-    __builtin_cpu_init(); /* OpenBLAS's FMA kernels (Haswell, Zen, SkylakeX) need AVX2 too */
-    return __builtin_cpu_supports("fma") && __builtin_cpu_supports("avx2");
-#elif HAVE_FMA_TARGET
-    return 1;
-#else
-    return 0;
-#endif
-}
 
 /* ------------------------------------------------------------------ the pivot */
 static int64_t pivot(Lemke *L, idx r, idx s)
@@ -158,10 +136,13 @@ static int64_t pivot(Lemke *L, idx r, idx s)
     for (idx c = 0; c < m; c++) T[r + n * c] = 0.0;
     memset(Ts, 0, n * sizeof(double));
     col[r] = 1.0;
-#if HAVE_FMA_TARGET
-    if (use_fma < 0) use_fma = fma_available();
-    if (use_fma)
-        update_fma(T, col, row, n, m);
+#if HAVE_AVX2_CLONE
+    if (use_avx2 < 0) {
+        __builtin_cpu_init();
+        use_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    if (use_avx2)
+        update_avx2(T, col, row, n, m);
     else
 #endif
         update_plain(T, col, row, n, m);
@@ -548,21 +529,6 @@ static PyObject *py_check(PyObject *self, PyObject *args)
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vq);
     return Py_BuildValue("Od", acc == 0.0 ? Py_True : Py_False, qmin);
-}
-
-/* set_fma(flag) -> bool: use fused multiply-adds in the update (only if the CPU has them);
- * returns the setting in force (set_fma(None) only asks). */
-static PyObject *py_set_fma(PyObject *self, PyObject *arg)
-{
-    (void)self;
-    if (arg == Py_None) { /* query only */
-        if (use_fma < 0) use_fma = fma_available();
-        return PyBool_FromLong(use_fma);
-    }
-    int flag = PyObject_IsTrue(arg);
-    if (flag < 0) return NULL;
-    use_fma = flag && fma_available();
-    return PyBool_FromLong(use_fma);
 }
 
 /* ------------------------------------------------------------------ one whole problem */
@@ -1168,7 +1134,6 @@ static PyMethodDef methods[] = {
      "lcp_measure_batch(Ms, qs, Z, MZ, out) -> bool: lcp_measure of k problems."},
     {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
      "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
-    {"set_fma", py_set_fma, METH_O, "set_fma(flag) -> bool: fused multiply-adds in the update."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
     {"setup", py_setup, METH_VARARGS,
      "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},

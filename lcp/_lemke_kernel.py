@@ -47,26 +47,6 @@ def use_compiled(flag: bool) -> bool:
     return previous
 
 
-def blas_uses_fma() -> bool:
-    """Does scipy's BLAS `dger` (the numpy loop's update) round each entry once, as a fused
-    multiply-add? The C update does so when the CPU has AVX2 and FMA, as OpenBLAS's kernels do;
-    tests/lcp/test_lemke_kernel.py checks the two agree on the machine at hand."""
-    from scipy.linalg.blas import dger
-
-    rng = np.random.default_rng(0)
-    A = np.asfortranarray(rng.standard_normal((67, 5)))
-    x, y = rng.standard_normal(67), rng.standard_normal(5)
-    plain = A + np.outer(x, y)
-    dger(1.0, x, y, 1, 1, A, 1, 1, 1)
-    return not np.array_equal(A, plain)
-
-
-def set_fma(flag: bool | None) -> bool:
-    """Round the C update with fused multiply-adds (only if the CPU has them); returns the
-    setting in force (None: only ask)."""
-    return _lemke_c.set_fma(flag)
-
-
 def run(lemke_run, max_iter: int):
     """`_Lemke.run` in C: the pivots on `lemke_run`'s dictionary, then its outcome (solution,
     ray, pivot limit, cycling) built by its own methods. Its bookkeeping becomes int64 arrays,

@@ -13,11 +13,12 @@ variable (a secondary ray).
 
 Implementation: a dense *dictionary* (compact tableau) x_B = beta + T x_N, stored as one
 Fortran-ordered n x (n + 2) array whose columns are the n + 1 nonbasic variables and beta. A
-pivot is one in-place rank-one update of that array (BLAS ``dger``), O(n^2) with no Python
-loop over rows. The ratio test needs only the entering column and beta; the lexicographic
-tie-break (Cottle-Pang-Stone Sec. 4.9) needs the rows of B^-1 of the tied rows only, and those
-are read from the w columns of the dictionary when (rarely) needed. Details and equations:
-docs/lemke.md.
+pivot is one in-place rank-one update of that array, O(n^2) with no Python loop over rows,
+each entry rounded twice (product, then sum; no fused multiply-add), in C (lcp/_lemke_c.c)
+or by numpy, so that both give the same numbers on every CPU. The ratio test needs only the
+entering column and beta; the lexicographic tie-break (Cottle-Pang-Stone Sec. 4.9) needs
+the rows of B^-1 of the tied rows only, and those are read from the w columns of the
+dictionary when (rarely) needed. Details and equations: docs/lemke.md.
 """
 
 from __future__ import annotations
@@ -33,11 +34,6 @@ from .solution import Solution
 
 #: Zero tolerance, relative to data normalized to max|M| = max|q| = max d = 1.
 DEFAULT_TOL = 1e-10
-#: Elements per ``dger`` call. OpenBLAS multithreads ?ger above 2304 * 4 = 9216 elements; on a
-#: busy machine one threaded call can take milliseconds instead of microseconds, so the update
-#: is issued in column chunks that stay single-threaded (see docs/lemke.md, "Speed").
-_GER_CHUNK = 8192
-
 _EPS = np.finfo(float).eps
 
 
@@ -172,21 +168,6 @@ class _Lemke:
         self.basic_np, self.slot_np = np.array(self.basic), np.array(self.slot_of)  # mirrors
 
     # -- the pivot -------------------------------------------------------------------------
-    @property
-    def chunks(self) -> list[tuple[np.ndarray, np.ndarray]]:
-        """Column blocks of T (and of the pivot row buffer) for `dger` (numpy loop only)."""
-        if not hasattr(self, "_chunks"):
-            from scipy.linalg.blas import dger  # here: the compiled loop needs no scipy.linalg
-
-            self.dger = dger
-            n, T = self.n, self.T
-            self.row = np.empty(n + 2)  # the pivot row buffer
-            step = max(1, _GER_CHUNK // n)
-            assert T.flags.f_contiguous  # dger updates the column chunks in place
-            self._chunks = [(self.row[j:j + step], T[:, j:j + step])
-                            for j in range(0, n + 2, step)]
-        return self._chunks
-
     def pivot(self, r: int, s: int) -> int:
         """Exchange basic row r with nonbasic slot s; return the variable that left.
 
@@ -194,21 +175,24 @@ class _Lemke:
         row i gets T[i, c] + T[i, s] * newrow[c] (c != s) and T[i, s] / p in slot s: one
         rank-one update after zeroing row r and column s (with the column's entry at r = 1).
         """
-        T, chunks = self.T, self.chunks
+        T = self.T
         if self.trace is not None:
             self.trace.append((r, s))
         colview = T[:, s]
         col = colview.copy()
         p = col[r]
-        row = self.row
-        np.multiply(T[r, :], -1.0 / p, out=row)
+        row = T[r, :] * (-1.0 / p)
         row[s] = 1.0 / p
         T[r, :] = 0.0
         colview.fill(0.0)
         col[r] = 1.0
-        dger = self.dger
-        for rv, tv in chunks:
-            dger(1.0, col, rv, 1, 1, tv, 1, 1, 1)  # tv += col rv^T, in place
+        # T[:, c] += col row[c] where row[c] != 0 (as the C loop: a zero adds nothing), the
+        # product and the sum rounded separately
+        nz = np.flatnonzero(row)
+        if nz.size == row.size:
+            T += np.multiply.outer(col, row)
+        else:
+            T[:, nz] += np.multiply.outer(col, row[nz])
         entering = self.nonbasic[s]
         leaving = self.basic[r]
         self.basic[r] = entering

@@ -432,14 +432,17 @@ def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
     assert sol.info["tol_used"] == pytest.approx(1e-8) and "restarted" in sol.message
 
 
-def test_real_event_that_cycles_at_the_default_tolerance():
-    """Event 252 of `rigidlcp simulate --lx 20 --ly 10 --gamma 0.16 --seed 1` (n = 720): at
-    tol = 1e-10 rounding defeats the lexicographic rule and a basis repeats after 766 pivots
-    (before the check, Lemke ran to its 73000-pivot limit); with ties at 1e-8 it is solved."""
+def test_real_event_that_cycles_at_a_fine_tolerance():
+    """Event 252 of `rigidlcp simulate --lx 20 --ly 10 --gamma 0.16 --seed 1` (n = 720), raw
+    data: at tol = 1e-12 rounding defeats the lexicographic rule and a basis repeats (before
+    the check, Lemke ran to its pivot limit); the restart with ties at 1e-10 solves it, as
+    does the default tolerance directly."""
     from pathlib import Path
 
     P = lcp.load(Path(__file__).parent.parent / "data" / "event_rect20x10_cycling.npz")
-    sol = lcp.solve(P, "lemke", equilibrate=False)  # the raw data, where rounding bites
+    sol = lcp.solve(P, "lemke", equilibrate=False, tol=1e-12)  # the raw data, where rounding bites
     assert sol.success and sol.residual < 1e-9
-    assert sol.info.get("tol_used") == pytest.approx(1e-8)
+    assert "numerical cycling" in sol.message and "restarted" in sol.message
+    assert sol.info.get("tol_used") == pytest.approx(1e-10)
+    assert lcp.solve(P, "lemke", equilibrate=False).success
     assert lcp.solve(P, "lemke").success  # equilibrated (the default)

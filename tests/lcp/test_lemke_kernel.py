@@ -89,22 +89,47 @@ def test_same_pivot_limit():
     assert sol.status == "max_iter" and sol.iterations == 50
 
 
-def test_update_rounds_like_the_blas_of_the_numpy_loop():
-    """The C update uses a fused multiply-add exactly when scipy's dger does (probed)."""
-    from rigidlcp.lcp import _lemke_c
+def test_update_rounds_product_and_sum_separately():
+    """Both loops round each entry of the rank-one update twice (product, then sum; no fused
+    multiply-add), on any CPU: one pivot of a 67 x 67 problem (OpenBLAS's Haswell dger fuses
+    blocks of 16 rows and rounds the other 3 twice, so a BLAS-shaped rule differs somewhere)
+    gives T + outer(col, row) as numpy rounds it, and that differs from the fused result."""
+    from fractions import Fraction
 
-    assert _lemke_c.set_fma(None) == kernel.blas_uses_fma()
-    A = np.asfortranarray(np.random.default_rng(1).standard_normal((9, 9)))
-    M, q = A @ A.T, -np.ones(9)
-    assert_same(M, q)
+    rng = np.random.default_rng(1)
+    n = 67
+    M, q, d = rng.standard_normal((n, n)), -rng.uniform(0.5, 1.5, n), rng.uniform(0.5, 2, n)
+    r = int(np.argmin(q / d))  # z0 enters (slot n); the row of min q_i / d_i leaves
+    for compiled in (True, False):
+        previous = kernel.use_compiled(compiled)
+        try:
+            L = _Lemke(M, q, d, 1e-10)
+            T0 = L.T.copy()
+            sol = L.run(1)
+        finally:
+            kernel.use_compiled(previous)
+        assert sol.status == "max_iter" and sol.iterations == 1
+        col = T0[:, n].copy()
+        row = T0[r, :] * (-1.0 / col[r])
+        row[n] = 1.0 / col[r]
+        T = T0.copy()
+        T[r, :] = 0.0
+        T[:, n] = 0.0
+        col[r] = 1.0
+        fused = np.array([[float(Fraction(T[i, c]) + Fraction(col[i]) * Fraction(row[c]))
+                           for c in range(n + 2)] for i in range(n)])
+        T += np.multiply.outer(col, row)
+        np.testing.assert_array_equal(L.T, T)
+        assert (T != fused).any()  # the rule is not vacuous here
 
 
 def test_real_event_cycles_in_both_loops():
-    """The event of test_lemke.py whose basis repeats at tol = 1e-10 after 766 pivots: the
-    compiled loop finds the same repeat (its rounding matches the BLAS of the numpy loop)."""
+    """The event of test_lemke.py whose basis repeats at a fine tolerance (rounding defeats the
+    lexicographic rule; at tol = 1e-12 with the update rounded twice): the compiled loop finds
+    the same repeat after the same pivots."""
     P = lcp.load(Path(__file__).parent.parent / "data" / "event_rect20x10_cycling.npz")
-    sol = assert_same(P.M, P.q)
-    assert sol.info.get("cycling") and sol.iterations == 766
+    sol = assert_same(P.M, P.q, tol=1e-12)
+    assert sol.info.get("cycling")
 
 
 def test_switch():
