@@ -26,25 +26,33 @@ from .api import check_options, get_method, solve
 from .problem import LCP, MLCP, InvalidProblem
 from .solution import Solution, solved_lcp
 
+#: Methods whose batch path runs the whole loop over the problems in compiled code (the others
+#: are a loop of their Python function with one lookup and one option check).
+COMPILED_BATCH = ("lemke",)
+
 
 def solve_many(
     problems: Sequence[LCP | MLCP] | tuple[np.ndarray, np.ndarray],
     method: str = "lemke",
+    *,
+    repair: bool = True,
     **options,
 ) -> list[Solution]:
     """Solve a list of LCPs (w = M z + q, 0 <= z perp w >= 0) by one method.
 
     problems: a sequence of `lcp.LCP` (stacked by size: the fast path), `lcp.MLCP` or
     `lcp.FrictionContact2D` (solved one by one by `lcp.solve`), or a pair (Ms, qs) of stacked
-    arrays of shapes (k, n, n) and (k, n). options: the method's options, the same for every
-    problem. Returns one Solution per problem, in order, each as `lcp.solve` would return it.
+    arrays of shapes (k, n, n) and (k, n). repair: as `lcp.solve`'s, for the problems the
+    batch loop hands to `lcp.solve` (with repair=False every answer is the method's own,
+    checked). options: the method's options, the same for every problem. Returns one Solution
+    per problem, in order, each as `lcp.solve(p, method, repair=repair, **options)` would.
     """
     info = get_method(method)
     check_options(info, options)
     if isinstance(problems, tuple) and len(problems) == 2 and not isinstance(
             problems[0], (LCP, MLCP)):
         Ms, qs = _stacked(*problems)
-        return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]))
+        return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]), repair)
     from .friction import FrictionContact2D
 
     problems = list(problems)
@@ -58,14 +66,15 @@ def solve_many(
         if not isinstance(p, LCP) or not p.M.flags.c_contiguous:
             # MLCP (u, reductions), friction problem, or an M in Fortran order (numpy's M z
             # rounds otherwise than on the stacked C-ordered copy): one by one
-            out[i] = solve(p, method, **options)
+            out[i] = solve(p, method, repair=repair, **options)
         else:
             groups.setdefault(p.q.size, []).append(i)
     for idx in groups.values():  # LCPs are validated at construction: stack them as they are
         n = problems[idx[0]].q.size
         Ms = np.concatenate([problems[i].M for i in idx]).reshape(len(idx), n, n)
         qs = np.concatenate([problems[i].q for i in idx]).reshape(len(idx), n)
-        sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]])
+        sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]],
+                            repair)
         for i, sol in zip(idx, sols):
             out[i] = sol
     return out  # type: ignore[return-value]
@@ -90,7 +99,7 @@ def _stacked(Ms, qs) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
-                 problem_of) -> list[Solution]:
+                 problem_of, repair: bool = True) -> list[Solution]:
     """Solve the stacked (validated, finite) problems; problem_of(i) is problem i as an LCP
     (built only when a problem must be solved one by one). As `solve` does (lcp.trust): the
     method runs on the Ruiz-equilibrated data when it is registered so, and each answer is
@@ -103,7 +112,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     info = get_method(method)
     on = info.equilibrate
     if method == "lemke" and k and _kernel.enabled() and info.func is _builtin_lemke():
-        return _lemke_batch(Ms, qs, on, options, problem_of)
+        return _lemke_batch(Ms, qs, on, options, problem_of, repair)
     eqs = [ruiz(Ms[i], qs[i]) for i in range(k)] if on else None
     Mr = np.stack([e.M for e in eqs]) if eqs else Ms
     qr = np.stack([e.q for e in eqs]) if eqs else qs
@@ -124,7 +133,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
                 sol.info["equilibrated"] = on
                 out.append(sol)
                 continue
-        out.append(solve(problem_of(i), method, **options))
+        out.append(solve(problem_of(i), method, repair=repair, **options))
     return out
 
 
@@ -134,8 +143,8 @@ def _builtin_lemke():
     return lemke
 
 
-def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of
-                 ) -> list[Solution]:
+def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of,
+                 repair: bool = True) -> list[Solution]:
     """`solve`'s first attempt for every problem in C (lcp.fast_lemke's steps: the
     equilibration of a balanced M, Lemke, z back; `_kernel.solve_batch`), then its check,
     lcp.residual's measure, for all at once (`_kernel.measure_batch`: M z by numpy, the rest in
@@ -159,7 +168,7 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
         W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
     measured = _kernel.measure_batch(Ms, qs, Z, W)
     if measured is None:  # not compiled as numpy sums: measure one by one
-        return [solve(problem_of(i), "lemke", **options) for i in range(k)]
+        return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
     rows, cols = np.nonzero(basic)  # the basis of problem i: cols[ends[i - 1]:ends[i]]
     ends = [0, *np.cumsum(np.bincount(rows, minlength=k)).tolist()]
     sols: list[Solution] = []
@@ -171,5 +180,5 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
                                    "" if piv else "q >= 0: z = 0 solves the LCP",
                                    {"equilibrated": on}))
         else:  # see the docstring: the single call gives the answer and its evidence
-            sols.append(solve(problem_of(i), "lemke", **options))
+            sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
     return sols

@@ -15,10 +15,11 @@ and judges each answer with what is known *without the solvers*:
   ``info["exception"]``): crash.
 
 It prints a table class x method (solved / honest failure / refused / crash / SILENT WRONG,
-median time per solve) and writes every silent-wrong or crashing case to OUT as
-`<class>-<seed>-<method>.npz` (an `lcp.LCP` file with the verdict in its meta), which
-tests/lcp/test_fuzz_regressions.py loads. Run: `python -m rigidlcp.bench.fuzz --count N
---seed S --out DIR` (CLI: `rigidlcp fuzz`).
+median time per solve; lemke solves CHUNK cases at a time in one `lcp.solve_many` call,
+the same answers as one call each, its time per solve being that call's mean) and writes
+every silent-wrong or crashing case to OUT as `<class>-<seed>-<method>.npz` (an `lcp.LCP`
+file with the verdict in its meta), which tests/lcp/test_fuzz_regressions.py loads.
+Run: `python -m rigidlcp.bench.fuzz --count N --seed S --out DIR` (CLI: `rigidlcp fuzz`).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidlcp import lcp
+from rigidlcp.lcp.batch import COMPILED_BATCH
 from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
@@ -44,6 +46,9 @@ TOL = 1e-8
 #: Options per method, to bound the time of slow iterations (pgs sweeps in pure Python).
 OPTIONS = {"pgs": {"max_iter": 2000}}
 OUTCOMES = ("solved", "honest", "refused", "crash", "WRONG")
+#: Cases drawn at a time: the methods with a compiled batch path (lcp.batch.COMPILED_BATCH:
+#: lemke) solve them in one lcp.solve_many call; the others one by one.
+CHUNK = 64
 
 
 def judge_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
@@ -110,8 +115,26 @@ def attempt(problem, method: str) -> tuple[lcp.Solution | None, dict]:
     return sol, {"seconds": seconds, "status": sol.status}
 
 
-def run_case(case: Case, method: str) -> dict:
-    sol, res = attempt(lcp.LCP(case.M, case.q), method)
+def batch_attempt(cases: list[Case], method: str) -> list[tuple[lcp.Solution, dict]] | None:
+    """`attempt` for many cases in one `lcp.solve_many` call (the same answers as one call
+    each; the time of each is the call's mean). None when the call raised or any answer
+    carries an exception: the cases are then attempted one by one, so that a crash is
+    attributed to its case."""
+    problems = [lcp.LCP(c.M, c.q) for c in cases]
+    t0 = time.perf_counter()
+    try:
+        sols = lcp.solve_many(problems, method, **OPTIONS.get(method, {}))
+    except Exception:  # noqa: BLE001 - one by one instead
+        return None
+    mean = (time.perf_counter() - t0) / max(len(cases), 1)
+    if any("exception" in sol.info for sol in sols):
+        return None
+    return [(sol, {"seconds": mean, "status": sol.status}) for sol in sols]
+
+
+def run_case(case: Case, method: str, done: tuple | None = None) -> dict:
+    """Attempt and judge one case (`done`: its (solution, result) from `batch_attempt`)."""
+    sol, res = done if done is not None else attempt(lcp.LCP(case.M, case.q), method)
     if sol is not None:
         res["outcome"], res["reason"] = judge(case, sol.status, sol.z)
     return res
@@ -135,21 +158,25 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
     out_dir = Path(out) if out is not None else None
     table: dict = defaultdict(lambda: {**{o: 0 for o in OUTCOMES}, "seconds": []})
     saved: list[Path] = []
-    for k in range(count):
-        kind = classes[k % len(classes)]
-        case = make_case(kind, seed * 1_000_003 + k)
-        for method in names:
-            if method in exhaustive and case.n > ENUM_MAX_N:
-                continue
-            res = run_case(case, method)
-            cell = table[(kind, method)]
-            cell[res["outcome"]] += 1
-            cell["seconds"].append(res["seconds"])
-            if res["outcome"] in ("WRONG", "crash") and out_dir is not None:
-                saved.append(save_case(case, method, res, out_dir))
-        if progress is not None:
-            progress(k + 1, {"table": dict(table), "saved": saved, "count": k + 1,
-                             "seed": seed})
+    for start in range(0, count, CHUNK):
+        cases = [make_case(classes[k % len(classes)], seed * 1_000_003 + k)
+                 for k in range(start, min(count, start + CHUNK))]
+        batched = {m: batch_attempt(cases, m) for m in names if m in COMPILED_BATCH}
+        for j, case in enumerate(cases):
+            k = start + j
+            for method in names:
+                if method in exhaustive and case.n > ENUM_MAX_N:
+                    continue
+                done = batched[method][j] if batched.get(method) else None
+                res = run_case(case, method, done)
+                cell = table[(case.kind, method)]
+                cell[res["outcome"]] += 1
+                cell["seconds"].append(res["seconds"])
+                if res["outcome"] in ("WRONG", "crash") and out_dir is not None:
+                    saved.append(save_case(case, method, res, out_dir))
+            if progress is not None:
+                progress(k + 1, {"table": dict(table), "saved": saved, "count": k + 1,
+                                 "seed": seed})
     return {"table": dict(table), "saved": saved, "count": count, "seed": seed}
 
 

@@ -179,6 +179,7 @@ def run_bench(
     sets: dict[str, list[LCP | MLCP]], methods: Iterable[str], *, time_limit: float = 10.0,
     tol: float = 1e-8, isolate: bool = True, siconos: SiconosRunner | None = None,
     progress: Callable[[Result], None] | None = None, grace: float = GRACE,
+    batch: bool = True,
 ) -> list[Result]:
     """Run every method on every problem of `sets` ({set name: problems}); one Result each.
 
@@ -186,6 +187,10 @@ def run_bench(
     an available SiconosRunner). An unknown name raises ValueError before anything runs.
     time_limit: seconds per solve; grace: extra seconds allowed for passing data to and from
     the worker before it is killed (a solve measured above time_limit fails either way).
+    batch: the LCPs of a set that share a size are given to a method with a compiled batch
+    path (lcp.batch.COMPILED_BATCH: lemke) in one `lcp.solve_many` call, each timed as the
+    batch's mean (message "batch of k"); a batch that fails or overruns k time limits is
+    solved one problem at a time instead.
     """
     methods = list(methods)
     known = {m.name for m in lcp.methods()}
@@ -203,6 +208,7 @@ def run_bench(
     results: list[Result] = []
     try:
         for set_name, problems in sets.items():
+            batched = _batched_answers(local, problems, methods, time_limit) if batch else {}
             for problem in problems:
                 if isinstance(problem, Unreadable):
                     results.append(judge(problem, "-", set_name, {}, time_limit, tol))
@@ -211,7 +217,8 @@ def run_bench(
                     continue
                 for method in methods:
                     runner = siconos if method in SICONOS_METHODS else local
-                    raw = runner.solve(problem, method, time_limit)
+                    raw = batched.get((id(problem), method)) or runner.solve(
+                        problem, method, time_limit)
                     r = judge(problem, method, set_name, raw, time_limit, tol)
                     results.append(r)
                     if progress is not None:
@@ -219,6 +226,27 @@ def run_bench(
     finally:
         local.close()
     return results
+
+
+def _batched_answers(local: LocalRunner, problems: list, methods: list[str],
+                     time_limit: float) -> dict:
+    """{(id(problem), method): raw answer} for the plain LCPs of a set solved by solve_many:
+    methods of lcp.batch.COMPILED_BATCH, groups of at least two LCPs of one size."""
+    from rigidlcp.lcp.batch import COMPILED_BATCH
+
+    groups: dict[int, list] = {}
+    for p in problems:
+        if type(p) is LCP:
+            groups.setdefault(p.n, []).append(p)
+    out: dict = {}
+    for method in (m for m in methods if m in COMPILED_BATCH):
+        for group in (g for g in groups.values() if len(g) >= 2):
+            raws = local.solve_batch(group, method, time_limit)
+            for p, raw in zip(group, raws or []):
+                msg = raw["message"]
+                raw["message"] = f"batch of {raw['batch']}" + (f"; {msg}" if msg else "")
+                out[(id(p), method)] = raw
+    return out
 
 
 def write_csv(results: list[Result], path: str | os.PathLike) -> Path:

@@ -88,7 +88,10 @@ def _worker_main(conn) -> None:
         if info is not None and method not in {m.name for m in lcp.methods()}:
             lcp.register(info.name, accepts=info.accepts, description=info.description,
                          max_n=info.max_n, native=info.native)(info.func)
-        conn.send(_solve_here(problem, method))
+        if isinstance(problem, list):  # a batch of same-size LCPs (LocalRunner.solve_batch)
+            conn.send(_solve_batch_here(problem, method))
+        else:
+            conn.send(_solve_here(problem, method))
 
 
 #: A small P-matrix LCP solved once, untimed, by each method in a fresh worker (imports, caches).
@@ -113,6 +116,23 @@ def _solve_here(problem, method: str) -> dict:
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
             "iterations": int(sol.iterations), "message": sol.message, "time": elapsed,
             "u": None if sol.u is None else np.asarray(sol.u, dtype=float)}
+
+
+def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:
+    """`lcp.solve_many(problems, method, repair=False)`, timed as a whole: one raw answer per
+    problem, each with the batch's mean time per problem ("batch": its size); or one
+    {"kind": "error"} for the whole batch (the harness then solves them one by one)."""
+    t0 = time.perf_counter()
+    try:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sols = lcp.solve_many(problems, method, repair=False)
+    except Exception as exc:  # noqa: BLE001 - one by one instead
+        return {"kind": "error", "message": f"{type(exc).__name__}: {exc}"}
+    mean = (time.perf_counter() - t0) / max(len(problems), 1)
+    return [{"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
+             "iterations": int(sol.iterations), "message": sol.message, "time": mean,
+             "u": None, "batch": len(problems)} for sol in sols]
 
 
 def start_method() -> str:
@@ -186,6 +206,29 @@ class LocalRunner:
         self.close()
         return {"kind": "timeout", "time": time_limit,
                 "message": f"no answer within {time_limit:g} s: killed"}
+
+    def solve_batch(self, problems: list, method: str, time_limit: float) -> list[dict] | None:
+        """Raw answers for same-size LCPs solved by one `lcp.solve_many` call (time: the mean
+        per problem), or None when the batch failed or took longer than time_limit per problem
+        on average (the caller then solves them one at a time, each with its own limit)."""
+        if method not in self.warm:
+            self.warm.add(method)
+            self.solve(WARM_UP, method, time_limit)
+        if not self.isolate:
+            raws = _solve_batch_here(problems, method)
+        else:
+            if self.proc is None or not self.proc.is_alive():
+                self._start()
+            self.conn.send((list(problems), method, _picklable_info(method)))
+            if not self.conn.poll(time_limit * len(problems) + self.grace):
+                self.close()
+                return None
+            try:
+                raws = self.conn.recv()
+            except (EOFError, OSError):
+                self.close()
+                return None
+        return raws if isinstance(raws, list) else None
 
     def close(self) -> None:
         if self.proc is not None:

@@ -49,6 +49,10 @@ def register(sub) -> None:
     p.add_argument("--no-isolation", action="store_true",
                    help="solve in this process (the time limit is then checked afterwards, "
                    "a solve cannot be interrupted)")
+    p.add_argument("--no-batch", action="store_true",
+                   help="solve every problem in its own call (by default lemke solves the "
+                   "LCPs of a set that share a size in one lcp.solve_many call, each timed "
+                   "as the batch's mean)")
     p.add_argument("--force", action="store_true",
                    help="write into an --out directory that is not empty")
     p.add_argument("--list", action="store_true", help="list the sets and methods and exit")
@@ -141,7 +145,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
                       f"{1e3 * r.time:10.2f} ms", flush=True)
 
         results = run_bench(sets, methods, time_limit=args.time_limit, tol=args.tol,
-                            isolate=not args.no_isolation, siconos=siconos, progress=progress)
+                            isolate=not args.no_isolation, siconos=siconos, progress=progress,
+                            batch=not args.no_batch)
         import numpy as np
 
         header = [
@@ -156,6 +161,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
             f"Sets: {', '.join(sets)}; methods: {', '.join(methods)}; time limit "
             f"{args.time_limit:g} s per solve; seed {args.seed}.",
         ]
+        if any(r.message.startswith("batch of ") for r in results):
+            header += ["", "Batch: the LCPs of a set that share a size were solved by lemke in "
+                       "one `lcp.solve_many` call each (results.csv: message 'batch of k'); "
+                       "such a row's time is the call's time / k. `--no-batch`: one call per "
+                       "problem."]
         csv_path = write_csv(results, os.path.join(args.out, "results.csv"))
         report = write_report(results, args.out, time_limit=args.time_limit, tol=args.tol,
                               set_info=set_info, header=header, notes=notes)

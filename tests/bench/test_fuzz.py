@@ -105,3 +105,19 @@ def test_a_wrong_mlcp_answer_is_judged_wrong():
     outcome, reason = judge_mlcp(P, "solved", sol.u + 0.1, sol.z)
     assert outcome == "WRONG" and "eq" in reason
     assert judge_mlcp(P, "infeasible", None, np.zeros(P.n))[0] == "WRONG"  # it has a solution
+
+
+def test_batched_lemke_judged_as_one_by_one(monkeypatch):
+    """run_fuzz solves lemke's cases CHUNK at a time with lcp.solve_many: the table's outcomes
+    are those of one lcp.solve per case."""
+    import rigidlcp.bench.fuzz as fuzz
+
+    count = 3 * len(CLASSES)
+    monkeypatch.setattr(fuzz, "CHUNK", 5)  # several chunks, one partial
+    batched = run_fuzz(count, seed=3, methods=("lemke",))
+    monkeypatch.setattr(fuzz, "COMPILED_BATCH", ())
+    single = run_fuzz(count, seed=3, methods=("lemke",))
+    strip = {k: {o: v for o, v in cell.items() if o != "seconds"}
+             for k, cell in batched["table"].items()}
+    assert strip == {k: {o: v for o, v in cell.items() if o != "seconds"}
+                     for k, cell in single["table"].items()}

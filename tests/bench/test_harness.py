@@ -251,3 +251,22 @@ def test_a_folder_of_every_kind_with_an_unreadable_file(tmp_path):
     assert s["states"].common == {"LCP": 1, "MLCP": 1, "FC2D": 1}
     assert set(s["states"].sgm_common) == {"FC2D"}
     assert set(s["newton-min"].sgm_common) == {"LCP", "MLCP", "FC2D"}
+
+
+def test_batched_lemke_answers_as_single_solves():
+    """`run_bench(batch=True)` (the default) gives lemke the same-size LCPs of a set in one
+    lcp.solve_many call: each row has the outcome, status and pivots of its single solve and
+    says "batch of k"; the other methods are untouched."""
+    sets = small_sets()
+    batched = run_bench(sets, ["lemke", "pivoting"], time_limit=30)
+    single = run_bench(sets, ["lemke", "pivoting"], time_limit=30, batch=False)
+    assert len(batched) == len(single)
+    shared = {(name, p.n) for name, ps in sets.items() for p in ps
+              if sum(o.n == p.n for o in ps) >= 2}  # sizes with a batch of >= 2
+    assert any(name == "murty" for name, _ in shared) is False  # one problem per size there
+    for a, b in zip(batched, single):
+        assert (a.set, a.problem, a.method, a.outcome, a.status, a.iterations) == (
+            b.set, b.problem, b.method, b.outcome, b.status, b.iterations)
+        in_batch = a.method == "lemke" and (a.set, a.n) in shared
+        assert a.message.startswith("batch of ") == in_batch
+        assert not b.message.startswith("batch of ")

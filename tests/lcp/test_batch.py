@@ -96,3 +96,13 @@ def test_bad_input_is_refused():
     with pytest.raises(lcp.InvalidProblem, match="shape"):
         lcp.solve_many((np.zeros((2, 3, 3)), np.zeros((2, 4))))
     assert lcp.solve_many([]) == []
+
+
+def test_repair_false_reaches_every_single_solve():
+    """repair=False: the answers of a loop of lcp.solve(..., repair=False), the hard ones too
+    (infeasible, a pivot limit, an MLCP), with every field as above."""
+    M, q = np.array([[1.0, -1.0], [-1.0, 1.0]]), np.array([-1.0, -1.0])  # infeasible
+    problems = [*random_lcps(4, 6, 4), lcp.LCP(M, q), lcp.LCP(murty_matrix(6), murty_q(6))]
+    sols = assert_same_as_loop(problems, max_iter=20, repair=False)
+    assert sols[4].status == "infeasible"
+    assert_same_as_loop(problems, "pivoting", repair=False)
