@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp.models.event import State
+from rigidlcp.models.observables import reported
 from rigidlcp.models.system import System
 
 #: Why a run stops (models/engine/loop.py's module doc says when).
@@ -37,8 +38,12 @@ class EventRecord:
     fallback: bool = False
 
     def __repr__(self) -> str:
-        return (f"<EventRecord t = {self.t:.6g}: mu_g = {self.mu_g:.6g}, D = "
-                f"{self.dissipation:.3g}, {int((self.s != 0).sum())} of {self.s.size} contacts "
+        D = self.dissipation  # rounding noise as 0, on the scale of observables.dissipation_summary
+        if self.S.size and self.R.size:
+            force = float(np.abs(self.R).sum() + np.abs(self.S).sum())
+            D = reported(D, force * float(np.abs(self.vt).max(initial=0.0)))
+        return (f"<EventRecord t = {self.t:.6g}: mu_g = {reported(self.mu_g, 1.0):.6g}, D = "
+                f"{D:.3g}, {int((self.s != 0).sum())} of {self.s.size} contacts "
                 f"sliding, {self.method}{' (fallback)' if self.fallback else ''}>")
 
 
@@ -107,7 +112,8 @@ class Run:
 
     def __repr__(self) -> str:
         lat = self.system.lattice
-        last = (f", t = {self.records[-1].t:.6g}, mu_g = {self.records[-1].mu_g:.6g}"
+        last = (f", t = {self.records[-1].t:.6g}, "
+                f"mu_g = {reported(self.records[-1].mu_g, 1.0):.6g}"
                 if self.records else "")
         return (f"<Run {lat.name} {lat.lx}x{lat.ly}: {self.status}, {self.n_events} events"
                 f"{last}, method {self.method!r}>")

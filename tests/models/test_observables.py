@@ -81,3 +81,16 @@ def test_short_reprs_and_bool_progress(runs, capsys):
 
 def test_empty_summary():
     assert dissipation_summary([]) == {}
+
+
+def test_reprs_report_rounding_noise_as_zero():
+    """A steady state at gamma = 0 where no contact slides: v_t = 0 at every contact, so
+    D = -sum S v_t = 0, and the repr prints 0, not the -1e-31 that rounding leaves; mu_g is
+    printed as `reported` gives it (0 within ZERO_TOL)."""
+    run = models.simulate(models.System(models.rectangular(4, 2), gamma=0.0), seed=1,
+                          progress=False)
+    last = run.last
+    assert run.steady and not np.any(last.s != 0)  # every v_t is 0 up to rounding
+    assert "D = 0," in repr(last)
+    mu = f"mu_g = {reported(last.mu_g, 1.0):.6g},"
+    assert mu in repr(last) and mu in repr(run)
