@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
@@ -224,3 +225,60 @@ def test_sizes_beyond_the_probe_take_the_general_path():
     P = lcp.LCP(np.eye(n) * 2.0 + 0.01, -np.ones(n))
     assert fast_pivoting.solve_pivoting(P) is None
     assert lcp.solve(P, "pivoting").status == "solved"
+
+
+@st.composite
+def conditioned_matrices(draw):
+    """m x m matrices U diag(s) V^T with singular values over up to 16 decades, rows and
+    columns scaled over up to 12 more, some entries rounded to few bits (ties, exact zeros)."""
+    m = draw(st.integers(1, 24))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    U, _ = np.linalg.qr(rng.standard_normal((m, m)))
+    V, _ = np.linalg.qr(rng.standard_normal((m, m)))
+    s = 10.0 ** -rng.uniform(0, draw(st.floats(0, 16)), m)
+    A = (U * s) @ V.T
+    scale = draw(st.floats(0, 12))
+    A *= 10.0 ** rng.uniform(-scale / 2, scale / 2, m)[:, None]
+    A *= 10.0 ** rng.uniform(-scale / 2, scale / 2, m)[None, :]
+    if draw(st.booleans()):
+        A = np.round(A * 4) / 4
+    return np.ascontiguousarray(A)
+
+
+@compiled
+@settings(max_examples=400, deadline=None)
+@given(conditioned_matrices())
+def test_rcond_shortcut_bounds_dgecons_estimate(A):
+    """_pivot_c skips dgecon when anorm * (its bound on the inverse-norm estimate) <=
+    0.1 / RCOND. The bound must hold: dgecon's rcond = 1 / (ainvnm anorm) satisfies
+    rcond * (anorm * bound) >= 1 (up to the roundings of the two divisions), so wherever the
+    shortcut fires dgecon would have found rcond >= 10 RCOND, the same 'nonsingular'."""
+    from scipy.linalg.lapack import dgecon
+
+    from rigidlcp.lcp.pivoting import RCOND
+
+    bound, lu = fast_pivoting._pivot_c.rcond_shortcut(A)
+    m = A.shape[0]
+    lu = np.array(lu).reshape(m, m, order="F")
+    if not np.isfinite(bound):
+        return
+    anorm = float(np.max(np.sum(np.abs(A), axis=0)))
+    rcond, _ = dgecon(lu, anorm, norm="1")
+    assert rcond * bound >= 1 - 1e-12
+    if bound <= 0.1 / RCOND:
+        assert rcond >= RCOND
+
+
+@compiled
+def test_rcond_shortcut_fires_on_well_conditioned_bases():
+    """Not vacuous: on well-conditioned matrices the bound is within the limit (dgecon is
+    skipped), on a singular-to-rounding one it is not."""
+    from rigidlcp.lcp.pivoting import RCOND
+
+    rng = np.random.default_rng(5)
+    for m in (1, 2, 6, 20):
+        A = rng.standard_normal((m, m)) + 3 * m * np.eye(m)
+        assert fast_pivoting._pivot_c.rcond_shortcut(A)[0] <= 0.1 / RCOND
+    u = rng.standard_normal(8)
+    A = np.outer(u, u) + 1e-15 * np.eye(8)
+    assert not fast_pivoting._pivot_c.rcond_shortcut(A)[0] <= 0.1 / RCOND
