@@ -496,21 +496,27 @@ static PyObject *py_matvec(PyObject *self, PyObject *args)
     Py_RETURN_NONE;
 }
 
+/* The buffer of a square float64 C-contiguous matrix of order 1..max_m, or -1 (an error set). */
+static int square_matrix(PyObject *arg, Py_buffer *v, idx max_m)
+{
+    if (PyObject_GetBuffer(arg, v, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    const char *f = v->format ? v->format : "B";
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+    if (v->ndim != 2 || v->shape[0] != v->shape[1] || v->shape[0] < 1 || v->shape[0] > max_m ||
+        v->itemsize != 8 || f[0] != 'd' || f[1] != 0) {
+        PyBuffer_Release(v);
+        PyErr_SetString(PyExc_ValueError, "A: a square float64 C-contiguous matrix");
+        return -1;
+    }
+    return 0;
+}
+
 /* col_abs_max(A) -> float(np.max(np.sum(np.abs(A), axis=0))) by `col_abs_max` (the probe). */
 static PyObject *py_col_abs_max(PyObject *self, PyObject *arg)
 {
     (void)self;
     Py_buffer v;
-    if (PyObject_GetBuffer(arg, &v, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
-        return NULL;
-    const char *f = v.format ? v.format : "B";
-    if (*f == '<' || *f == '=' || *f == '@') f++;
-    if (v.ndim != 2 || v.shape[0] != v.shape[1] || v.shape[0] < 1 || v.shape[0] > 46000 ||
-        v.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
-        PyBuffer_Release(&v);
-        PyErr_SetString(PyExc_ValueError, "A: a square float64 C-contiguous matrix");
-        return NULL;
-    }
+    if (square_matrix(arg, &v, 46000) < 0) return NULL;
     int m = (int)v.shape[0];
     double *t = malloc(sizeof(double) * m);
     if (!t) {
@@ -529,16 +535,11 @@ static PyObject *py_rcond_shortcut(PyObject *self, PyObject *arg)
 {
     (void)self;
     Py_buffer v;
-    if (PyObject_GetBuffer(arg, &v, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
-        return NULL;
-    const char *f = v.format ? v.format : "B";
-    if (*f == '<' || *f == '=' || *f == '@') f++;
-    if (!getrf || v.ndim != 2 || v.shape[0] != v.shape[1] || v.shape[0] < 1 ||
-        v.shape[0] > 4000 || v.itemsize != 8 || f[0] != 'd' || f[1] != 0) {
-        PyBuffer_Release(&v);
-        PyErr_SetString(PyExc_ValueError, "A: a square float64 C-contiguous matrix (after init)");
+    if (!getrf) {
+        PyErr_SetString(PyExc_RuntimeError, "call init first");
         return NULL;
     }
+    if (square_matrix(arg, &v, 4000) < 0) return NULL;
     int m = (int)v.shape[0], info = 0;
     const double *A = v.buf;
     double *buf = malloc(sizeof(double) * ((size_t)m * m + 3 * (size_t)m));
