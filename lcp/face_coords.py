@@ -116,8 +116,9 @@ class _Face:
 
 def small_lp(g: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray) -> np.ndarray | None:
     """A minimizer of g'x over {Aineq x <= bineq} (x = 0 feasible), by DAQP's proximal-point
-    iterations; None unless DAQP reports an optimum that is feasible to 1e-11 |bineq| and its
-    multipliers lam prove optimality: lam >= 0, g + Aineq' lam = 0 and lam' (bineq - Aineq x)
+    iterations; None unless DAQP reports an optimum that is feasible to 1e-11 |bineq| and
+    multipliers lam (DAQP's, or those of the tight constraints by least squares) prove
+    optimality: lam >= 0, g + Aineq' lam = 0 and lam' (bineq - Aineq x)
     = 0, each to 1e-9 of its scale (then g'x exceeds the minimum by at most those residuals
     times the size of x, by weak duality)."""
     d = g.size
@@ -131,11 +132,24 @@ def small_lp(g: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray) -> np.ndarray 
     x, lam = out
     gscale = max(float(np.abs(g).max(initial=0.0)), 1e-300)
     bscale = max(float(np.abs(bineq).max(initial=0.0)), 1.0)
-    if (lam.min(initial=0.0) < -1e-9 * gscale
-            or np.abs(g + Aineq.T @ lam).max(initial=0.0) > 1e-9 * gscale
-            or abs(lam @ (bineq - Aineq @ x)) > 1e-9 * gscale * bscale):
+    slack = bineq - Aineq @ x
+
+    def proves(lam: np.ndarray) -> bool:
+        return bool(lam.min(initial=0.0) >= -1e-9 * gscale
+                    and np.abs(g + Aineq.T @ lam).max(initial=0.0) <= 1e-9 * gscale
+                    and abs(lam @ slack) <= 1e-9 * gscale * bscale)
+
+    if proves(lam):
+        return x
+    # DAQP's multipliers are those of its last proximal step (g + prox (x - x_k) + A'lam = 0):
+    # when that step was long they miss stationarity. The multipliers of the constraints
+    # tight at x, by least squares, may still prove x optimal.
+    tight = np.flatnonzero(slack <= 1e-11 * bscale)
+    if tight.size == 0:
         return None
-    return x
+    exact = np.zeros_like(lam)
+    exact[tight] = np.linalg.lstsq(Aineq[tight].T, -g, rcond=None)[0]
+    return x if proves(exact) else None
 
 
 def small_qp(P: np.ndarray, f: np.ndarray, Aineq: np.ndarray, bineq: np.ndarray,
