@@ -64,6 +64,11 @@ def initial_state(
     drawn from `seed` (zeros when neither is given). Contacts with |v_t| <= zero_tol start as
     non-sliding candidates."""
     p = system.p
+    if omega is None and seed is not None:
+        if not (np.isfinite(omega_scale) and omega_scale >= 0):
+            raise ValueError(f"omega_scale must be a finite number >= 0, got {omega_scale!r}")
+        if isinstance(seed, (int, np.integer)) and seed < 0:  # numpy's own message names none
+            raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
     if omega is None:
         omega = (
             np.zeros(p) if seed is None

@@ -97,6 +97,18 @@ def _check_size(name: str, value, minimum: int) -> int:
     return int(value)
 
 
+#: The largest array built: 10^6 disks (2 x 10^6 contacts). The sparse event path handles
+#: 100 x 100 disks in seconds per hundred events; a million disks already needs gigabytes for
+#: one factorization, and a size past this is a typo (a missing comma), not a system.
+MAX_DISKS = 1_000_000
+
+
+def _check_disks(lx: int, ly: int) -> None:
+    if lx * ly > MAX_DISKS:
+        raise InvalidSystem(f"an array of lx x ly = {lx} x {ly} disks is larger than the "
+                            f"{MAX_DISKS} disks this toolkit builds")
+
+
 def _check_radius(radius) -> float:
     r = float(radius)
     if not np.isfinite(r) or r <= 0:
@@ -107,6 +119,7 @@ def _check_radius(radius) -> float:
 def rectangular(lx: int, ly: int, radius: float = 1.0) -> Lattice:
     """Ly rows of Lx disks in columns; every row touches both walls, the bottom row the plane."""
     lx, ly, r = _check_size("lx", lx, 1), _check_size("ly", ly, 1), _check_radius(radius)
+    _check_disks(lx, ly)
     rows = [[(r + 2 * r * k, r + 2 * r * m) for k in range(lx)] for m in range(ly)]
     return _build("rect", lx, ly, r, rows, full=[True] * ly)
 
@@ -118,6 +131,7 @@ def triangular(lx: int, ly: int, radius: float = 1.0) -> Lattice:
     lx - 1 >= 1 disks must exist above the bottom row).
     """
     lx, ly, r = _check_size("lx", lx, 1), _check_size("ly", ly, 1), _check_radius(radius)
+    _check_disks(lx, ly)
     if ly >= 2 and lx < 2:
         raise InvalidSystem(
             f"a triangular array with ly = {ly} rows needs lx >= 2 (the rows in the hollows "

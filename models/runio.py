@@ -67,6 +67,9 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
 def load_run(path: str | os.PathLike) -> Run:
     """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
     data_path, _ = run_paths(path)
+    if Path(path).is_file() and not data_path.exists():  # e.g. a text file, not PATH.npz
+        raise InvalidFile(f"{path}: not a run file (a run is the .npz written by "
+                          "`rigidlcp simulate`)")
     try:
         return _load_run(data_path)
     except (RigidLCPError, OSError):

@@ -167,6 +167,9 @@ class Sweep:
                              f"got {opts['omega_scale']!r}")
         seen = set()
         for point in self.points():
+            seed = point["seed"]
+            if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+                raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
             sysp = tuple(point[k] for k in PARAMS if k != "seed")
             if sysp in seen:
                 continue
@@ -291,6 +294,8 @@ def run_sweep(sweep: Sweep, out: str | os.PathLike, *, jobs: int | None = None,
     (`Sweep.validate`); OUT must be new, empty or a sweep directory (else `OutputExists`,
     unless `force`)."""
     sweep.validate()  # the whole grid, before anything is written or run
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
+        raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
     out = check_out(out, force)
     out.mkdir(parents=True, exist_ok=True)
     log = log or (lambda msg: print(msg, file=sys.stderr))

@@ -218,6 +218,8 @@ def run_from_args(args: argparse.Namespace) -> int:
         raise InvalidInput(f"unknown class(es) {bad}; classes: {', '.join(CLASSES)}")
     if args.count < 1:
         raise InvalidInput(f"--count must be >= 1, got {args.count}")
+    if args.seed < 0:
+        raise InvalidInput(f"--seed must be >= 0, got {args.seed}")
     if args.out is not None and Path(args.out).exists():
         raise OutputExists(f"--out {args.out} exists; give a new folder")
     methods = tuple(args.methods.split(",")) if args.methods else None

@@ -12,6 +12,8 @@ import platform
 import shlex
 import sys
 
+from rigidlcp.cli.main import seed
+
 DEFAULT_METHODS = ("lemke,pivoting,pgs,qp-clarabel,qp-osqp,enumerate,newton-min,newton-fb,"
                    "enumerate-mlcp,states,nsgs")
 
@@ -38,7 +40,7 @@ def register(sub) -> None:
                    help="seconds per solve; a longer solve is killed and fails (default 10)")
     p.add_argument("--tol", type=float, default=1e-8,
                    help="certification tolerance on the scaled residual (default 1e-8)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the generated sets")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the generated sets")
     p.add_argument("--sizes", default=None, metavar="N[,N]",
                    help="sizes n for the generated sets (default: each set's own)")
     p.add_argument("--per-size", type=int, default=None, help="problems per size")
@@ -85,10 +87,28 @@ def cmd_bench(args: argparse.Namespace) -> int:
                         f"unavailable: no {spec.kind} solvers in this Siconos")
                 print(f"  {m:<24} {spec.kind} problems ({state})")
             return 0
-        if not args.sets or not args.out:
-            raise ValueError("--set and --out are required (or --list)")
+        missing = [o for o, v in (("--set", args.sets), ("--out", args.out)) if not v]
+        if missing:
+            raise ValueError(f"{' and '.join(missing)} required (or --list)")
         if not (args.time_limit > 0 and args.tol > 0):
             raise ValueError("--time-limit and --tol must be positive")
+        params = {}
+        if args.sizes:
+            try:
+                params["sizes"] = tuple(int(s) for s in args.sizes.split(","))
+            except ValueError:
+                raise ValueError(f"--sizes takes integers N[,N], got {args.sizes!r}") from None
+            if min(params["sizes"]) < 1:
+                raise ValueError(f"--sizes must be >= 1, got {args.sizes}")
+        if args.per_size is not None:
+            if args.per_size < 1:
+                raise ValueError(f"--per-size must be >= 1, got {args.per_size}")
+            params["per_size"] = args.per_size
+        specs = [s.strip() for s in args.sets.split(",") if s.strip()]
+        unknown = [s for s in specs if s not in SETS and not os.path.isdir(s)]
+        if unknown:
+            raise ValueError(f"unknown set(s) {', '.join(unknown)}: neither a set name "
+                             f"({', '.join(SETS)}) nor a folder")
         from rigidlcp.lcp.io.files import output_dir
 
         output_dir(args.out, force=args.force)  # new or empty, unless --force
@@ -118,13 +138,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
                          "given n <= 20 (LCP), m <= 16 (MLCP), c <= 5 contacts (fc2d); the "
                          "MLCP and fc2d solvers have Siconos's other defaults; a nonzero "
                          "Siconos info is a failure (it proves nothing)")
-        params = {}
-        if args.sizes:
-            params["sizes"] = tuple(int(s) for s in args.sizes.split(","))
-        if args.per_size is not None:
-            params["per_size"] = args.per_size
         sets, set_info = {}, {}
-        for spec in [s.strip() for s in args.sets.split(",") if s.strip()]:
+        for spec in specs:
             kw = params if spec in SETS and not spec.startswith("events-") else {}
             problems = get_set(spec, seed=args.seed, cache_dir=args.cache, **kw)
             name = spec if spec in SETS else os.path.basename(os.path.normpath(spec))

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+from rigidlcp.cli.main import seed
+
 
 def register(sub) -> None:
     from .simulate import add_system_arguments
@@ -19,7 +21,7 @@ def register(sub) -> None:
         "orders of convergence (docs/integrators.md).")
     add_system_arguments(p)
     g = p.add_argument_group("comparison")
-    g.add_argument("--seed", type=int, default=1, help="seed of the initial angular velocities")
+    g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
     g.add_argument("--h", type=float, default=2e-3, help="largest time step")
     g.add_argument("--levels", type=int, default=3, help="number of step sizes (h halving)")
     g.add_argument("--theta", type=float, default=1.0, help="theta of the Moreau-Jean scheme")

@@ -18,6 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidlcp.cli.main import seed
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -31,7 +33,7 @@ def register(sub) -> None:
 
     add_system_arguments(p)  # the system options of `rigidlcp simulate` (and its friction)
     p.set_defaults(lattice="tri", lx=5, ly=4, gamma=0.0)  # Fig. 4: a triangular array
-    p.add_argument("--seed", type=int, default=0, help="seed of the angular velocities")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the angular velocities")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
     p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1)")
@@ -70,8 +72,8 @@ def cmd_forces(args: argparse.Namespace) -> int:
     lcp.get_method(args.method)
     names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"
                                               for k in range(args.networks)]
-    out = output_dir(args.out, force=args.force, names=names)
     state = models.initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
+    out = output_dir(args.out, force=args.force, names=names)  # after every input is checked
     ep = models.event_problem(system, state)
     sol = lcp.solve(ep.lcp, method=args.method)
     if sol.status != "solved":

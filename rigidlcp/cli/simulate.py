@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import time
 
 import numpy as np
+
+from rigidlcp.cli.main import seed
 
 
 def add_system_arguments(p: argparse.ArgumentParser) -> None:
@@ -43,7 +46,7 @@ def register(sub) -> None:
                        description="Exact event-driven evolution of a disk array (Sec. II C, IV).")
     add_system_arguments(p)
     g = p.add_argument_group("run")
-    g.add_argument("--seed", type=int, default=1, help="seed of the initial angular velocities")
+    g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
     g.add_argument("--omega-scale", type=float, default=1.0,
                    help="initial angular velocities uniform in [-scale, scale]")
     g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
@@ -73,6 +76,7 @@ def register(sub) -> None:
 
 def cmd_simulate(args) -> int:
     from rigidlcp import lcp
+    from rigidlcp.lcp.errors import InvalidInput
     from rigidlcp.lcp.io.files import check_new, output_dir
     from rigidlcp.models.engine import simulate
     from rigidlcp.models.event import initial_state
@@ -92,6 +96,9 @@ def cmd_simulate(args) -> int:
     # Outputs are checked before the run, not after it: a user's file is never overwritten
     # (without --force) and a run is never lost to an unwritable folder.
     if args.out:
+        if os.path.isdir(args.out):
+            raise InvalidInput(f"--out {args.out} is a directory; a run is a file (e.g. "
+                               f"{os.path.join(args.out, 'run.npz')})")
         paths = run_paths(args.out)
         check_new(paths, force=args.force)
         output_dir(paths[0].parent, force=True)

@@ -99,6 +99,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from rigidlcp.models.sweep import check_out, run_sweep, varying
 
     sweep = sweep_from_args(args)
+    if args.jobs is not None and args.jobs < 1:
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     check_out(args.out, force=args.force)
     n = len(sweep.points())
     print(f"sweep: {n} point(s); axes: " + (", ".join(

@@ -7,6 +7,8 @@ import json
 
 import numpy as np
 
+from rigidlcp.cli.main import seed
+
 
 def register(sub) -> None:
     from .simulate import add_system_arguments
@@ -18,7 +20,7 @@ def register(sub) -> None:
                        "checked (docs/integrators.md).")
     add_system_arguments(p)
     g = p.add_argument_group("run")
-    g.add_argument("--seed", type=int, default=1, help="seed of the initial angular velocities")
+    g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
     g.add_argument("--h", type=float, default=1e-3, help="time step")
     g.add_argument("--theta", type=float, default=1.0, help="theta in [0.5, 1]")
     g.add_argument("--method", default="lemke", help="LCP method of a step")
@@ -26,14 +28,15 @@ def register(sub) -> None:
     g.add_argument("--max-steps", type=int, default=2_000_000)
     g.add_argument("--record-every", type=int, default=100,
                    help="also record every N steps (besides state changes; 0: only those)")
-    g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json); refuses "
-                   "to overwrite")
+    g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json); an "
+                   "existing run is not overwritten without --force")
+    g.add_argument("--force", action="store_true", help="overwrite an existing --out")
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=cmd_timestep)
 
 
 def cmd_timestep(args) -> int:
-    from rigidlcp.lcp.errors import OutputExists
+    from rigidlcp.lcp.io.files import check_new
     from rigidlcp.models.runio import run_paths, save_run
     from rigidlcp.models.timestepping import moreau_jean
 
@@ -41,9 +44,7 @@ def cmd_timestep(args) -> int:
 
     system = system_from_args(args)
     if args.out:
-        for path in run_paths(args.out):
-            if path.exists():
-                raise OutputExists(f"--out: {path} exists (not overwritten)")
+        check_new(run_paths(args.out), force=args.force)
     run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta, method=args.method,
                       t_max=args.t_max, max_steps=args.max_steps,
                       record_every=args.record_every)
@@ -55,5 +56,9 @@ def cmd_timestep(args) -> int:
     else:
         width = max(len(k) for k in summary)
         for k, v in summary.items():
+            if isinstance(v, float):
+                v = f"{v:.6g}"
+            elif isinstance(v, (list, tuple)) and all(isinstance(x, float) for x in v):
+                v = "[" + ", ".join(f"{x:.6g}" for x in v) + "]"
             print(f"  {k:<{width}}  {v}")
     return 0 if run.status in ("steady", "time_limit", "event_limit") else 1

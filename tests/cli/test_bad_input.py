@@ -42,6 +42,7 @@ CASES: list[tuple[str, str]] = [
     ("plot run.npz --out figs", "--force"),
     ("plot run.npz --out out1 --event 99", "--event"),
     ("plot run.npz", "--out"),
+    ("plot existfile --out out1", "not a run file"),
     # simulate
     ("simulate --lx 0", "lx"),
     ("simulate --ly -1", "ly"),
@@ -58,6 +59,9 @@ CASES: list[tuple[str, str]] = [
     ("simulate --max-events 0", "--max-events"),
     ("simulate --omega-scale -1", "--omega-scale"),
     ("simulate --lx 3 --ly 2 --out run.npz", "--force"),
+    ("simulate --lx 100000000 --ly 100000000 --out big.npz", "disks"),
+    ("simulate --seed -1 --out s.npz", "--seed"),
+    ("simulate --lx 3 --ly 1 --out emptydir", "directory"),
     ("simulate --lx 3 --ly 2 --out existfile/run.npz", "existfile"),
     ("simulate --lx 3 --ly 2 --dump-problems existfile", "existfile"),
     ("simulate --lx 3 --ly 2 --dump-problems figs", "--force"),
@@ -73,6 +77,8 @@ CASES: list[tuple[str, str]] = [
     ("sweep --max-events 0 --out sw", "max-events"),
     ("sweep --out existfile", "existfile"),
     ("sweep --out figs", "--force"),
+    ("sweep --lx 3 --ly 1 --seed -1 --out sw", "seed"),
+    ("sweep --lx 3 --ly 1 --gamma 0.1 --jobs 0 --out sw", "--jobs"),
     # effective
     ("effective missing", "missing"),
     ("effective corrupt.npz", "corrupt.npz"),
@@ -99,6 +105,8 @@ CASES: list[tuple[str, str]] = [
     ("forces --method nope --out f", "unknown method"),
     ("forces --out existfile", "existfile"),
     ("forces --out figs", "--force"),
+    ("forces --omega-scale -1 --out f", "omega_scale"),
+    ("forces --seed -1 --out f", "--seed"),
     # certify, timestep, compare-integrators
     ("certify missing.npz", "missing.npz"),
     ("certify corrupt.npz", "not a .npz"),
@@ -107,6 +115,7 @@ CASES: list[tuple[str, str]] = [
     ("timestep --lx 0", "lx"),
     ("timestep --mu-pp -1", "mu_pp"),
     ("timestep --lx 3 --ly 2 --out run.npz", "exists"),
+    ("timestep --seed -1", "--seed"),
     ("compare-integrators --lx 0", "lx"),
     ("compare-integrators --mu-plane -1", "mu_plane"),
     # certify-run
@@ -128,6 +137,13 @@ CASES: list[tuple[str, str]] = [
     ("bench --set random-p --out figs", "--force"),
     ("bench --set random-p --out b4 --time-limit -1", "--time-limit"),
     ("bench --out b5", "--set"),
+    ("bench --set random-p --sizes abc --out b6", "--sizes"),
+    ("bench --set random-p --sizes 0 --out b7", "--sizes"),
+    ("bench --set random-p --per-size 0 --out b8", "--per-size"),
+    ("bench --set random-p --seed -1 --out b9", "--seed"),
+    ("fuzz --count 3 --seed -1", "--seed"),
+    ("fuzz --count 0", "--count"),
+    ("fuzz --count 3 --out existfile", "existfile"),
     # reproduce
     ("reproduce --out existfile", "existfile"),
     ("reproduce --out figs", "--force"),
@@ -195,6 +211,8 @@ def test_every_bad_input_is_one_line_and_status_2(workdir):
     after = _snapshot(workdir)
     changed = [k for k, v in before.items() if after.get(k) != v]
     assert not changed, f"a user's file was changed: {changed}"
+    left = sorted(set(after) - set(before))
+    assert not left, f"a refused command left something behind: {left}"
 
 
 def test_force_overwrites_and_files_get_ordinary_permissions(workdir, tmp_path):

@@ -111,12 +111,10 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
     task = _EventTask(run, options)
     bar = None
     if progress:
-        import sys
+        from rigidlcp.models.progress import new_bar  # erased at the end: no stale bar
 
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(todo_all), initial=len(todo_all) - len(todo), unit="event",
-                   desc="certify", file=sys.stderr, dynamic_ncols=True)
+        bar = new_bar(total=len(todo_all), initial=len(todo_all) - len(todo), unit="event",
+                      desc="certify")
     new: dict[int, dict] = {}
     try:
         for _, row in iter_map(task, todo, jobs=jobs):
