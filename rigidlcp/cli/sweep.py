@@ -135,18 +135,25 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def print_table(rows: list[dict], cols: list[str]) -> None:
-    head = cols + ["status", "events", "mu_g", "F_g", "D (rate)", "NS", "sliding"]
+    """One row per point; D(t) is the dissipation rate right after the last event (at t), dD/dt
+    its slope: under gamma != 0 the sliding velocities grow linearly in the steady state, so
+    D(t) depends on when the run stopped and dD/dt is the steady observable (Sec. IV C)."""
+    head = cols + ["status", "events", "t", "mu_g", "F_g", "D(t)", "dD/dt", "NS", "sliding"]
     table = []
     for r in rows:
         ns = sum(r.get(f"NS_{k}") or 0 for k in ("pp", "plane", "wall"))
         sl = sum(r.get(f"sliding_{k}") or 0 for k in ("pp", "plane", "wall"))
         table.append([_fmt(r.get(c)) for c in cols] + [
-            str(r["status"]), str(r["events"]), _fmt(r.get("mu_g")), _fmt(r.get("F_g")),
-            _fmt(r.get("dissipation_rate")), str(ns), str(sl)])
+            str(r["status"]), str(r["events"]), _fmt(r.get("t")), _fmt(r.get("mu_g")),
+            _fmt(r.get("F_g")), _fmt(r.get("dissipation_rate")),
+            _fmt(r.get("dissipation_rate_slope")), str(ns), str(sl)])
     widths = [max(len(h), *(len(t[k]) for t in table)) for k, h in enumerate(head)]
     print("  ".join(h.rjust(w) for h, w in zip(head, widths)))
     for t in table:
         print("  ".join(v.rjust(w) for v, w in zip(t, widths)))
+    if any(r.get("gamma") for r in rows):
+        print("D(t): dissipation rate after the last event, at t (m g sqrt(g r)); under gamma "
+              "!= 0 it grows as dD/dt in the steady state: compare dD/dt across points")
 
 
 def _fmt(v) -> str:
