@@ -26,9 +26,12 @@ def _nonneg(name: str, value) -> float:
 
 
 def _positive(name: str, value) -> float:
-    v = _nonneg(name, value)
-    if v == 0:
-        raise InvalidSystem(f"{name} must be > 0, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+    if not (np.isfinite(v) and v > 0):
+        raise InvalidSystem(f"{name} must be a finite number > 0, got {value!r}")
     return v
 
 

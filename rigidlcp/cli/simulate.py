@@ -19,8 +19,9 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
 
     g = p.add_argument_group("system")
     g.add_argument("--lattice", choices=("rect", "tri"), default="rect")
-    g.add_argument("--lx", type=int, default=10, help="disks in the rows touching both walls")
-    g.add_argument("--ly", type=int, default=4, help="number of rows")
+    g.add_argument("--lx", type=int, default=10,
+                   help="disks in the rows touching both walls (default 10)")
+    g.add_argument("--ly", type=int, default=4, help="number of rows (default 4)")
     for name, text in (("mu_pp", "particle-particle"), ("mu_plane", "particle-plane"),
                        ("mu_wall", "particle-wall")):
         g.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
@@ -90,9 +91,12 @@ def cmd_simulate(args) -> int:
         raise ValueError(f"--max-events must be >= 1, got {args.max_events}")
     if not args.t_max > 0:
         raise ValueError(f"--t-max must be > 0, got {args.t_max}")
-    for name in (args.method, args.fallback):
+    for option, name in (("--method", args.method), ("--fallback", args.fallback)):
         if name not in ("none", "sparse-pivoting"):
-            lcp.get_method(name)  # an unknown method fails now, not at the first event
+            try:  # an unknown method fails now, not at the first event
+                lcp.get_method(name)
+            except lcp.InvalidProblem as exc:
+                raise type(exc)(f"{option}: {exc}") from None
     # Outputs are checked before the run, not after it: a user's file is never overwritten
     # (without --force) and a run is never lost to an unwritable folder.
     if args.out:
