@@ -15,10 +15,11 @@ and judges each answer with what is known *without the solvers*:
   ``info["exception"]``): crash.
 
 It prints a table class x method (solved / honest failure / refused / crash / SILENT WRONG,
-median time per solve; lemke solves CHUNK cases at a time in one `lcp.solve_many` call,
-the same answers as one call each, its time per solve being that call's mean) and writes
-every silent-wrong or crashing case to OUT as `<class>-<seed>-<method>.npz` (an `lcp.LCP`
-file with the verdict in its meta), which tests/lcp/test_fuzz_regressions.py loads.
+median time per solve; lemke solves the cases of a class among CHUNK drawn at a time in one
+`lcp.solve_many` call, the same answers as one call each, its time per solve being that
+call's mean) and writes every silent-wrong or crashing case to OUT as
+`<class>-<seed>-<method>.npz` (an `lcp.LCP` file with the verdict in its meta), which
+tests/lcp/test_fuzz_regressions.py loads.
 Run: `python -m rigidlcp.bench.fuzz --count N --seed S --out DIR` (CLI: `rigidlcp fuzz`).
 """
 
@@ -132,6 +133,20 @@ def batch_attempt(cases: list[Case], method: str) -> list[tuple[lcp.Solution, di
     return [(sol, {"seconds": mean, "status": sol.status}) for sol in sols]
 
 
+def batch_by_class(cases: list[Case], method: str) -> list | None:
+    """`batch_attempt` per class of problem (so that each class's time is its own mean), in
+    the order of `cases`; an entry is None where its class's call must go one by one."""
+    out: list = [None] * len(cases)
+    by_kind: dict[str, list[int]] = defaultdict(list)
+    for i, case in enumerate(cases):
+        by_kind[case.kind].append(i)
+    for idx in by_kind.values():
+        done = batch_attempt([cases[i] for i in idx], method)
+        for i, d in zip(idx, done or [None] * len(idx)):
+            out[i] = d
+    return out
+
+
 def run_case(case: Case, method: str, done: tuple | None = None) -> dict:
     """Attempt and judge one case (`done`: its (solution, result) from `batch_attempt`)."""
     sol, res = done if done is not None else attempt(lcp.LCP(case.M, case.q), method)
@@ -161,13 +176,13 @@ def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
     for start in range(0, count, CHUNK):
         cases = [make_case(classes[k % len(classes)], seed * 1_000_003 + k)
                  for k in range(start, min(count, start + CHUNK))]
-        batched = {m: batch_attempt(cases, m) for m in names if m in COMPILED_BATCH}
+        batched = {m: batch_by_class(cases, m) for m in names if m in COMPILED_BATCH}
         for j, case in enumerate(cases):
             k = start + j
             for method in names:
                 if method in exhaustive and case.n > ENUM_MAX_N:
                     continue
-                done = batched[method][j] if batched.get(method) else None
+                done = batched[method][j] if method in batched else None
                 res = run_case(case, method, done)
                 cell = table[(case.kind, method)]
                 cell[res["outcome"]] += 1
