@@ -15,31 +15,29 @@ import numpy as np
 from .lattice import KINDS, PLANE, InvalidSystem, Lattice
 
 
-def _nonneg(name: str, value) -> float:
+def _float(name: str, value) -> float:
     try:
-        v = float(value)
+        return float(value)
     except (TypeError, ValueError):
         raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+
+
+def _nonneg(name: str, value) -> float:
+    v = _float(name, value)
     if not np.isfinite(v) or v < 0:
         raise InvalidSystem(f"{name} must be a finite number >= 0, got {value!r}")
     return v
 
 
 def _positive(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+    v = _float(name, value)
     if not (np.isfinite(v) and v > 0):
         raise InvalidSystem(f"{name} must be a finite number > 0, got {value!r}")
     return v
 
 
 def _finite(name: str, value) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidSystem(f"{name} must be a number, got {value!r}") from None
+    v = _float(name, value)
     if not np.isfinite(v):
         raise InvalidSystem(f"{name} must be finite, got {value!r}")
     return v
