@@ -50,6 +50,13 @@ def reported(value: float, scale: float) -> float:
     return 0.0 if abs(value) <= ZERO_TOL * abs(scale) else float(value)
 
 
+def reported_rate(R: np.ndarray, S: np.ndarray, v: np.ndarray) -> float:
+    """-S.v (the dissipation rate D with v = v_t, its slope dD/dt with v = a_t), reported as 0
+    within ZERO_TOL of its terms' magnitude (sum |R| + sum |S|) max |v|."""
+    force = float(np.sum(np.abs(R)) + np.sum(np.abs(S)))
+    return reported(-float(S @ v), force * float(np.max(np.abs(v), initial=0.0)))
+
+
 def dissipated_energy(records, t_end: float | None = None) -> float:
     """Energy dissipated by friction from the first event to `t_end` (default: the last
     event): the integral of D(t). Between events S is constant and v_t = v_t,k + a_t,k (t -
@@ -88,12 +95,9 @@ def dissipation_summary(records) -> dict:
     if any(r.S.size == 0 for r in recs):  # light records (sparse engine): the rate only
         return {"dissipation_rate": float(last.dissipation), "dissipation_rate_slope": None,
                 "dissipated_energy": None, "dissipated_energy_interval": None}
-    force = float(np.sum(np.abs(last.R)) + np.sum(np.abs(last.S)))
     return {
-        "dissipation_rate": reported(-float(last.S @ last.vt),
-                                     force * float(np.max(np.abs(last.vt), initial=0.0))),
-        "dissipation_rate_slope": reported(-float(last.S @ last.at),
-                                           force * float(np.max(np.abs(last.at), initial=0.0))),
+        "dissipation_rate": reported_rate(last.R, last.S, last.vt),
+        "dissipation_rate_slope": reported_rate(last.R, last.S, last.at),
         "dissipated_energy": dissipated_energy(recs),
         "dissipated_energy_interval": [float(recs[0].t), float(last.t)],
     }
@@ -153,6 +157,7 @@ def states_text(system: System, R: np.ndarray, s: np.ndarray) -> list[str]:
 __all__ = [
     "global_friction", "global_friction_coefficient", "dissipation_rate", "reported",
     "dissipated_energy", "dissipation_summary", "regime", "EXCLUDED", "ZERO_TOL",
+    "reported_rate",
     "rotational_energy",
     "obstacle_force_on_disks", "horizontal_balance", "state_counts", "states_text",
     "LEFT_WALL", "RIGHT_WALL", "PLANE",

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp.models.event import State
-from rigidlcp.models.observables import reported
+from rigidlcp.models.observables import reported, reported_rate
 from rigidlcp.models.system import System
 
 #: Why a run stops (models/engine/loop.py's module doc says when).
@@ -38,10 +38,8 @@ class EventRecord:
     fallback: bool = False
 
     def __repr__(self) -> str:
-        D = self.dissipation  # rounding noise as 0, on the scale of observables.dissipation_summary
-        if self.S.size and self.R.size:
-            force = float(np.abs(self.R).sum() + np.abs(self.S).sum())
-            D = reported(D, force * float(np.abs(self.vt).max(initial=0.0)))
+        # rounding noise as 0, as in the run's summary (light records keep no S, v_t)
+        D = reported_rate(self.R, self.S, self.vt) if self.S.size else self.dissipation
         return (f"<EventRecord t = {self.t:.6g}: mu_g = {reported(self.mu_g, 1.0):.6g}, D = "
                 f"{D:.3g}, {int((self.s != 0).sum())} of {self.s.size} contacts "
                 f"sliding, {self.method}{' (fallback)' if self.fallback else ''}>")
