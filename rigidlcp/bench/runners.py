@@ -62,6 +62,8 @@ SICONOS_METHODS: dict[str, SiconosMethod] = {
     "siconos-fc2d-lemke": SiconosMethod("fc2d", "lemke"),
     "siconos-fc2d-enum": SiconosMethod("fc2d", "enum", max_size=5),
 }
+#: What LocalRunner._ask returns when the worker gives no reply.
+_TIMEOUT, _DIED = object(), object()
 #: Seconds a new worker may take to start (imports), outside every time limit.
 STARTUP = 300.0
 #: Seconds allowed beyond the time limit for passing the problem and the answer around.
@@ -112,9 +114,13 @@ def _solve_here(problem, method: str) -> dict:
     except Exception as exc:  # noqa: BLE001 - a harness reports, never dies
         return {"kind": "error", "message": f"{type(exc).__name__}: {exc}",
                 "time": time.perf_counter() - t0}
-    elapsed = time.perf_counter() - t0
+    return _answer(sol, time.perf_counter() - t0)
+
+
+def _answer(sol, seconds: float) -> dict:
+    """A solution as the harness's raw answer (judged there, never trusted)."""
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
-            "iterations": int(sol.iterations), "message": sol.message, "time": elapsed,
+            "iterations": int(sol.iterations), "message": sol.message, "time": seconds,
             "u": None if sol.u is None else np.asarray(sol.u, dtype=float)}
 
 
@@ -130,9 +136,7 @@ def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:
     except Exception as exc:  # noqa: BLE001 - one by one instead
         return {"kind": "error", "message": f"{type(exc).__name__}: {exc}"}
     mean = (time.perf_counter() - t0) / max(len(problems), 1)
-    return [{"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
-             "iterations": int(sol.iterations), "message": sol.message, "time": mean,
-             "u": None, "batch": len(problems)} for sol in sols]
+    return [{**_answer(sol, mean), "batch": len(problems)} for sol in sols]
 
 
 def start_method() -> str:
@@ -194,18 +198,28 @@ class LocalRunner:
             self.solve(WARM_UP, method, time_limit)
         if not self.isolate:
             return _solve_here(problem, method)
+        answer = self._ask(problem, method, time_limit + self.grace)
+        if answer is _DIED:
+            return {"kind": "error", "message": "the worker died", "time": 0.0}
+        if answer is _TIMEOUT:
+            return {"kind": "timeout", "time": time_limit,
+                    "message": f"no answer within {time_limit:g} s: killed"}
+        return answer
+
+    def _ask(self, payload, method: str, timeout: float):
+        """Send a problem (or a list of them) to the worker and return its reply; _TIMEOUT
+        (the worker killed) or _DIED when there is none."""
         if self.proc is None or not self.proc.is_alive():
             self._start()
-        self.conn.send((problem, method, _picklable_info(method)))
-        if self.conn.poll(time_limit + self.grace):
-            try:
-                return self.conn.recv()
-            except (EOFError, OSError):
-                self.close()
-                return {"kind": "error", "message": "the worker died", "time": 0.0}
-        self.close()
-        return {"kind": "timeout", "time": time_limit,
-                "message": f"no answer within {time_limit:g} s: killed"}
+        self.conn.send((payload, method, _picklable_info(method)))
+        if not self.conn.poll(timeout):
+            self.close()
+            return _TIMEOUT
+        try:
+            return self.conn.recv()
+        except (EOFError, OSError):
+            self.close()
+            return _DIED
 
     def solve_batch(self, problems: list, method: str, time_limit: float) -> list[dict] | None:
         """Raw answers for same-size LCPs solved by one `lcp.solve_many` call (time: the mean
@@ -214,21 +228,9 @@ class LocalRunner:
         if method not in self.warm:
             self.warm.add(method)
             self.solve(WARM_UP, method, time_limit)
-        if not self.isolate:
-            raws = _solve_batch_here(problems, method)
-        else:
-            if self.proc is None or not self.proc.is_alive():
-                self._start()
-            self.conn.send((list(problems), method, _picklable_info(method)))
-            if not self.conn.poll(time_limit * len(problems) + self.grace):
-                self.close()
-                return None
-            try:
-                raws = self.conn.recv()
-            except (EOFError, OSError):
-                self.close()
-                return None
-        return raws if isinstance(raws, list) else None
+        raws = (_solve_batch_here(problems, method) if not self.isolate else
+                self._ask(list(problems), method, time_limit * len(problems) + self.grace))
+        return raws if isinstance(raws, list) else None  # an error, a timeout, a dead worker
 
     def close(self) -> None:
         if self.proc is not None:
