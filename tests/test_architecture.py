@@ -164,3 +164,16 @@ def test_engine_functions_are_short():
                 if n > 60:
                     long.append(f"{path.name}:{node.name} ({n} lines)")
     assert long == []
+
+
+def test_no_two_models_modules_import_each_other():
+    """Not even inside functions (issue 24.8: models/engine/simulate.py <-> sparse.py through
+    blas_limit, now in loop.py below both): a piece two modules share lives below both.
+    (The floor `lcp` keeps its lazy method registry, lcp/api.py <-> the methods it lists.)"""
+    modules = {n: p for n, p in _modules().items() if _floor(n) == "rigidlcp.models"}
+    deps = {name: {t for t in _imports(name, path) if t in modules and t != name}
+            for name, path in modules.items()}
+    mutual = sorted(f"{a} <-> {b}" for a in deps for b in deps[a]
+                    if a < b and a in deps.get(b, ()) and not b.startswith(a + ".")
+                    and not a.startswith(b + "."))
+    assert not mutual, "modules importing each other: " + "; ".join(mutual)

@@ -88,7 +88,21 @@ def output_dir(path: str | os.PathLike, force: bool = False,
     out.mkdir(parents=True, exist_ok=True)
     if not os.access(out, os.W_OK | os.X_OK):
         raise PermissionError(13, "Permission denied (not writable)", str(out))
+    _probe(out)
     return out
+
+
+def _probe(folder: Path) -> None:
+    """Create and remove a file in `folder`: some folders (/proc, a full or read-only file
+    system, root's access() answers) refuse files that access() allows. The error names the
+    folder, not the probe's hidden name."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".rigidlcp-probe.", suffix=".tmp")
+    except OSError as exc:
+        raise OSError(exc.errno, f"{exc.strerror} (no file can be created in this folder)",
+                      str(folder)) from None
+    os.close(fd)
+    os.unlink(tmp)
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None],
@@ -103,7 +117,10 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None],
     if path.parent.exists() and not path.parent.is_dir():
         raise InvalidInput(f"{path.parent} is a file, not a directory")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:  # name the user's path, not the temporary one
+        raise OSError(exc.errno, f"{exc.strerror} (cannot write)", str(path)) from None
     os.close(fd)
     try:
         os.chmod(tmp, 0o666 & ~_umask())

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -111,6 +112,16 @@ def run_events(system: System, state: State, backend: Backend, limits: Limits = 
     run.final = state
     run.wall_time = _time.perf_counter() - start
     return run
+
+
+def blas_limit(threads: int | None) -> AbstractContextManager:
+    """BLAS limited to `threads` threads while the context is open (None: left alone); used by
+    both backends' entry points (simulate.py, sparse.py), hence here, below both."""
+    if threads is None:
+        return nullcontext()
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(threads)
 
 
 def states_after(s_in: np.ndarray, mu: np.ndarray, a_t: np.ndarray, tol_a: float) -> np.ndarray:

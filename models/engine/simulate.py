@@ -2,17 +2,18 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
-from contextlib import AbstractContextManager, nullcontext
 
 import numpy as np
 
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, initial_state
 from rigidlcp.models.system import System
 
 from .dense import DenseBackend
-from .loop import Limits, run_events
+from .loop import Limits, blas_limit, run_events
 from .records import Run
 
 
@@ -40,9 +41,10 @@ def simulate(
     method: any `lcp` method, solving each event's dense LCP (models/engine/dense.py; "pivoting"
     is warm-started from the previous event's contact states when warm_start is true), or
     "sparse-pivoting": the sparse backend (models/engine/sparse.py; select "none" only, no
-    dump_dir). Every solution's residual max|min(z, w)| must be <= check_tol (in units of the
-    problem's scale), or the run stops with "solver_failed"; the other stop rules and their
-    parameters (t_max, max_events, zeno_events, zeno_time) are models/engine/loop.py's.
+    dump_dir). A dense run too large for the memory is refused first (`check_dense_memory`).
+    Every solution's residual max|min(z, w)| must be <= check_tol (in units of the problem's
+    scale), or the run stops with "solver_failed"; the other stop rules and their parameters
+    (t_max, max_events, zeno_events, zeno_time) are models/engine/loop.py's.
 
     select: the particular solution of an event whose solution is not unique: "face-min-norm"
     (default), "global" or "none" (see `DenseBackend`). fallback: when `method` fails at an
@@ -52,6 +54,8 @@ def simulate(
     problems are small dense matrices, for which one thread is fastest, and much faster on a
     loaded machine); None leaves BLAS alone.
     """
+    if method != "sparse-pivoting":
+        check_dense_memory(system.c, f"this array of {system.c} contacts")
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
@@ -75,13 +79,41 @@ def simulate(
         return run_events(system, state, backend, limits, progress or None)
 
 
-def blas_limit(threads: int | None) -> AbstractContextManager:
-    """BLAS limited to `threads` threads while the context is open (None: left alone)."""
-    if threads is None:
-        return nullcontext()
-    from threadpoolctl import threadpool_limits
+def dense_bytes(contacts: int) -> int:
+    """A lower bound on the memory of one dense event of an array with c = `contacts` contacts
+    (bytes): W = H M^-1 H^T (2c x 2c), and the event's G (2c x n), B and M (n x n) with
+    n >= c (models/event.py, Eq. 2.7)."""
+    c = int(contacts)
+    return 8 * (4 * c * c + 2 * c * c + 2 * c * c)
 
-    return threadpool_limits(threads)
+
+def available_bytes() -> int | None:
+    """The memory the system can give now (MemAvailable, else the physical memory; None when
+    unknown)."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):
+        return None
+
+
+def check_dense_memory(contacts: int, what: str, available: int | None = None) -> None:
+    """Refuse, before anything is allocated, a dense run whose event matrices cannot fit in
+    memory (InvalidInput naming the sparse backend). `what` names the array in the message;
+    `contacts` may be a lower bound (every disk rests on at least one contact: c >= p)."""
+    need = dense_bytes(contacts)
+    have = available_bytes() if available is None else available
+    if have is not None and need > have:
+        raise InvalidInput(
+            f"the dense event LCP of {what} needs at least {need / 2**30:.1f} GiB of memory "
+            f"and {have / 2**30:.1f} GiB is available: use the sparse backend (--method "
+            "sparse-pivoting --select none; Python: method='sparse-pivoting', select='none')")
 
 
 def _print_progress(run: Run) -> None:

@@ -39,7 +39,7 @@ from rigidlcp.models.sparse_event import (
 )
 from rigidlcp.models.system import System
 
-from .loop import Limits, Outcome, run_events
+from .loop import Limits, Outcome, blas_limit, run_events
 from .records import Run
 from .sparse_pivoting import StateSolution, lcp_residual, solve_states
 
@@ -159,8 +159,6 @@ def simulate_sparse(
     """Evolve `system` event by event on the sparse path (see the module doc and
     `SparseBackend` for the options; the others as models.simulate). The run's `sparse_info`
     holds the seconds of every event and the pivoting's counters."""
-    from .simulate import blas_limit
-
     if state is None:
         state = initial_state(system, omega=omega, seed=seed)
     backend = SparseBackend(system, Dynamics(system), warm_start=warm_start, tol=tol,

@@ -80,10 +80,15 @@ def cmd_simulate(args) -> int:
     from rigidlcp.lcp.errors import InvalidInput
     from rigidlcp.lcp.io.files import check_new, output_dir
     from rigidlcp.models.engine import simulate
+    from rigidlcp.models.engine.simulate import check_dense_memory
     from rigidlcp.models.event import initial_state
+    from rigidlcp.models.lattice import MAX_DISKS
     from rigidlcp.models.observables import state_counts
     from rigidlcp.models.runio import run_paths, save_run
 
+    p = args.lx * args.ly  # c >= p: refused before the lattice (seconds at 10^5 disks) is built
+    if args.method != "sparse-pivoting" and 0 < p <= MAX_DISKS:
+        check_dense_memory(p, f"a {args.lx} x {args.ly} array (at least {p} contacts)")
     system = system_from_args(args)
     if args.omega_scale < 0 or not np.isfinite(args.omega_scale):
         raise ValueError(f"--omega-scale must be a finite number >= 0, got {args.omega_scale}")
@@ -105,7 +110,10 @@ def cmd_simulate(args) -> int:
                                f"{os.path.join(args.out, 'run.npz')})")
         paths = run_paths(args.out)
         check_new(paths, force=args.force)
-        output_dir(paths[0].parent, force=True)
+        try:
+            output_dir(paths[0].parent, force=True)
+        except OSError as exc:  # name the user's path
+            raise OSError(exc.errno, f"--out {args.out}: {exc.strerror}", exc.filename) from None
     if args.dump_problems:
         output_dir(args.dump_problems, force=args.force)
     state = initial_state(system, seed=args.seed, omega_scale=args.omega_scale)

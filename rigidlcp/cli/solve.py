@@ -108,6 +108,8 @@ def cmd_certify(args: argparse.Namespace) -> int:
     """Solve the problem file, certify the answer, print the certificate (or JSON)."""
     from rigidlcp.verify import certify
 
+    if not args.time_limit > 0:  # checked first: -3 would read as "time limit reached"
+        raise ValueError(f"--time-limit must be > 0 seconds, got {args.time_limit}")
     problem = _load(args.problem)
     sol = solve(problem, method=args.method, **parse_options(args.option))
     if sol.z is None or not sol.success:

@@ -65,6 +65,9 @@ CASES: list[tuple[str, str]] = [
     ("simulate --lx 3 --ly 2 --out existfile/run.npz", "existfile"),
     ("simulate --lx 3 --ly 2 --dump-problems existfile", "existfile"),
     ("simulate --lx 3 --ly 2 --dump-problems figs", "--force"),
+    # the dense backend's memory is estimated before anything is allocated (issue 24.1)
+    ("simulate --lx 1000 --ly 1000 --out mid.npz --max-events 1", "sparse"),
+    ("simulate --lx 3 --ly 2 --no-progress --out /proc/x.npz", "/proc/x.npz"),
     # sweep (the whole grid is validated before anything runs)
     ("sweep --lattice hex --out sw", "hex"),
     ("sweep --mu-pp -0.1 --out sw", "mu_pp"),
@@ -112,6 +115,8 @@ CASES: list[tuple[str, str]] = [
     ("certify corrupt.npz", "not a .npz"),
     ("certify run.npz", "run saved by"),
     ("certify lcp.npz --method nope", "unknown method"),
+    ("certify lcp.npz --time-limit -3", "--time-limit"),
+    ("certify lcp.npz --time-limit nan", "--time-limit"),
     ("timestep --lx 0", "lx"),
     ("timestep --mu-pp -1", "mu_pp"),
     ("timestep --lx 3 --ly 2 --out run.npz", "exists"),
