@@ -216,9 +216,13 @@ def cmd_effective(args: argparse.Namespace) -> int:
                for (p, e, lo), lab in zip(usable, labels)]
     from rigidlcp.lcp.io.files import atomic_write_text, output_dir
 
-    output_dir(out, force=args.force, names=EFFECTIVE_FILES)
-    atomic_write_text(out / "effective.json", json.dumps(payload, indent=1) + "\n")
-    files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out)
+    text = json.dumps(payload, indent=1) + "\n"
+    if not args.force and _up_to_date(out, text):  # a re-display: the same table from the same sweep, no --force
+        files = [out / name for name in EFFECTIVE_FILES[1:]]
+    else:
+        output_dir(out, force=args.force, names=EFFECTIVE_FILES)
+        atomic_write_text(out / "effective.json", text)
+        files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out)
     if args.json:
         print(json.dumps(payload, indent=1))
         return 0
@@ -233,10 +237,28 @@ def cmd_effective(args: argparse.Namespace) -> int:
     n_out = sum(len(lo) for _, _, lo in usable)
     if n_out:
         print(f"{n_out} point(s) left out (not steady)", file=sys.stderr)
-    print("fit: 'exact' = the local fit matched F_g within rounding (no kink in its window)")
+    print(f"fit: 'exact' = a window of {args.window} points on one linear piece of F_g: a is "
+          f"dF_g/dgamma; 'kink' = every window of {args.window} points around gamma straddles "
+          "a change of contact states (a kink of F_g, Fig. 11): a is a chord slope, not the "
+          "derivative (open markers in effective.png)")
+    kinks = sum(not r["exact"] for item in payload for r in item["rows"])
+    if kinks:
+        total = sum(len(item["rows"]) for item in payload)
+        print(f"warning: {kinks} of {total} points are 'kink': their a, m_e and mu_e are chord "
+              "estimates, not Eqs. (4.1)-(4.2); refine the gamma grid there (F_g has a kink "
+              "wherever a disk changes mode)", file=sys.stderr)
     for f in files:
         print(f)
     return 0
+
+
+def _up_to_date(out: Path, text: str) -> bool:
+    """True when `out` already holds this very effective.json and its figures."""
+    try:
+        same = (out / "effective.json").read_text(encoding="utf-8") == text
+    except (OSError, UnicodeDecodeError):
+        return False
+    return same and all((out / name).is_file() for name in EFFECTIVE_FILES[1:])
 
 
 def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
@@ -260,9 +282,16 @@ def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
     plt.close(fig)
     files.append(path)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11.0, 4.0))
+    marked = False
     for label, e in curves:
-        ax1.plot(e.gamma, e.m_e, "o-", ms=3, label=label)
-        ax2.plot(e.gamma, e.mu_e, "o-", ms=3, label=label)
+        for ax, y in ((ax1, e.m_e), (ax2, e.mu_e)):
+            line, = ax.plot(e.gamma, y, "-", lw=1, label=label)
+            ax.plot(e.gamma[e.exact], y[e.exact], "o", ms=4, color=line.get_color())
+            ax.plot(e.gamma[~e.exact], y[~e.exact], "o", ms=6, mfc="none",
+                    color=line.get_color())
+        marked |= bool((~e.exact).any())
+    if marked:  # open markers: chord estimates (every fit window straddles a kink of F_g)
+        ax1.plot([], [], "o", mfc="none", color="grey", label="kink: chord, not dF_g/dγ")
     for _, e in curves[:1]:
         ax1.axhline(e.m_g, color="grey", lw=0.8, ls="--", label=r"$m_g$")
     ax1.set_xlabel(r"$\gamma$ / g")
