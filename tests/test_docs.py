@@ -6,6 +6,8 @@
   `<!-- not-run: REASON -->` is skipped (the reason is required).
 * Every `rigidlcp ...` line of a ```bash block is parsed by the real parser (the command and
   every option must exist, choices must be valid), and the cheap commands (CHEAP) are run.
+* A ```bash block preceded by `<!-- run-in-ci: REASON -->` is run whole, line by line, in a
+  temporary directory: every `rigidlcp ...` line must exit 0 (docs/usage.md's first steps).
 * In the other fenced blocks (listings, transcripts), every `rigidlcp NAME` must name an
   existing command.
 * The README lists every command.
@@ -27,6 +29,7 @@ DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 #: Commands cheap enough to run from the docs' bash blocks (seconds).
 CHEAP = {"methods", "verify-formulas"}
 _NOT_RUN = re.compile(r"<!--\s*not-run:\s*(\S.*?)\s*-->")
+_RUN = re.compile(r"<!--\s*run-in-ci:\s*(\S.*?)\s*-->")
 
 
 def blocks(path: Path) -> list[tuple[str, int, str, str | None]]:
@@ -135,6 +138,39 @@ def test_shell_commands_exist_and_parse(path: Path, tmp_path, monkeypatch, capsy
                 if main(words) != 0:
                     problems.append(f"line {line}: exit status != 0: {cmd}")
     assert not problems, f"{path.name}:\n" + "\n".join(problems)
+
+
+def _run_in_ci_blocks() -> list[tuple[Path, int, str]]:
+    out = []
+    for path in DOCS:
+        lines = path.read_text().splitlines()
+        for lang, line, code, _ in blocks(path):
+            prev = next((lines[j] for j in range(line - 3, -1, -1) if lines[j].strip()), "")
+            if lang == "bash" and _RUN.search(prev):
+                out.append((path, line, code))
+    return out
+
+
+def test_usage_has_run_in_ci_first_steps():
+    assert any(p.name == "usage.md" for p, _, _ in _run_in_ci_blocks())
+
+
+@pytest.mark.parametrize("path, line, code", _run_in_ci_blocks(),
+                         ids=[f"{p.name}:{n}" for p, n, _ in _run_in_ci_blocks()])
+def test_run_in_ci_blocks_run(path, line, code, tmp_path, monkeypatch, capsys):
+    """Each command of the block, in order, in one fresh folder, exits 0 (a second run of a
+    command that only displays, such as `effective`, must not need --force: run twice)."""
+    from rigidlcp.cli.main import main
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+    for cmd in _command_lines(code):
+        words = shlex.split(cmd)[1:]
+        code_ = main(words)
+        err = capsys.readouterr().err
+        assert code_ == 0, f"{path.name}:{line}: {cmd}: exit {code_}: {err[-300:]}"
+        if words[0] == "effective":
+            assert main(words) == 0, f"{path.name}:{line}: {cmd} again: {capsys.readouterr()}"
 
 
 def test_readme_lists_every_command():

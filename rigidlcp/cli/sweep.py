@@ -217,7 +217,7 @@ def cmd_effective(args: argparse.Namespace) -> int:
     from rigidlcp.lcp.io.files import atomic_write_text, output_dir
 
     text = json.dumps(payload, indent=1) + "\n"
-    if not args.force and _up_to_date(out, text):  # a re-display: the same table from the same sweep, no --force
+    if not args.force and _up_to_date(out, text):  # a re-display of the same table
         files = [out / name for name in EFFECTIVE_FILES[1:]]
     else:
         output_dir(out, force=args.force, names=EFFECTIVE_FILES)
