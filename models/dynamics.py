@@ -1,7 +1,7 @@
 """Kinematics and dynamics of a system: H, the mass matrix, the Delassus operator W and q.
 
 Generalized velocities nu = [vx (p), vy (p), omega (p)]; contact forces lambda = [R (c), S (c)].
-The relative velocity of body j with respect to body i at contact alpha (DESIGN.md) is
+The relative velocity of body j with respect to body i at contact alpha (docs/mechanics.md) is
 
     u_alpha = (v_j - v_i - r (omega_i + omega_j) t) . (n, t)  =  (H nu + u_obs)_alpha,
 

@@ -9,7 +9,7 @@ Geometry of the paper (Sec. II A, Fig. 1). Units: radius r (default 1). The box 
   Lx is the paper's: the number of disks in the rows that touch both walls (Eq. 3.3).
 
 Contact alpha joins body i (always a disk) and body j (a disk or an obstacle). Its unit normal n
-points from i to j and its tangent is t = n rotated by +90 degrees (DESIGN.md). For two disks,
+points from i to j and its tangent is t = n rotated by +90 degrees (mechanics.md). For two disks,
 i is the lower (or, in a row, the left) one, so n points up or to the right.
 """
 

@@ -1,10 +1,10 @@
 """Observables of the paper: contact states, global friction, dissipation, balances, energy.
 
-Signs (DESIGN.md): the force of the plane on a disk is -(R n + S t) with n = (0, -1), t = (1, 0),
-so its horizontal part is -S. The global friction F_g = sum over plane contacts of S is counted
-positive when it opposes the box's motion relative to the plane, so that Eq. (2.1) reads
-N - F_g = m_g gamma; mu_g = F_g / (m_g g). The dissipation rate is D = -sum S v_t >= 0 and the
-power the plane gives the disks is F_g V, so between events d(E_rot)/dt = F_g V - D.
+Signs (docs/mechanics.md): the force of the plane on a disk is -(R n + S t) with n = (0, -1),
+t = (1, 0), so its horizontal part is -S. The global friction F_g = sum over plane contacts of S
+is counted positive when it opposes the box's motion relative to the plane, so that Eq. (2.1)
+reads N - F_g = m_g gamma; mu_g = F_g / (m_g g). The dissipation rate is D = -sum S v_t >= 0 and
+the power the plane gives the disks is F_g V, so between events d(E_rot)/dt = F_g V - D.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ EXCLUDED = {"detachment": "a contact opens (a_n > 0): particles would move, whic
 def dissipation_rate(S: np.ndarray, vt: np.ndarray) -> float:
     """D = -sum_alpha S_alpha v_t,alpha (>= 0 under Coulomb's law), the power dissipated by
     friction: the paper's total dissipation rate W' = sum S theta'^t of Fig. 13 (Sec. IV C),
-    with this toolkit's sign of S (DESIGN.md). Raw value: see `reported` for the noise."""
+    with this toolkit's sign of S (docs/mechanics.md). Raw value: see `reported` for the noise."""
     return float(-np.dot(S, vt))
 
 

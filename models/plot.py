@@ -26,7 +26,7 @@ def _plt():
     return plt
 
 
-#: Units of the quantities drawn (r = m = g = 1, DESIGN.md).
+#: Units of the quantities drawn (r = m = g = 1, docs/mechanics.md).
 UNITS = {"omega_dot": "g / r", "omega": "sqrt(g / r)", "t": "sqrt(r / g)", "force": "m g",
          "D": "m g sqrt(g r)"}
 

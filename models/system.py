@@ -1,9 +1,9 @@
 """A system: a lattice, the three coefficients of friction, the disks' inertia and the driving.
 
-Frame (DESIGN.md): the box's frame, x to the right, y up. The box moves relative to the plane
-with velocity V(t) = V0 + gamma t, so in the box frame every disk feels gravity (0, -m g) and
-the inertial force (-m gamma, 0); the walls are fixed and the plane moves with velocity -V(t).
-Constant velocity is gamma = 0.
+Frame (docs/mechanics.md): the box's frame, x to the right, y up. The box moves relative to the
+plane with velocity V(t) = V0 + gamma t, so in the box frame every disk feels gravity (0, -m g)
+and the inertial force (-m gamma, 0); the walls are fixed and the plane moves with velocity
+-V(t). Constant velocity is gamma = 0.
 """
 
 from __future__ import annotations

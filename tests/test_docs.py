@@ -209,3 +209,33 @@ def test_public_submodules_are_attributes():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.strip()
     assert out == "", f"not attributes of their package: {out}"
+
+
+def test_no_reference_to_a_design_file_the_repository_lacks():
+    """Issue 24.6: docs and docstrings sent readers to a DESIGN.md outside the repository; the
+    sign conventions live in docs/mechanics.md."""
+    files = [*DOCS, *ROOT.glob("models/**/*.py"), *ROOT.glob("lcp/**/*.py"),
+             *ROOT.glob("verify/**/*.py"), *ROOT.glob("rigidlcp/**/*.py")]
+    bad = [str(p.relative_to(ROOT)) for p in files if "DESIGN.md" in p.read_text()]
+    assert not (ROOT / "DESIGN.md").exists() and not bad, bad
+    text = (ROOT / "docs" / "mechanics.md").read_text()
+    assert "### Sign conventions" in text and "D = -sum_alpha S_alpha v_t,alpha" in text
+
+
+def test_readme_main_job_writes_only_ignored_files(tmp_path):
+    """Issue 24.6: the README's main job left an untracked run.json in the checkout."""
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("needs git and a git checkout")
+    readme = (ROOT / "README.md").read_text()
+    line = next(c for lang, _, code, _ in blocks(ROOT / "README.md") if lang == "bash"
+                for c in _command_lines(code) if c.startswith("rigidlcp simulate"))
+    words = shlex.split(line)
+    out = words[words.index("--out") + 1]
+    assert out in readme
+    paths = [out, out.removesuffix(".npz") + ".json"]
+    proc = subprocess.run(["git", "-C", str(ROOT), "check-ignore", *paths],
+                          capture_output=True, text=True)
+    assert sorted(proc.stdout.split()) == sorted(paths), f"not ignored: {paths}"

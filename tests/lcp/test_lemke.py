@@ -126,7 +126,7 @@ def degenerate_integer_lcps(draw, max_n: int = 5):
 
 
 def friction_lcp(W: np.ndarray, mu: np.ndarray, qn: np.ndarray, qt: np.ndarray):
-    """The LCP of DESIGN.md's non-sliding contacts (tau = mu R + S, a_+ = a_t + a_-):
+    """The LCP of docs/mechanics.md's non-sliding contacts (tau = mu R + S, a_+ = a_t + a_-):
 
         a_n       = (W_nn - mu W_nt) R + W_nt tau + q_n            0 <= R    perp a_n
         a_+       = (W_tn - mu W_tt) R + W_tt tau + a_- + q_t      0 <= tau  perp a_+
