@@ -103,8 +103,9 @@ def force_key(ax, fmax: float, max_width: float, name: str = "R", signed: bool =
     if signed:
         handles += [Line2D([], [], color=c, lw=3) for c in ("tab:red", "tab:blue")]
         labels += [f"{name} > 0", f"{name} < 0"]
+    # at most three entries a row: five in one row ran past a narrow figure and were clipped
     ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0),
-              ncol=len(labels), fontsize="x-small", frameon=False, handlelength=2.5)
+              ncol=min(len(labels), 3), fontsize="x-small", frameon=False, handlelength=2.5)
 
 
 def plot_rows(fig, system: System, omega_dot: np.ndarray, title: str = "") -> None:
@@ -129,16 +130,23 @@ def plot_rows(fig, system: System, omega_dot: np.ndarray, title: str = "") -> No
         axes[0].set_title(title, fontsize="medium")
 
 
+#: The one linear threshold of every symmetric-log time axis (in sqrt(r / g)): times below it
+#: are drawn linearly (t = 0 included), above it logarithmically.
+TIME_LINTHRESH = 1e-3
+
+
 def time_axis(ax, t: np.ndarray) -> None:
-    """A time axis that shows the transient: symmetric-log, linear below the first event
-    interval (on a linear scale the early events are squeezed against the axis)."""
+    """A time axis that shows the transient: symmetric-log (linear below TIME_LINTHRESH,
+    logarithmic above; on a linear scale the early events are squeezed against the axis) when
+    the times span more than two decades above the threshold, else linear. The label says
+    which."""
     t = np.asarray(t)
-    pos = t[t > 0]
-    if pos.size and pos.max() > 20 * pos.min():
-        lin = 10.0 ** np.floor(np.log10(pos.min()))  # a power of ten: no tick inside
-        ax.set_xscale("symlog", linthresh=float(lin), linscale=1.0)
-    log = ax.get_xscale() == "symlog"
-    ax.set_xlabel(f"t ({UNITS['t']})" + (", log scale" if log else ""))
+    if t.size and t.max() > 100 * TIME_LINTHRESH:
+        ax.set_xscale("symlog", linthresh=TIME_LINTHRESH, linscale=1.0)
+        ax.set_xlabel(f"t ({UNITS['t']}); symlog: linear below {TIME_LINTHRESH:g}, "
+                      "logarithmic above")
+    else:
+        ax.set_xlabel(f"t ({UNITS['t']})")
 
 
 def step_series(run: Run, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -206,18 +214,18 @@ def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
     ax.step(t, mu, where="post")
     time_axis(ax, t)
     ax.set_ylabel(r"$\mu_g = F_g / (m_g\, g)$")
-    ax.set_title("global friction coefficient (Fig. 10)")
+    ax.set_title("global friction coefficient")
     save(fig, "mu_g.png")
     fig, ax = plt.subplots(figsize=(6.5, 4))
     t, D = dissipation_curve(run)
     ax.plot(t, D)
     time_axis(ax, t)
     ax.set_ylabel(f"dissipation rate D ({UNITS['D']})")
-    ax.set_title(r"$D = -\sum S\, v_t$ (Fig. 13's $\dot W$)")
+    ax.set_title(r"dissipation rate $D = -\sum S\, v_t$")
     save(fig, "dissipation.png")
     return files
 
 
 __all__ = ["PLOT_FILES", "UNITS", "plot_run", "draw_lattice", "draw_forces", "force_key",
-           "plot_rows", "time_axis", "dissipation_curve", "step_series", "LEFT_WALL",
-           "RIGHT_WALL", "PLANE"]
+           "plot_rows", "time_axis", "TIME_LINTHRESH", "dissipation_curve", "step_series",
+           "LEFT_WALL", "RIGHT_WALL", "PLANE"]

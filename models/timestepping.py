@@ -45,7 +45,7 @@ from __future__ import annotations
 
 import time as _time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -285,6 +285,10 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
                    and np.abs(omega_dot - od_prev).max(initial=0.0) <= 1e-9 * acc_scale
                    and not np.any((s != 0) & (s * (ut - ut_prev) < -1e-12 * u_scale)))
         quiet = quiet + 1 if settled else 0
+        if step == 0:  # the run's records start at its initial state (plots, dissipated
+            # energy from t = state.t): the first step's forces, from the initial velocities
+            run.records.append(replace(rec, t=t, V=V, omega=nu[2 * p:].copy(), vt=ut_prev.copy(),
+                                       dissipation=dissipation_rate(S, ut_prev)))
         t, V, nu, od_prev, s_prev, P_prev = t + h, V_next, nu_next, omega_dot, s, P
         ut_prev, at_prev = ut, at
         last = (opening.size or quiet >= opts.steady_steps or t >= opts.t_max

@@ -222,7 +222,8 @@ def cmd_effective(args: argparse.Namespace) -> int:
     else:
         output_dir(out, force=args.force, names=EFFECTIVE_FILES)
         atomic_write_text(out / "effective.json", text)
-        files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out)
+        files = plot_effective([(lab, e) for (_, e, _), lab in zip(usable, labels)], out,
+                               cite=all(is_paper_fig11(p) for p, _, _ in usable))
     if args.json:
         print(json.dumps(payload, indent=1))
         return 0
@@ -261,8 +262,20 @@ def _up_to_date(out: Path, text: str) -> bool:
     return same and all((out / name).is_file() for name in EFFECTIVE_FILES[1:])
 
 
-def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
-    """mu_g(gamma) (Fig. 11) and m_e(gamma), mu_e(gamma) (Fig. 12) for labelled curves."""
+#: The parameters of the paper's Figs. 11-12 (rect 10x1, mu_pp 0.05, mu_plane 0.1, frictionless
+#: walls, from rest): only a sweep of this system is titled with their numbers.
+PAPER_FIG11 = dict(lattice="rect", lx=10, ly=1, mu_pp=0.05, mu_plane=0.1, mu_wall=0.0, v0=0.0)
+
+
+def is_paper_fig11(params: dict) -> bool:
+    return all(params.get(k) == v for k, v in PAPER_FIG11.items()) and params.get(
+        "inertia") is None
+
+
+def plot_effective(curves: list[tuple[str, object]], out: Path,
+                   cite: bool = False) -> list[Path]:
+    """mu_g(gamma) and m_e(gamma), mu_e(gamma) for labelled curves; cite: the titles name the
+    paper's Figs. 11 and 12 (only when the curves are of the paper's system)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -274,7 +287,7 @@ def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
         ax.plot(e.gamma, e.mu_g, "o-", ms=3, label=label)
     ax.set_xlabel(r"$\gamma$ / g")
     ax.set_ylabel(r"$\mu_g$")
-    ax.set_title("global friction coefficient (Fig. 11)")
+    ax.set_title("global friction coefficient" + (" (Fig. 11)" if cite else ""))
     if len(curves) > 1:
         ax.legend(fontsize="small")
     path = out / "mu_g.png"
@@ -296,10 +309,10 @@ def plot_effective(curves: list[tuple[str, object]], out: Path) -> list[Path]:
         ax1.axhline(e.m_g, color="grey", lw=0.8, ls="--", label=r"$m_g$")
     ax1.set_xlabel(r"$\gamma$ / g")
     ax1.set_ylabel(r"$m_e = m_g + \partial F_g/\partial\gamma$")
-    ax1.set_title("(a) effective inertia (Fig. 12)")
+    ax1.set_title("(a) effective inertia" + (" (Fig. 12)" if cite else ""))
     ax2.set_xlabel(r"$\gamma$ / g")
     ax2.set_ylabel(r"$\mu_e = (F_g - \gamma\,\partial F_g/\partial\gamma) / (m_g g)$")
-    ax2.set_title("(b) effective friction coefficient (Fig. 12)")
+    ax2.set_title("(b) effective friction coefficient" + (" (Fig. 12)" if cite else ""))
     ax1.legend(fontsize="small")
     if len(curves) > 1:
         ax2.legend(fontsize="small")

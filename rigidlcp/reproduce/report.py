@@ -50,6 +50,7 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
 
     plt = _plt()
     files: dict[str, Path] = {}
+    smaller = size_differences(res.plan)  # a title cites the paper's figure only at its sizes
     # Fig. 7: angular accelerations at three stages of one run.
     run = res.seeds("fig7")[0]
     w, h = _size(run.system)
@@ -62,20 +63,7 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
                                                       else ""))
     files["fig7"] = _save(fig, out / "fig7_stages.png")
     # Fig. 8: angular accelerations, normal and friction forces of the steady state.
-    run = res.seeds("fig8")[0]
-    w, h = _size(run.system)
-    fig, axes = plt.subplots(3, 1, figsize=(w, 3.3 * h))
-    draw_lattice(axes[0], run.system, run.last.omega_dot,
-                 label=r"$\dot\omega$ (" + UNITS["omega_dot"] + ")")
-    axes[0].set_title("(a) angular accelerations; first-row modes "
-                      + row_modes(run.system, run.last).text())
-    for ax, F, signed, title, sym in (
-            (axes[1], run.last.R, False, "(b) normal forces R, width ~ R", "R"),
-            (axes[2], run.last.S, True, "(c) friction forces S, width ~ |S|", "S")):
-        draw_lattice(ax, run.system)
-        draw_forces(ax, run.system, F, signed=signed, name=sym)
-        ax.set_title(title)
-    files["fig8"] = _save(fig, out / "fig8_steady_state.png")
+    files["fig8"] = fig8_steady_state(res.seeds("fig8")[0], out / "fig8_steady_state.png")
     # Fig. 9: steady angular accelerations against position, one panel per row.
     run = res.seeds("fig9")[0]
     fig = plt.figure(figsize=(6.5, 1.0 + 1.1 * run.system.lattice.ly), layout="constrained")
@@ -89,14 +77,16 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
         ax.step(t, mu, where="post", label=f"seed {seed}")
     time_axis(ax, t)
     ax.set_ylabel(r"$\mu_g = F_g / (m_g\, g)$")
-    ax.set_title("global friction coefficient from several initial states (Fig. 10)")
+    ax.set_title("global friction coefficient from several initial states"
+                 + (" (Fig. 10)" if "fig10" not in smaller else " (quick run)"))
     ax.legend(fontsize="small", title="initial angular velocities")
     files["fig10"] = _save(fig, out / "fig10_mu_g.png")
     # Figs. 11-12 (base system) and Sec. IV B (three systems).
     d = out / "fig11_12"
     d.mkdir(exist_ok=True)
     base = res.effective("fig11")
-    mu_g_png, eff_png = plot_effective([("10x1, mu 0.05 / 0.1 / 0", base)], d)
+    mu_g_png, eff_png = plot_effective([("10x1, mu 0.05 / 0.1 / 0", base)], d,
+                                       cite="fig11" not in smaller)
     files["fig11"], files["fig12"] = mu_g_png, eff_png
     d = out / "ivb"
     d.mkdir(exist_ok=True)
@@ -133,6 +123,25 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     axes[1].set_title("steady state; stars: Fig. 5(e) loop contacts")
     files["fig6"] = _save(fig, out / "fig6_omega.png")
     return files
+
+
+def fig8_steady_state(run, path: Path) -> Path:
+    """Fig. 8: angular accelerations, normal and friction forces of a run's last state."""
+    plt = _plt()
+    w, h = _size(run.system)
+    fig, axes = plt.subplots(3, 1, figsize=(w, 3.3 * h), gridspec_kw={"hspace": 0.55})
+    draw_lattice(axes[0], run.system, run.last.omega_dot,
+                 label=r"$\dot\omega$ (" + UNITS["omega_dot"] + ")")
+    # two lines, left-aligned: on one line the title ran into the colour bar
+    axes[0].set_title("(a) angular accelerations\nfirst-row modes "
+                      + row_modes(run.system, run.last).text(), loc="left")
+    for ax, F, signed, title, sym in (
+            (axes[1], run.last.R, False, "(b) normal forces R, width ~ R", "R"),
+            (axes[2], run.last.S, True, "(c) friction forces S, width ~ |S|", "S")):
+        draw_lattice(ax, run.system)
+        draw_forces(ax, run.system, F, signed=signed, name=sym)
+        ax.set_title(title)
+    return _save(fig, path)
 
 
 SECTIONS = [

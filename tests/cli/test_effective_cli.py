@@ -51,3 +51,13 @@ def test_plateau_values_are_exact_on_a_grid_that_resolves_it(tmp_path, capsys):
         assert r["exact"]
         assert r["m_e"] == pytest.approx(10.0, abs=1e-9)
         assert r["mu_e"] == pytest.approx(0.2, abs=1e-9)
+
+
+def test_effective_titles_cite_the_paper_only_for_its_system():
+    from rigidlcp.cli.sweep import is_paper_fig11
+
+    paper = dict(lattice="rect", lx=10, ly=1, mu_pp=0.05, mu_plane=0.1, mu_wall=0.0, v0=0.0,
+                 inertia=None)
+    assert is_paper_fig11(paper)
+    assert not is_paper_fig11(dict(paper, mu_pp=0.1))  # the README's sweep: defaults 0.1 / 0.2
+    assert not is_paper_fig11(dict(paper, lx=6))

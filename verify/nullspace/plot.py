@@ -1,8 +1,11 @@
 """Drawings of null-space basis vectors on the lattice (matplotlib, Agg backend).
 
 One panel per basis vector: the disks, walls and plane (`models.plot.draw_lattice`), every
-contact as a thin grey segment, and the contacts that the vector involves as thick segments,
-width ~ sqrt(R^2 + S^2), red where R > 0, blue where R < 0, green where only S is nonzero.
+contact as a thin grey segment; R as thick segments, width ~ |R|, red where R > 0, blue where
+R < 0; S as a green arrow at the contact point along S t (t = n turned by +90 degrees, the
+tangential part of the force on body j, docs/mechanics.md), length ~ |S|, so that the sign of
+S shows wherever it is nonzero, also where R is. Sizes are relative to the vector's largest
+entry, max(|R|, |S|).
 """
 
 from __future__ import annotations
@@ -34,14 +37,20 @@ def _draw_vector(ax, system: models.System, R: np.ndarray, S: np.ndarray, title:
     a, b = contact_points(system)
     segs = np.stack([a, b], axis=1)
     ax.add_collection(LineCollection(segs, colors="0.8", linewidths=0.6))
-    mag = np.hypot(R, S)
-    scale = max(mag.max(initial=0.0), 1e-300)
-    on = mag > 1e-9 * scale
-    colors = np.where(R > 1e-9 * scale, "tab:red", np.where(R < -1e-9 * scale, "tab:blue",
-                                                             "tab:green"))
+    scale = max(np.abs(R).max(initial=0.0), np.abs(S).max(initial=0.0), 1e-300)
+    on = np.abs(R) > 1e-9 * scale
     if np.any(on):
-        ax.add_collection(LineCollection(segs[on], colors=list(colors[on]),
-                                         linewidths=1.0 + 4.0 * mag[on] / scale))
+        colors = np.where(R[on] > 0, "tab:red", "tab:blue")
+        ax.add_collection(LineCollection(segs[on], colors=list(colors),
+                                         linewidths=1.0 + 4.0 * np.abs(R[on]) / scale))
+    lat = system.lattice
+    tan = np.abs(S) > 1e-9 * scale
+    if np.any(tan):  # S t at the contact point: the sign of S, with or without R
+        point = lat.x[lat.i[tan]] + lat.radius * lat.n[tan]
+        vec = 1.2 * lat.radius * (S[tan] / scale)[:, None] * lat.t[tan]
+        ax.quiver(point[:, 0], point[:, 1], vec[:, 0], vec[:, 1], color="tab:green",
+                  angles="xy", scale_units="xy", scale=1.0, width=0.014, pivot="middle",
+                  zorder=4)
     ax.set_title(title, fontsize="small")
 
 
@@ -51,9 +60,10 @@ def _key():
     from matplotlib.lines import Line2D
 
     handles = [Line2D([], [], color="tab:red", lw=5), Line2D([], [], color="tab:blue", lw=5),
-               Line2D([], [], color="tab:green", lw=5), Line2D([], [], color="k", lw=5),
-               Line2D([], [], color="k", lw=1)]
-    labels = ["R > 0", "R < 0", "S only", "largest |(R, S)|", "smallest drawn"]
+               Line2D([], [], color="tab:green", marker=">", lw=2),
+               Line2D([], [], color="k", lw=5), Line2D([], [], color="k", lw=1)]
+    labels = ["R > 0", "R < 0", "S t (arrow: sign and size of S)", "largest |R|",
+              "smallest |R| drawn"]
     return handles, labels
 
 
@@ -76,7 +86,7 @@ def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarr
         _draw_vector(ax, system, R, S, title)
     if suptitle:
         fig.suptitle(suptitle)
-    fig.legend(*_key(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=5,
+    fig.legend(*_key(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=3,
                fontsize="small", frameon=False)
     path = Path(out)
     path.parent.mkdir(parents=True, exist_ok=True)
