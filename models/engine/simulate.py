@@ -55,7 +55,7 @@ def simulate(
     loaded machine); None leaves BLAS alone.
     """
     if method != "sparse-pivoting":
-        check_dense_memory(system.c, f"this array of {system.c} contacts")
+        check_dense_memory(system.c, f"the dense event LCP of {system.c} contacts")
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
@@ -103,17 +103,22 @@ def available_bytes() -> int | None:
         return None
 
 
-def check_dense_memory(contacts: int, what: str, available: int | None = None) -> None:
-    """Refuse, before anything is allocated, a dense run whose event matrices cannot fit in
-    memory (InvalidInput naming the sparse backend). `what` names the array in the message;
-    `contacts` may be a lower bound (every disk rests on at least one contact: c >= p)."""
+#: What to use instead of a dense run that cannot fit in memory.
+SPARSE_INSTEAD = ("use the sparse backend (--method sparse-pivoting --select none; Python: "
+                  "method='sparse-pivoting', select='none')")
+
+
+def check_dense_memory(contacts: int, what: str, available: int | None = None,
+                       instead: str = SPARSE_INSTEAD) -> None:
+    """Refuse, before anything is allocated, a dense computation whose matrices cannot fit in
+    memory (InvalidInput saying `instead` what to do). `what` names the computation and the
+    array; `contacts` may be a lower bound (every disk rests on at least one contact: c >= p).
+    """
     need = dense_bytes(contacts)
     have = available_bytes() if available is None else available
     if have is not None and need > have:
-        raise InvalidInput(
-            f"the dense event LCP of {what} needs at least {need / 2**30:.1f} GiB of memory "
-            f"and {have / 2**30:.1f} GiB is available: use the sparse backend (--method "
-            "sparse-pivoting --select none; Python: method='sparse-pivoting', select='none')")
+        raise InvalidInput(f"{what}: at least {need / 2**30:.1f} GiB of memory needed, "
+                           f"{have / 2**30:.1f} GiB available; {instead}")
 
 
 def _print_progress(run: Run) -> None:

@@ -39,8 +39,9 @@ def cmd_compare_integrators(args) -> int:
     from rigidlcp.models.timestepping import StepOptions
     from rigidlcp.verify.integrators import compare_integrators, format_comparison
 
-    from .simulate import system_from_args
+    from .simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
 
+    refuse_too_large_for_dense(args, "the dense event and step LCPs", DENSE_ONLY)
     system = system_from_args(args)
     if args.levels < 3:
         raise ValueError(f"--levels must be >= 3 (an order needs three step sizes), "

@@ -49,7 +49,7 @@ def register(sub) -> None:
 
 def cmd_forces(args: argparse.Namespace) -> int:
     from rigidlcp import lcp, models
-    from rigidlcp.cli.simulate import system_from_args
+    from rigidlcp.cli.simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
     from rigidlcp.lcp.io.files import atomic_write_text, output_dir
     from rigidlcp.models.event import acceleration_tol
     from rigidlcp.verify.certificates.certify import certify
@@ -68,6 +68,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
         raise ValueError(f"--networks must be >= 1, got {args.networks}")
     if not args.time_limit > 0:
         raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
+    refuse_too_large_for_dense(args, "the dense event LCP and force polyhedra", DENSE_ONLY)
     system = system_from_args(args)
     lcp.get_method(args.method)
     names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"

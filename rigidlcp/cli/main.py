@@ -2,9 +2,10 @@
 
 Each module in `COMMAND_MODULES` adds its sub-commands with `register(subparsers)` and keeps
 its heavy imports inside the commands, so that `rigidlcp --help` stays fast. An error raised on
-purpose by the toolkit (`rigidlcp.lcp.errors.RigidLCPError`), a bad value, or a file that is
-missing, exists already or cannot be written, is printed as one line naming the problem, with
-exit status 2: never a traceback.
+purpose by the toolkit (`rigidlcp.lcp.errors.RigidLCPError`), a bad value, a file that is
+missing, exists already or cannot be written, or an allocation that fails (MemoryError, past
+the commands' up-front memory estimates), is printed as one line naming the problem, with exit
+status 2: never a traceback.
 """
 
 from __future__ import annotations
@@ -76,6 +77,11 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     except (RigidLCPError, ValueError, OSError) as exc:
         print(f"rigidlcp {args.command}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except MemoryError as exc:  # past the up-front estimates (lower bounds): still one line
+        print(f"rigidlcp {args.command}: error: out of memory ({_one_line(exc)}); use a "
+              "smaller array (large arrays: rigidlcp simulate --method sparse-pivoting "
+              "--select none)", file=sys.stderr)
         return 2
 
 

@@ -61,6 +61,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     import numpy as np
 
     from rigidlcp import models
+    from rigidlcp.cli.simulate import DENSE_ONLY, refuse_too_large_for_dense
     from rigidlcp.verify.nullspace.contact import (
         null_space,
         paper_states,
@@ -68,6 +69,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
         rotation_loops,
     )
 
+    refuse_too_large_for_dense(args, "the dense contact matrix and its SVD", DENSE_ONLY)
     system = models.System(models.make_lattice(args.lattice, args.lx, args.ly),
                            mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
     if args.plot:  # checked before the SVD: never overwrite a user's file without --force

@@ -42,6 +42,25 @@ def system_from_args(args):
                        mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
 
 
+#: The advice of the commands that have no sparse path.
+DENSE_ONLY = ("this command is dense only: use a smaller array (the event-driven evolution of "
+              "large arrays: rigidlcp simulate --method sparse-pivoting --select none)")
+
+
+def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> None:
+    """One line and exit 2, in a second and before anything is built or written, when the
+    dense matrices of `what` for the --lx x --ly array cannot fit in memory (c >= p = lx ly
+    contacts: the lattice itself takes minutes at 10^6 disks). instead: the advice (default:
+    the sparse backend of `simulate`)."""
+    from rigidlcp.models.engine.simulate import SPARSE_INSTEAD, check_dense_memory
+    from rigidlcp.models.lattice import MAX_DISKS
+
+    p = args.lx * args.ly
+    if 0 < p <= MAX_DISKS:  # beyond MAX_DISKS the lattice refuses the size itself
+        check_dense_memory(p, f"{what} of a {args.lx} x {args.ly} array (at least {p} "
+                           "contacts)", instead=instead or SPARSE_INSTEAD)
+
+
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="evolve an array event by event to its steady state",
                        description="Exact event-driven evolution of a disk array (Sec. II C, IV).")
@@ -80,15 +99,12 @@ def cmd_simulate(args) -> int:
     from rigidlcp.lcp.errors import InvalidInput
     from rigidlcp.lcp.io.files import check_new, output_dir
     from rigidlcp.models.engine import simulate
-    from rigidlcp.models.engine.simulate import check_dense_memory
     from rigidlcp.models.event import initial_state
-    from rigidlcp.models.lattice import MAX_DISKS
     from rigidlcp.models.observables import state_counts
     from rigidlcp.models.runio import run_paths, save_run
 
-    p = args.lx * args.ly  # c >= p: refused before the lattice (seconds at 10^5 disks) is built
-    if args.method != "sparse-pivoting" and 0 < p <= MAX_DISKS:
-        check_dense_memory(p, f"a {args.lx} x {args.ly} array (at least {p} contacts)")
+    if args.method != "sparse-pivoting":
+        refuse_too_large_for_dense(args, "the dense event LCP")
     system = system_from_args(args)
     if args.omega_scale < 0 or not np.isfinite(args.omega_scale):
         raise ValueError(f"--omega-scale must be a finite number >= 0, got {args.omega_scale}")

@@ -40,8 +40,9 @@ def cmd_timestep(args) -> int:
     from rigidlcp.models.runio import run_paths, save_run
     from rigidlcp.models.timestepping import moreau_jean
 
-    from .simulate import system_from_args
+    from .simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
 
+    refuse_too_large_for_dense(args, "the time-stepper's dense step LCP", DENSE_ONLY)
     system = system_from_args(args)
     if args.out:
         check_new(run_paths(args.out), force=args.force)

@@ -38,6 +38,38 @@ def test_dense_run_too_large_for_memory_names_the_sparse_backend(tmp_path):
              "sub/mid.npz", "--no-progress")
 
 
+@pytest.mark.parametrize("command", ["timestep", "compare-integrators", "nullspace", "forces"])
+def test_dense_only_commands_refuse_arrays_too_large_for_memory(tmp_path, command):
+    """24.1 on the other dense commands (they ended in a numpy MemoryError traceback, and
+    `forces` left its --out folder behind)."""
+    extra = ["--out", "f"] if command == "forces" else []
+    _refused(tmp_path, "dense only", command, "--lx", "1000", "--ly", "1000", *extra)
+
+
+def test_memory_error_is_one_line(monkeypatch, capsys):
+    """Past the up-front estimate (a lower bound), an allocation that fails is one line."""
+    import importlib
+
+    cli = importlib.import_module("rigidlcp.cli.main")
+
+    def boom(args):
+        raise MemoryError("Unable to allocate 99.0 GiB for an array")
+
+    parser = cli.build_parser
+    monkeypatch.setattr(cli, "build_parser", lambda: _with_func(parser(), boom))
+    assert cli.main(["methods"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "out of memory" in err[0] and "99.0 GiB" in err[0]
+
+
+def _with_func(parser, func):
+    parser.set_defaults(func=func)
+    sub = next(a for a in parser._actions if a.__class__.__name__ == "_SubParsersAction")
+    for p in sub.choices.values():
+        p.set_defaults(func=func)
+    return parser
+
+
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux's /proc")
 def test_unwritable_out_names_the_users_path(tmp_path):
     """24.5: --out /proc/x.npz named a hidden temporary file (/proc/.x.npz.XXXX.tmp), and only
