@@ -7,7 +7,8 @@ from __future__ import annotations
 import pytest
 
 from rigidlcp.reproduce.experiments import Claim, Results, plan
-from rigidlcp.reproduce.report import claim_sizes, size_differences, write_report
+from rigidlcp.reproduce.quick import claim_sizes, size_differences
+from rigidlcp.reproduce.report import write_report
 
 IDS = ("fig7-steady", "fig8-row1-mode1", "fig8-any-selection", "fig9-counts", "ivb-pp-mu_e",
        "fig13-minimum", "fig6-singular", "eq33-tri")
