@@ -96,9 +96,13 @@ class Verdict:
         return float(np.max(self.hi - self.lo, initial=0.0))
 
     def to_dict(self) -> dict:
+        """Strict JSON: face_width is null when the ranges were not computed (NaN) and
+        "unbounded" is true when a range is infinite (JSON has neither NaN nor Infinity)."""
+        width = self.face_width
         return {"verdict": self.verdict, "stage": self.stage, "reason": self.reason,
                 "seconds": round(self.seconds, 4), "scope": self.scope,
-                "face_width": self.face_width,
+                "face_width": width if np.isfinite(width) else None,
+                "face_unbounded": bool(np.isinf(width)),
                 "witness": None if self.witness is None else self.witness.to_dict()}
 
 
