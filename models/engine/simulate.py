@@ -34,6 +34,7 @@ def simulate(
     select: str = "face-min-norm",
     fallback: str | None = "lemke",
     blas_threads: int | None = 1,
+    selection: str | None = None,
 ) -> Run:
     """Evolve `system` from `state` (or from omega / a seed) event by event (Sec. II C, IV).
 
@@ -44,14 +45,19 @@ def simulate(
     problem's scale), or the run stops with "solver_failed"; the other stop rules and their
     parameters (t_max, max_events, zeno_events, zeno_time) are models/engine/loop.py's.
 
-    select: the particular solution of an event whose solution is not unique: "face-min-norm"
-    (default), "global" or "none" (see `DenseBackend`). fallback: when `method` fails at an
-    event (no solution, cycling, iteration limit), that event is solved again by this method
-    (None: stop); each use is counted in the record. progress: called with the run after each
-    event (None or False: not called). blas_threads: BLAS threads during the run (the event
-    problems are small dense matrices, for which one thread is fastest, and much faster on a
-    loaded machine); None leaves BLAS alone.
+    selection (or its older name select): the rule that picks the particular solution of an
+    event whose solution is not unique: "face-min-norm" (default), "max-sum-R[:CAP]",
+    "random:SEED", "global" or "none" (models/selection.py, `DenseBackend`). fallback: when
+    `method` fails at an event (no solution, cycling, iteration limit), that event is solved
+    again by this method (None: stop); each use is counted in the record. progress: called
+    with the run after each event (None or False: not called). blas_threads: BLAS threads
+    during the run (the event problems are small dense matrices, for which one thread is
+    fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
+    if selection is not None:
+        if select not in ("face-min-norm", selection):
+            raise ValueError(f"select={select!r} and selection={selection!r}: give one")
+        select = selection
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
