@@ -117,16 +117,17 @@ def certify(
 
     problem: an `lcp.LCP`, an `lcp.MLCP` (reduced by the Schur complement for the uniqueness
     questions), or a `models.EventProblem` (its LCP, with the observables "forces" and
-    "accelerations"). uniqueness: "auto" (P-matrix test; then enumeration for n <= 10, else the
-    stages of verify.certificates.stages: the face, other solvers, a MILP per open question,
-    as uniqueness="staged"; the MILP instead when objective="min-sum" asks for its least-sum
-    witness), "p-matrix", "enumeration", "milp", "staged" or "none". delta: the relative margin by which
-    another solution must differ to count (see uniqueness.milp_search; the MILP raises
-    it to its rounding floor, 1e-4 with the default box; the margin used is reported); bound: the
-    MILP's box (default 1e3 z_s); time_limit: seconds per MILP; objective: "none" (the first
-    other solution HiGHS meets) or "min-sum" (the other solution of least sum z, e.g. the
-    small-force one; slower: optimality must be proved). observables: extra linear maps
-    L (quantity = L z + const) whose uniqueness is asked too.
+    "accelerations"). uniqueness: "auto" (P-matrix test; then enumeration for n <= 10, else
+    the stages of verify.certificates.stages: the face, other solvers, a MILP per open
+    question, as uniqueness="staged"; the MILP instead when objective="min-sum" asks for its
+    least-sum witness), "p-matrix", "enumeration", "milp", "staged" or "none". delta: the
+    relative margin by which another solution must differ to count (see
+    uniqueness.milp_search; the MILP raises it to its rounding floor, 1e-4 with the default
+    box; the margin used is reported); bound: the MILP's box (default 1e3 z_s); time_limit:
+    seconds per MILP; objective: "none" (the first other solution HiGHS meets) or "min-sum"
+    (the other solution of least sum z, e.g. the small-force one; slower: optimality must be
+    proved). observables: extra linear maps L (quantity = L z + const) whose uniqueness is
+    asked too.
     """
     if uniqueness not in UNIQUENESS_METHODS:
         raise ValueError(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
