@@ -129,8 +129,7 @@ def test_lines_are_strict_json_with_witnesses(run_file, tmp_path):
 
 def test_witness_at_a_steady_event_says_whether_it_is_steady():
     """A 3x1 row (0.1/0.2/0, gamma 0.16, seed 1) ends steady; at its last event one witness
-    (other accelerations) opens a contact and starts a transmitting contact sliding: not a
-    steady state; another (other forces, same accelerations) is one. Each verdict is checked
+    (other accelerations) opens a contact (a_n != 0): not a steady state; another (other forces, same accelerations) is one. Each verdict is checked
     here from the witness's own accelerations."""
     from rigidlcp.models.event import event_problem
 
@@ -149,7 +148,8 @@ def test_witness_at_a_steady_event_says_whether_it_is_steady():
         es = ep.unpack(np.array(w["z"]))
         tol = 1e-6 * system.g  # the verdicts are clear-cut here: far above rounding
         closed = np.all(np.abs(es.a_n) <= tol)
-        kept = np.all(np.abs(es.a_t[(s_in == 0) & (system.mu > 0) & (es.R > 1e-9)]) <= tol)
+        # es.s: the states after the event (a contact starting to slide there is sliding)
+        kept = np.all(np.abs(es.a_t[(es.s == 0) & (system.mu > 0) & (es.R > 1e-9)]) <= tol)
         no_slowing = np.all(s_in * es.a_t >= -tol)
         assert w["steady"] == bool(closed and kept and no_slowing)
     # at a non-steady event the question is not asked
