@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linprog
 
 from rigidlcp.lcp import LCP
 from rigidlcp.lcp.face import face_minimum_norm
@@ -137,6 +136,8 @@ class _Face:
 
     def lp(self, z: np.ndarray, cost: np.ndarray, capped: bool) -> tuple[str, np.ndarray | None]:
         """min cost'y over the face of z (and sum R <= cap_R when capped)."""
+        from scipy.optimize import linprog  # not at import: a default run loads no LP stack
+
         A = np.flatnonzero(self.support(z))
         if A.size == 0:
             return "empty", None

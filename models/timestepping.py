@@ -1,9 +1,11 @@
-"""Moreau-Jean time-stepping (theta-method): a second, independent integrator.
+"""Moreau-Jean time-stepping (theta-method): a second integrator of the same systems.
 
-The event-driven evolution (models.evolution) is exact: it finds the next event analytically.
+The event-driven evolution (models.engine) is exact: it finds the next event analytically.
 This module integrates the same systems with a fixed step h instead, as NSCD codes (Siconos,
-LMGC90) do, so that every steady state can be checked by a method that shares nothing with
-the event loop except the kinematics (models.dynamics: H, M, f, u_obs).
+LMGC90) do. It shares with the event loop the kinematics (models.dynamics: H, M, f, u_obs) and
+the LCP solvers, and where a step's solution is not unique it follows the point of its
+selection rule (models.selection; default "none": the solver's): agreement between the two is
+a self-consistency check of this code, not an independent confirmation (docs/integrators.md).
 
 The geometry does not change (the paper's regime, no particle displacement): every contact stays
 closed and the step from t_k to t_{k+1} = t_k + h is, with impulses P = [P_n (c); P_t (c)]

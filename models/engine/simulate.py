@@ -54,10 +54,7 @@ def simulate(
     during the run (the event problems are small dense matrices, for which one thread is
     fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
-    if selection is not None:
-        if select not in ("face-min-norm", selection):
-            raise ValueError(f"select={select!r} and selection={selection!r}: give one")
-        select = selection
+    select = _one_rule(select, selection)
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
@@ -79,6 +76,13 @@ def simulate(
         progress = None if progress is False else _print_progress
     with blas_limit(blas_threads):
         return run_events(system, state, backend, limits, progress or None)
+
+
+def _one_rule(select: str, selection: str | None) -> str:
+    """The selection rule, given by its name `selection` or its older name `select`."""
+    if selection is None or select in ("face-min-norm", selection):
+        return select if selection is None else selection
+    raise ValueError(f"select={select!r} and selection={selection!r}: give one")
 
 
 def blas_limit(threads: int | None) -> AbstractContextManager:

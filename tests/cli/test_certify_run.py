@@ -129,8 +129,9 @@ def test_lines_are_strict_json_with_witnesses(run_file, tmp_path):
 
 def test_witness_at_a_steady_event_says_whether_it_is_steady():
     """A 3x1 row (0.1/0.2/0, gamma 0.16, seed 1) ends steady; at its last event one witness
-    (other accelerations) opens a contact (a_n != 0): not a steady state; another (other forces, same accelerations) is one. Each verdict is checked
-    here from the witness's own accelerations."""
+    (other accelerations) opens a contact (a_n != 0): not a steady state; another (other
+    forces, same accelerations) is one. Each verdict is checked here from the witness's own
+    accelerations."""
     from rigidlcp.models.event import event_problem
 
     system = models.System(models.rectangular(3, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
