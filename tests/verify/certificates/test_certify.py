@@ -200,3 +200,25 @@ def test_repr_and_bad_arguments():
         certify(problem, np.zeros(3))
     with pytest.raises(ValueError):
         certify(problem, np.zeros(2), uniqueness="guess")
+
+
+def test_defaults_decide_fig9_events():
+    """verify.certify at its defaults (uniqueness="auto") decides every question at events of
+    Fig. 9's run (n = 84 and more: beyond the enumeration, the staged path; issue 21.5), and
+    each "another solution exists" rests on a witness that is itself accepted."""
+    from rigidlcp import models
+    from rigidlcp.verify.forces.polyhedra import event_z
+
+    system = models.System(models.rectangular(10, 4), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.16)
+    run = models.simulate(system, seed=1, max_events=10)
+    for k in (0, run.n_events - 1):
+        ep = models.event_problem(system, run.state_at(k))
+        z = event_z(ep, np.r_[run.records[k].R, run.records[k].S])
+        cert = certify(ep, z)
+        assert cert.accepted and cert.method.startswith("staged (auto")
+        flags = [cert.w_unique, cert.z_unique, cert.pattern_unique, *cert.observables.values()]
+        assert None not in flags, cert
+        if False in flags:
+            assert cert.others and all(certify(ep, o, uniqueness="none").accepted
+                                       for o in cert.others)
