@@ -64,6 +64,10 @@ class DenseBackend:
     _events: int = field(default=0, repr=False)
     _rule: Selection | None = field(default=None, repr=False)
     _rng: np.random.Generator | None = field(default=None, repr=False)
+    #: events where the rule's face was unbounded in sum R (the cap applied) / where the rule's
+    #: point failed the acceptance test (the face-min-norm point was kept)
+    capped: int = field(default=0, repr=False)
+    rejected: int = field(default=0, repr=False)
 
     def __post_init__(self) -> None:
         self._rule = Selection.parse(self.select)  # InvalidSelection (a ValueError) naming RULES
@@ -136,9 +140,27 @@ class DenseBackend:
         stick_side[: self.system.c + ep.k] = True
         y, status = select(ep.lcp, z0, ep.G, self.system.c, stick_side, self._rule, self._rng)
         if status.startswith("failed"):
+            self.rejected += 1
             return z0, r0
         r = lcp.complementarity_residual(y, ep.lcp.M @ y + ep.lcp.q)
-        return (y, r) if r <= self.check_tol * scale else (z0, r0)
+        if r > self.check_tol * scale:
+            self.rejected += 1
+            return z0, r0
+        self.capped += status == "capped"
+        return y, r
+
+
+def selection_note(backend, run):
+    """Name a non-default selection rule in run.method and say in run.message at how many
+    events its cap applied or its point was rejected (models/selection.py)."""
+    if isinstance(backend, DenseBackend) and backend.select != "face-min-norm":
+        run.method += f" (selection {backend.select})"
+        notes = [f"{n} events {what}" for n, what in (
+            (backend.capped, "at the cap of sum R (unbounded face)"),
+            (backend.rejected, "kept the face-min-norm point (the rule's failed)")) if n]
+        if notes:
+            run.message += f"; selection {backend.select}: " + ", ".join(notes)
+    return run
 
 
 def warm_active_set(ep: EventProblem, prev: EventSolution, state: State) -> np.ndarray:

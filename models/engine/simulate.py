@@ -11,7 +11,7 @@ from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, initial_state
 from rigidlcp.models.system import System
 
-from .dense import DenseBackend
+from .dense import DenseBackend, selection_note
 from .loop import Limits, run_events
 from .records import Run
 
@@ -75,7 +75,7 @@ def simulate(
     if progress is True or progress is False:
         progress = None if progress is False else _print_progress
     with blas_limit(blas_threads):
-        return run_events(system, state, backend, limits, progress or None)
+        return selection_note(backend, run_events(system, state, backend, limits, progress or None))
 
 
 def _one_rule(select: str, selection: str | None) -> str:

@@ -75,6 +75,7 @@ def test_steady_states_of_two_rules_differ_and_both_are_valid():
     b = models.simulate(system, seed=1, selection="max-sum-R")
     assert a.status == b.status == "steady"
     assert abs(a.last.mu_g - b.last.mu_g) > 1e-3
+    assert a.method == "lemke" and b.method == "lemke (selection max-sum-R)"
     for run in (a, b):
         chk = event_check(system, run.last)
         assert chk.valid and chk.steady
