@@ -99,6 +99,39 @@ def test_every_selected_point_satisfies_the_laws(data, rule):
     assert certify(ep, y, uniqueness="none").accepted
 
 
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(systems(st.sampled_from([models.rectangular(2, 1), models.rectangular(3, 1),
+                                models.rectangular(2, 2)])),
+       st.integers(0, 10_000), st.sampled_from(RULES))
+def test_every_selected_step_point_satisfies_the_step_laws(system, seed, rule):
+    """The same on a Moreau-Jean step's LCP (z = [P_n, tau, u_minus], every frictional contact
+    a candidate), checked by the step's own Coulomb-law residual of the impulses P = G z."""
+    from rigidlcp.models.dynamics import Dynamics
+    from rigidlcp.models.timestepping import StepProblem, coulomb_residual
+
+    dyn = Dynamics(system)
+    h = 1e-2
+    omega = np.random.default_rng(seed).uniform(-1, 1, system.p)
+    nu = np.concatenate([np.zeros(2 * system.p), omega])
+    b = dyn.H @ (nu + h * dyn.Minv * dyn.f) + dyn.u_obs(h * system.gamma)
+    sp = StepProblem(system, dyn, np.zeros(system.c, int))
+    problem = sp.lcp(b, h)
+    sol = lcp.solve(problem, method="lemke")
+    if sol.status != "solved":
+        return
+    sel = Selection.parse(rule)
+    y, status = select(problem, sol.z, sp.G, system.c, np.arange(sp.n) < system.c + sp.k,
+                       sel, sel.rng())
+    if status.startswith("failed"):
+        return
+    P = sp.G @ y
+    u = dyn.H @ (nu + dyn.Minv * (dyn.H.T @ P) + h * dyn.Minv * dyn.f) + dyn.u_obs(
+        h * system.gamma)
+    P_scale = max(float(np.abs(P).max()), h * system.mass * system.g)
+    u_scale = max(float(np.abs(b).max()), system.g * h)
+    assert coulomb_residual(system, P, u, P_scale, u_scale) <= 1e-8
+
+
 def test_time_stepper_rules_reach_different_checked_steady_states():
     system = _row()
     a = moreau_jean(system, seed=1, h=4e-3, t_max=20)
