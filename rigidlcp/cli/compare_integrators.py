@@ -69,6 +69,8 @@ def cmd_compare_integrators(args) -> int:
     Selection.parse(args.selection)
     if args.ensemble is not None:
         return _ensemble(system, args)
+    if args.step_rules is not None:
+        raise ValueError("--step-rules goes with --ensemble")
     hs = tuple(args.h / 2**k for k in range(args.levels))
     cmp = compare_integrators(system, seed=args.seed, hs=hs, T=args.T, t_max=args.t_max,
                               event_options={"selection": args.selection},

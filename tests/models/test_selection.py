@@ -154,6 +154,8 @@ def test_ensemble_and_command(capsys):
                  "face-min-norm,nosuch"]) == 2
     err = capsys.readouterr().err
     assert "nosuch" in err and len(err.strip().splitlines()) == 1
+    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--step-rules", "none"]) == 2
+    assert "--ensemble" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exc:  # argparse: one line, exit status 2
         main(["timestep", "--lx", "2", "--ly", "1", "--selection", "best"])
     assert exc.value.code == 2 and "--selection" in capsys.readouterr().err
