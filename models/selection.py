@@ -13,7 +13,9 @@ then follow one point, chosen by a *rule*, a parameter of every run (never a hid
   sum R <= F times the "face-min-norm" point's sum R (F = 2 unless given) and says so.
 * "random:SEED": a random point of the face of the "face-min-norm" point: a convex combination
   (Dirichlet(1) weights) of that point and the minimizers of 3 random linear functionals over
-  the face (capped as above), drawn from numpy's default_rng(SEED), one generator per run.
+  the face (capped as above), drawn from numpy's default_rng(SEED), one generator per run. (In
+  the time-stepper a new point is drawn at every step, so its steady test, which needs forces
+  unchanged over 20 steps, rarely holds: such a run ends at t_max.)
 * "global" (events only): the least sum R over the whole solution set by a MILP.
 * "none": the solver's own solution: the time-stepper's default.
 
