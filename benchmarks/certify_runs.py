@@ -1,6 +1,6 @@
 """Staged uniqueness certificates over whole runs (issue 17): verdicts and seconds per event.
 
-    python benchmarks/certify_runs.py [--quick] [--enumerate]
+    python benchmarks/certify_runs.py [--quick] [--enumerate] [--defaults [K]]
 
 Simulates the runs of the paper's figures (Fig. 9: rect 10x4, gamma 0.16 g, seed 1; Fig. 10:
 rect 10x2, gamma 0.3 g; Fig. 11: rect 10x1, mu 0.05/0.1, gamma 0.1 g; Fig. 13: tri 10x3 at
@@ -8,7 +8,10 @@ constant velocity), certifies every event with verify.certificates.certify_run (
 settings, one process) and prints one table row per run: events, pairs, the verdict counts for
 accelerations / forces / states, the deciding stages, median and max seconds per event.
 `--enumerate`: on small runs (events with n <= 20), every "unique" verdict is compared with
-lcp.enumerate_solutions (slow: 2^n bases).
+lcp.enumerate_solutions (slow: 2^n bases). `--defaults K`: `verify.certify(event, solution)`
+at its defaults (uniqueness="auto") on K events of Fig. 9's run spread evenly over it (the
+first and the last included): one row per event with its verdicts and seconds, then the median,
+the max and the number of "unknown" verdicts (issue 21.5: none, median < 1 s, max < 30 s).
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ import time
 
 import numpy as np
 
-from rigidlcp import lcp, models
+from rigidlcp import lcp, models, verify
 from rigidlcp.verify.certificates.run import certify_run
 from rigidlcp.verify.certificates.stages import UNIQUE, certify_stages, observables_of
 from rigidlcp.verify.forces.polyhedra import event_z
@@ -90,11 +93,41 @@ def enumerate_check(max_n: int = 20) -> None:
               flush=True)
 
 
+def defaults_table(k: int) -> None:
+    run = simulate(RUNS["fig9 rect 10x4"])
+    events = sorted(set(np.linspace(0, run.n_events - 1, k).round().astype(int).tolist()))
+    print(f"\nFig. 9's run: {run.n_events} events, {run.status}; verify.certify at its defaults "
+          f"on events {events}\n")
+    print("| event | t | n | method | w | z | accelerations | forces | pattern | seconds |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    secs, unknown = [], 0
+    short = {True: "unique", False: "other", None: "UNKNOWN"}
+    for e in events:
+        ep = models.event_problem(run.system, run.state_at(e))
+        rec = run.records[e]
+        z = event_z(ep, np.r_[rec.R, rec.S])
+        t0 = time.perf_counter()
+        cert = verify.certify(ep, z)
+        secs.append(time.perf_counter() - t0)
+        flags = [cert.w_unique, cert.z_unique, cert.observables["accelerations"],
+                 cert.observables["forces"], cert.pattern_unique]
+        unknown += sum(f is None for f in flags)
+        print(f"| {e} | {rec.t:.4f} | {ep.lcp.n} | {cert.method} | "
+              + " | ".join(short[f] for f in flags) + f" | {secs[-1]:.2f} |", flush=True)
+    print(f"\nmedian {np.median(secs):.2f} s, max {max(secs):.2f} s, unknown verdicts: "
+          f"{unknown} of {5 * len(events)}")
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--quick", action="store_true", help="first 10 events of each run only")
     p.add_argument("--enumerate", action="store_true", help="the enumeration cross-check")
+    p.add_argument("--defaults", type=int, nargs="?", const=9, default=0, metavar="K",
+                   help="only verify.certify at its defaults on K events of Fig. 9 (default 9)")
     args = p.parse_args()
+    if args.defaults:
+        defaults_table(args.defaults)
+        return
     table(args.quick)
     if args.enumerate:
         enumerate_check()

@@ -1,9 +1,11 @@
-"""Moreau-Jean time-stepping (theta-method): a second, independent integrator.
+"""Moreau-Jean time-stepping (theta-method): a second integrator of the same systems.
 
-The event-driven evolution (models.evolution) is exact: it finds the next event analytically.
+The event-driven evolution (models.engine) is exact: it finds the next event analytically.
 This module integrates the same systems with a fixed step h instead, as NSCD codes (Siconos,
-LMGC90) do, so that every steady state can be checked by a method that shares nothing with
-the event loop except the kinematics (models.dynamics: H, M, f, u_obs).
+LMGC90) do. It shares with the event loop the kinematics (models.dynamics: H, M, f, u_obs) and
+the LCP solvers, and where a step's solution is not unique it follows the point of its
+selection rule (models.selection; default "none": the solver's): agreement between the two is
+a self-consistency check of this code, not an independent confirmation (docs/integrators.md).
 
 The geometry does not change (the paper's regime, no particle displacement): every contact stays
 closed and the step from t_k to t_{k+1} = t_k + h is, with impulses P = [P_n (c); P_t (c)]
@@ -56,6 +58,7 @@ from .engine.records import EventRecord, Run
 from .event import State, initial_state
 from .lattice import InvalidSystem
 from .observables import dissipation_rate, global_friction
+from .selection import Selection, select
 from .system import System
 
 
@@ -77,6 +80,7 @@ class StepOptions:
     record_every: int = 0
     max_steps: int = 2_000_000
     t_max: float = np.inf
+    selection: str = "none"
 
     def __post_init__(self) -> None:
         h = _number("h", self.h)
@@ -99,6 +103,10 @@ class StepOptions:
         for name in (self.method, self.fallback):
             if name is not None:
                 lcp.get_method(name)  # InvalidProblem naming the available methods
+        rule = Selection.parse(self.selection)  # InvalidSelection naming the rules
+        if rule.rule == "global":
+            raise InvalidStep("selection 'global' is the event engine's (a MILP per event); a "
+                              "step takes none, face-min-norm, max-sum-R[:CAP] or random:SEED")
         object.__setattr__(self, "h", h)
         object.__setattr__(self, "theta", theta)
 
@@ -195,8 +203,13 @@ def moreau_jean(
     "time_limit", "event_limit" (max_steps), "detachment" (u_n > 0: the no-displacement regime
     ends), "no_solution" / "solver_failed" (a step no solver solves within check_tol).
     options: the fields of StepOptions (method, fallback, warm_start, check_tol, steady_steps,
-    record_every, max_steps, t_max); bad values raise InvalidStep. progress(run, t, omega) is
-    called after every step with the time and the angular velocities reached.
+    record_every, max_steps, t_max, selection); bad values raise InvalidStep. selection: which
+    solution of a step's LCP is followed where it has more than one (models/selection.py):
+    "none" (default: the solver's, warm-started from the previous step), "face-min-norm",
+    "max-sum-R[:CAP]" or "random:SEED" (sum of P_n in place of sum R); a selected point must
+    pass the same Coulomb-law check as the solver's, else the solver's is kept.
+    progress(run, t, omega) is called after every step with the time and the angular
+    velocities reached.
     """
     opts = StepOptions(h=h, theta=theta, **options)
     from threadpoolctl import threadpool_limits
@@ -219,7 +232,8 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
 
     state = (initial_state(system, omega=omega, seed=seed) if state is None else state).copy()
     h, c, p = opts.h, system.c, system.p
-    run = Run(system, method=f"moreau-jean h={h:g} theta={opts.theta:g} ({opts.method})")
+    run = Run(system, method=f"moreau-jean h={h:g} theta={opts.theta:g} ({opts.method}"
+              + (f", selection {opts.selection})" if opts.selection != "none" else ")"))
     nu = np.concatenate([np.zeros(2 * p), state.omega])
     t, V = state.t, state.V
     f_theta = opts.theta * dyn.f + (1.0 - opts.theta) * dyn.f  # f does not depend on t
@@ -231,6 +245,8 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
     at_prev = np.full(c, np.inf)
     od_prev, P_prev = None, None
     quiet = 0
+    rule = Selection.parse(opts.selection)
+    rng = rule.rng()  # "random:SEED": one generator per run
     start = _time.perf_counter()
     for step in range(opts.max_steps):
         V_next = V + system.gamma * h
@@ -246,14 +262,24 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
             sp = step_problem(s_fixed)
             warm = (sp.warm_active(P_prev, ut_prev)
                     if opts.warm_start and P_prev is not None else None)
-            sol, used, fell_back = _solve_step(sp.lcp(b, t + h), opts, warm)
+            problem = sp.lcp(b, t + h)
+            sol, used, fell_back = _solve_step(problem, opts, warm)
             if sol.status != "solved":
                 continue
-            P = sp.G @ sol.z
-            dnu = dyn.Minv * (dyn.H.T @ P) + free_dnu
-            u = dyn.H @ (nu + dnu) + dyn.u_obs(V_next)
-            P_scale = max(float(np.abs(P).max(initial=0.0)), P_floor)
-            res = coulomb_residual(system, P, u, P_scale, u_scale)
+            points = [sol.z]
+            if rule.rule != "none":  # the rule's point first, the solver's if it fails
+                stick = np.arange(sp.n) < c + sp.k
+                y, how = select(problem, sol.z, sp.G, c, stick, rule, rng)
+                if not how.startswith("failed"):
+                    points.insert(0, y)
+            for z in points:
+                P = sp.G @ z
+                dnu = dyn.Minv * (dyn.H.T @ P) + free_dnu
+                u = dyn.H @ (nu + dnu) + dyn.u_obs(V_next)
+                P_scale = max(float(np.abs(P).max(initial=0.0)), P_floor)
+                res = coulomb_residual(system, P, u, P_scale, u_scale)
+                if res <= opts.check_tol:
+                    break
             if res <= opts.check_tol:
                 break
         if sol.status != "solved":

@@ -23,12 +23,14 @@ from rigidlcp.models.event import (
     acceleration_tol,
     event_problem,
 )
+from rigidlcp.models.selection import Selection, select
 from rigidlcp.models.system import System
 
 from .loop import Outcome
 
-#: How an event's particular solution is chosen when it is not unique (see `DenseBackend`).
-SELECT = ("face-min-norm", "global", "none")
+#: How an event's particular solution is chosen when it is not unique (see `DenseBackend`;
+#: "random" is given with its seed, "random:SEED"; models/selection.py).
+SELECT = ("face-min-norm", "max-sum-R", "random", "global", "none")
 
 
 @dataclass
@@ -43,7 +45,10 @@ class DenseBackend:
     least |lambda|, so that the result does not depend on which point a method happened to
     return (docs/theory.md, "Non-unique events"). The face walk is local: "global" minimizes
     sum R over every solution of the event (a mixed-integer program, slower). "none" keeps the
-    solver's solution. dump_dir: write every event's LCP to DIR/event_NNNNNN.npz.
+    solver's solution. "max-sum-R[:CAP]" (the other end: the largest sum R) and "random:SEED" (a
+    seeded random point of the face) are the other rules of models/selection.py, for ensembles
+    over rules; their points are checked like the solver's (residual <= check_tol x scale, else
+    the face-min-norm point is kept). dump_dir: write every event's LCP to DIR/event_NNNNNN.npz.
     """
 
     system: System
@@ -57,10 +62,16 @@ class DenseBackend:
     info: dict | None = None
     _prev: EventSolution | None = field(default=None, repr=False)
     _events: int = field(default=0, repr=False)
+    _rule: Selection | None = field(default=None, repr=False)
+    _rng: np.random.Generator | None = field(default=None, repr=False)
+    #: events where the rule's face was unbounded in sum R (the cap applied) / where the rule's
+    #: point failed the acceptance test (the face-min-norm point was kept)
+    capped: int = field(default=0, repr=False)
+    rejected: int = field(default=0, repr=False)
 
     def __post_init__(self) -> None:
-        if self.select not in SELECT:
-            raise ValueError(f"select must be one of {SELECT}, got {self.select!r}")
+        self._rule = Selection.parse(self.select)  # InvalidSelection (a ValueError) naming RULES
+        self._rng = self._rule.rng()  # "random:SEED": one generator per run
         for name in (self.method, self.fallback):
             if name is not None:
                 lcp.get_method(name)  # raises InvalidProblem naming the available methods
@@ -81,6 +92,8 @@ class DenseBackend:
         z, residual = sol.z, sol.residual
         if self.select != "none" and residual <= self.check_tol * scale:  # accepted points only
             z, residual = self._select(ep, z, residual)
+            if self._rule.rule in ("max-sum-R", "random"):
+                z, residual = self._other_rule(ep, z, residual, scale)
         es = ep.unpack(z)
         self._prev = es
         return Outcome("solved", sol.method, R=es.R, S=es.S, omega_dot=es.omega_dot,
@@ -111,12 +124,43 @@ class DenseBackend:
         # R (a_n = 0), tau (a_plus = 0, S inside the cone), but not a_minus (a_minus = 0).
         stick_side = np.zeros(ep.lcp.n, bool)
         stick_side[: c + ep.k] = True
-        face = global_selection(ep, z, least_force) if self.select == "global" else None
+        face = global_selection(ep, z, least_force) if self._rule.rule == "global" else None
         if face is None or face.status.startswith("failed"):
             face = face_minimum_norm(ep.lcp, z, ep.G, c=least_force, z_side=stick_side)
         if not face.status.startswith("selected"):
             return z, residual
         return face.z, lcp.complementarity_residual(face.z, ep.lcp.M @ face.z + ep.lcp.q)
+
+
+    def _other_rule(self, ep: EventProblem, z0: np.ndarray, r0: float, scale: float
+                    ) -> tuple[np.ndarray, float]:
+        """The point of "max-sum-R" / "random" from the face-min-norm point z0 (models.selection),
+        kept only if it passes the acceptance test the solver's point passed."""
+        stick_side = np.zeros(ep.lcp.n, bool)
+        stick_side[: self.system.c + ep.k] = True
+        y, status = select(ep.lcp, z0, ep.G, self.system.c, stick_side, self._rule, self._rng)
+        if status.startswith("failed"):
+            self.rejected += 1
+            return z0, r0
+        r = lcp.complementarity_residual(y, ep.lcp.M @ y + ep.lcp.q)
+        if r > self.check_tol * scale:
+            self.rejected += 1
+            return z0, r0
+        self.capped += status == "capped"
+        return y, r
+
+
+def selection_note(backend, run):
+    """Name a non-default selection rule in run.method and say in run.message at how many
+    events its cap applied or its point was rejected (models/selection.py)."""
+    if isinstance(backend, DenseBackend) and backend.select != "face-min-norm":
+        run.method += f" (selection {backend.select})"
+        notes = [f"{n} events {what}" for n, what in (
+            (backend.capped, "at the cap of sum R (unbounded face)"),
+            (backend.rejected, "kept the face-min-norm point (the rule's failed)")) if n]
+        if notes:
+            run.message += f"; selection {backend.select}: " + ", ".join(notes)
+    return run
 
 
 def warm_active_set(ep: EventProblem, prev: EventSolution, state: State) -> np.ndarray:

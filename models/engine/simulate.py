@@ -12,7 +12,7 @@ from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, initial_state
 from rigidlcp.models.system import System
 
-from .dense import DenseBackend
+from .dense import DenseBackend, selection_note
 from .loop import Limits, blas_limit, run_events
 from .records import Run
 
@@ -35,6 +35,7 @@ def simulate(
     select: str = "face-min-norm",
     fallback: str | None = "lemke",
     blas_threads: int | None = 1,
+    selection: str | None = None,
 ) -> Run:
     """Evolve `system` from `state` (or from omega / a seed) event by event (Sec. II C, IV).
 
@@ -46,16 +47,18 @@ def simulate(
     scale), or the run stops with "solver_failed"; the other stop rules and their parameters
     (t_max, max_events, zeno_events, zeno_time) are models/engine/loop.py's.
 
-    select: the particular solution of an event whose solution is not unique: "face-min-norm"
-    (default), "global" or "none" (see `DenseBackend`). fallback: when `method` fails at an
-    event (no solution, cycling, iteration limit), that event is solved again by this method
-    (None: stop); each use is counted in the record. progress: called with the run after each
-    event (None or False: not called). blas_threads: BLAS threads during the run (the event
-    problems are small dense matrices, for which one thread is fastest, and much faster on a
-    loaded machine); None leaves BLAS alone.
+    selection (or its older name select): the rule that picks the particular solution of an
+    event whose solution is not unique: "face-min-norm" (default), "max-sum-R[:CAP]",
+    "random:SEED", "global" or "none" (models/selection.py, `DenseBackend`). fallback: when
+    `method` fails at an event (no solution, cycling, iteration limit), that event is solved
+    again by this method (None: stop); each use is counted in the record. progress: called
+    with the run after each event (None or False: not called). blas_threads: BLAS threads
+    during the run (the event problems are small dense matrices, for which one thread is
+    fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
     if method != "sparse-pivoting":
         check_dense_memory(system.c, f"the dense event LCP of {system.c} contacts")
+    select = _one_rule(select, selection)
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
@@ -76,7 +79,14 @@ def simulate(
     if progress is True or progress is False:
         progress = None if progress is False else _print_progress
     with blas_limit(blas_threads):
-        return run_events(system, state, backend, limits, progress or None)
+        return selection_note(backend, run_events(system, state, backend, limits, progress or None))
+
+
+def _one_rule(select: str, selection: str | None) -> str:
+    """The selection rule, given by its name `selection` or its older name `select`."""
+    if selection is None or select in ("face-min-norm", selection):
+        return select if selection is None else selection
+    raise ValueError(f"select={select!r} and selection={selection!r}: give one")
 
 
 def dense_bytes(contacts: int) -> int:

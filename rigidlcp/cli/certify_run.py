@@ -14,9 +14,11 @@ def register(sub) -> None:
         "event of a run",
         description="Certify every event of a run saved by `rigidlcp simulate --out`: for the "
         "accelerations, the forces and the contact states, is the recorded solution the only "
-        "one? Stages: the face (same contact states), other solvers, a MILP. One JSON line per "
-        "event in DIR/certificates.jsonl (resumable), totals in DIR/summary.json, a figure "
-        "DIR/determinacy.png. See docs/verification.md.")
+        "one? Stages: the face (same contact states), other solvers, a MILP. One strict-JSON line "
+        "per event in DIR/certificates.jsonl (resumable) with every witness found (its z, "
+        "residual and how the observables differ; at a steady event, whether the witness is "
+        "itself a steady state), totals in DIR/summary.json, a figure DIR/determinacy.png. See "
+        "docs/verification.md.")
     p.add_argument("run", help="a run file (RUN.npz, with its RUN.json)")
     p.add_argument("--out", help="output directory (default: RUN_cert beside the run); never "
                    "overwritten without --resume or --force")

@@ -7,6 +7,10 @@ import math
 
 from rigidlcp.cli.main import seed
 
+#: The default ensemble (rigidlcp.verify.ensemble.RULES, repeated here so that registering the
+#: command imports nothing heavy).
+ENSEMBLE_RULES = ("face-min-norm", "max-sum-R", "random:1", "random:2", "none")
+
 
 def register(sub) -> None:
     from .simulate import add_system_arguments
@@ -32,10 +36,23 @@ def register(sub) -> None:
     g.add_argument("--phases", type=int, default=1,
                    help="average the sup error over N grids shifted by j h / N (shows the "
                    "order cleanly; N times the cost)")
+    g.add_argument("--selection", default="face-min-norm", metavar="RULE",
+                   help="the event engine's selection rule (face-min-norm, max-sum-R[:CAP], "
+                   "random:SEED, global, none; default face-min-norm)")
+    g.add_argument("--step-selection", default="none", metavar="RULE",
+                   help="the time-stepper's selection rule (default none: the solver's point)")
+    e = p.add_argument_group("ensemble over selection rules (instead of the h halving)")
+    e.add_argument("--ensemble", nargs="?", const=",".join(ENSEMBLE_RULES), default=None,
+                   metavar="RULES", help="run the event engine once per rule from the same start "
+                   "and print the spread of the valid steady states reached (mu_g, contact "
+                   f"states); default rules {','.join(ENSEMBLE_RULES)}")
+    e.add_argument("--step-rules", default=None, metavar="RULES",
+                   help="with --ensemble: also the time-stepper (step --h) over these rules")
     p.set_defaults(func=cmd_compare_integrators)
 
 
 def cmd_compare_integrators(args) -> int:
+    from rigidlcp.models.selection import Selection
     from rigidlcp.models.timestepping import StepOptions
     from rigidlcp.verify.integrators import compare_integrators, format_comparison
 
@@ -48,10 +65,36 @@ def cmd_compare_integrators(args) -> int:
                          f"got {args.levels}")
     if not (math.isfinite(args.t_max) and args.t_max > 0):
         raise ValueError(f"--t-max must be a finite number > 0, got {args.t_max}")
-    StepOptions(h=args.h, theta=args.theta)  # bad h / theta: one line, exit status 2
+    # bad h / theta / rules: one line, exit status 2
+    StepOptions(h=args.h, theta=args.theta, selection=args.step_selection)
+    Selection.parse(args.selection)
+    if args.ensemble is not None:
+        return _ensemble(system, args)
+    if args.step_rules is not None:
+        raise ValueError("--step-rules goes with --ensemble")
     hs = tuple(args.h / 2**k for k in range(args.levels))
     cmp = compare_integrators(system, seed=args.seed, hs=hs, T=args.T, t_max=args.t_max,
-                              step_options={"theta": args.theta}, phases=args.phases)
+                              event_options={"selection": args.selection},
+                              step_options={"theta": args.theta,
+                                            "selection": args.step_selection},
+                              phases=args.phases)
     print(format_comparison(cmp))
     bad = [r.h for r in cmp.rows if r.run.status not in ("steady", "time_limit")]
     return 1 if bad else 0
+
+
+def _ensemble(system, args) -> int:
+    from rigidlcp.models.selection import Selection
+    from rigidlcp.verify.ensemble import format_ensemble, selection_ensemble
+
+    rules = tuple(r.strip() for r in args.ensemble.split(",") if r.strip())
+    steps = (tuple(r.strip() for r in args.step_rules.split(",") if r.strip())
+             if args.step_rules else None)
+    if not rules:
+        raise ValueError("--ensemble needs at least one rule")
+    for r in rules + (steps or ()):
+        Selection.parse(r)  # every rule checked before anything runs
+    ens = selection_ensemble(system, seed=args.seed, rules=rules,
+                             h=args.h if steps else None, t_max=args.t_max, step_rules=steps)
+    print(format_ensemble(ens))
+    return 0

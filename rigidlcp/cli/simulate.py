@@ -61,6 +61,17 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
                            "contacts)", instead=instead or SPARSE_INSTEAD)
 
 
+def selection_rule(text: str) -> str:
+    """argparse type of --selection: a rule of rigidlcp.models.selection (checked, kept as
+    text)."""
+    from rigidlcp.models.selection import InvalidSelection, Selection
+
+    try:
+        return str(Selection.parse(text))
+    except InvalidSelection as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 def register(sub) -> None:
     p = sub.add_parser("simulate", help="evolve an array event by event to its steady state",
                        description="Exact event-driven evolution of a disk array (Sec. II C, IV).")
@@ -72,9 +83,11 @@ def register(sub) -> None:
     g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
     g.add_argument("--fallback", default="lemke",
                    help="method used at an event where --method fails ('none': stop)")
-    g.add_argument("--select", choices=("face-min-norm", "global", "none"),
-                   default="face-min-norm",
-                   help="particular solution when an event's solution is not unique")
+    g.add_argument("--selection", "--select", dest="select", type=selection_rule,
+                   default="face-min-norm", metavar="RULE",
+                   help="the point followed where an event's solution is not unique: "
+                   "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none "
+                   "(docs/integrators.md)")
     g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
     g.add_argument("--max-events", type=int, default=100_000)
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")

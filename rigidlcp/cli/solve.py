@@ -42,7 +42,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     _add_problem_arguments(p)
     p.add_argument("--uniqueness", default="auto",
                    choices=("auto", "staged", "p-matrix", "enumeration", "milp", "none"),
-                   help="how uniqueness is decided (default auto; docs/verification.md)")
+                   help="how uniqueness is decided (default auto: the P-matrix test, "
+                   "enumeration for n <= 10, the staged path beyond; docs/verification.md)")
     p.add_argument("--time-limit", type=float, default=30.0,
                    help="seconds per MILP of the uniqueness search (default 30)")
     p.add_argument("--json", action="store_true", help="print the certificate as JSON")

@@ -8,6 +8,8 @@ import json
 import sys
 from pathlib import Path
 
+from rigidlcp.cli.simulate import selection_rule
+
 GRID_HELP = "a value, a list A,B,C, or a range START:STOP:NUM (NUM values, ends included)"
 
 
@@ -49,9 +51,10 @@ def add_sweep(sub) -> None:
     r.add_argument("--method", default=RUN_OPTIONS["method"], help="LCP method")
     r.add_argument("--fallback", default=RUN_OPTIONS["fallback"],
                    help="method used where --method fails ('none': stop)")
-    r.add_argument("--select", choices=("face-min-norm", "global", "none"),
-                   default=RUN_OPTIONS["select"],
-                   help="particular solution when an event's solution is not unique")
+    r.add_argument("--selection", "--select", dest="select", type=selection_rule,
+                   default=RUN_OPTIONS["select"], metavar="RULE",
+                   help="the point followed where an event's solution is not unique: "
+                   "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none")
     r.add_argument("--max-events", type=int, default=RUN_OPTIONS["max_events"])
     r.add_argument("--t-max", type=float, default=None)
     r.add_argument("--omega-scale", type=float, default=RUN_OPTIONS["omega_scale"],

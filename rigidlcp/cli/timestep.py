@@ -8,6 +8,7 @@ import json
 import numpy as np
 
 from rigidlcp.cli.main import seed
+from rigidlcp.cli.simulate import selection_rule
 
 
 def register(sub) -> None:
@@ -24,6 +25,9 @@ def register(sub) -> None:
     g.add_argument("--h", type=float, default=1e-3, help="time step")
     g.add_argument("--theta", type=float, default=1.0, help="theta in [0.5, 1]")
     g.add_argument("--method", default="lemke", help="LCP method of a step")
+    g.add_argument("--selection", type=selection_rule, default="none", metavar="RULE",
+                   help="the point followed where a step's solution is not unique: none "
+                   "(default: the solver's), face-min-norm, max-sum-R[:CAP], random:SEED")
     g.add_argument("--t-max", type=float, default=np.inf)
     g.add_argument("--max-steps", type=int, default=2_000_000)
     g.add_argument("--record-every", type=int, default=100,
@@ -48,7 +52,7 @@ def cmd_timestep(args) -> int:
         check_new(run_paths(args.out), force=args.force)
     run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta, method=args.method,
                       t_max=args.t_max, max_steps=args.max_steps,
-                      record_every=args.record_every)
+                      record_every=args.record_every, selection=args.selection)
     summary = run.summary()
     if args.out:
         summary["saved"] = str(save_run(run, args.out))

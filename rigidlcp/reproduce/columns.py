@@ -1,6 +1,6 @@
 """Columns and rows of the report that cross-check the claims (issues 16.5, 17.4).
 
-`cross_check(res, claim)` fills a claim's "confirmed by time-stepping" and "determinacy"
+`cross_check(res, claim)` fills a claim's "kept by the toolkit's time-stepper" and "determinacy"
 columns from the checks of crosscheck.py; `fig8_any` / `fig9_any` are the rows saying whether
 the paper's Fig. 8-9 modes are reached by any valid particular-solution selection we ran.
 """
@@ -33,7 +33,7 @@ def experiments_of(cid: str) -> tuple[list[str], list[str]]:
 
 
 def cross_check(res: Results, c: Claim) -> None:
-    """Fill the columns "confirmed by time-stepping" and "determinacy" of claim c from the
+    """Fill the columns "kept by the toolkit's time-stepper" and "determinacy" of claim c from the
     cross-checks in res (crosscheck.py). A missing or broken check is a FAIL in the column."""
     exps, sweeps = experiments_of(c.id)
     if not exps and not sweeps:
@@ -52,9 +52,9 @@ def cross_check(res: Results, c: Claim) -> None:
     else:
         bad = [x for x in checks if not x.confirmed]
         c.ts_confirmed = not bad
-        c.ts = (f"confirmed ({len(checks)} steady state(s): {', '.join(labels)})" if not bad
-                else "NOT confirmed: " + "; ".join(x.text() for x in bad)
-                + (f" ({len(checks) - len(bad)} other(s) confirmed)" if len(bad) < len(checks)
+        c.ts = (f"kept ({len(checks)} steady state(s): {', '.join(labels)})" if not bad
+                else "NOT kept: " + "; ".join(x.text() for x in bad)
+                + (f" ({len(checks) - len(bad)} other(s) kept)" if len(bad) < len(checks)
                    else ""))
     if not exps:
         c.determinacy = "not certified (sweep points)"

@@ -1,19 +1,24 @@
 """Cross-checks of the report's steady states: by the independent integrator and by certificate.
 
-**Confirmed by time-stepping** (issue 16.5). Full Moreau-Jean runs of a 10x4 array take
+**Kept by the toolkit's time-stepper** (issue 16.5; renamed in issue 21.4 from "confirmed by
+time-stepping", for what it checks): a SELF-CONSISTENCY check, not an independent confirmation.
+The time-stepper shares this toolkit's solvers (lemke, warm pivoting) and follows their points
+where a step's solution is not unique, so agreement shows that the two integrators of one code
+agree; integrators that select otherwise reach other valid steady states (`rigidlcp
+compare-integrators --ensemble`, docs/integrators.md). Full Moreau-Jean runs of a 10x4 array take
 minutes, so the report does not integrate from the initial state: it starts the time-stepper
 (`models.timestepping.moreau_jean`, h = TS_H, theta = 1) FROM the event-driven steady state
 (its time, angular velocities, box velocity and contact states) and runs it until the
 time-stepper's own steady test holds (contact states and omega' unchanged for 20 consecutive
 steps, no sliding contact decelerating) or for at most TS_STEPS steps. The steady state is
-**confirmed** when that run ends "steady" (no step failed: every step's Coulomb residual is
+**kept** when that run ends "steady" (no step failed: every step's Coulomb residual is
 checked by the integrator) and at its last step
 
 * every contact has the event-driven state (T/NT and NS/S+/S-, `verify.integrators.state_labels`);
 * max |omega'_TS - omega'_ED| <= TOL_ALPHA g / r and |mu_g,TS - mu_g,ED| <= TOL_MU,
 
 i.e. the event-driven steady state is (to rounding) a steady state of the independent
-integrator. Otherwise "not confirmed", with the drift. Transient state changes on the way
+integrator. Otherwise "NOT kept", with the drift. Transient state changes on the way
 (e.g. a degenerate non-sliding contact sliding at O(h) velocity for one step) are reported,
 not judged. Each check also says whether the event-driven state satisfies the time-stepper's
 step laws (`verify.integrators.step_check`): where it does and the run still moves away, the
@@ -49,14 +54,15 @@ TOL_MU = 1e-9
 TS_DEFINITION = (
     f"Moreau-Jean (h = {TS_H:g}, theta = 1) started from the event-driven steady state, run "
     f"until its own steady test ({TS_STEADY} steps with unchanged states and omega') or "
-    f"{TS_STEPS} steps; confirmed when it ends steady with every step's Coulomb residual "
+    f"{TS_STEPS} steps; kept when it ends steady with every step's Coulomb residual "
     f"checked and, at its last step, the same contact state at every contact (T/NT, "
     f"NS/S+/S-), max|d omega'| <= {TOL_ALPHA:g} g/r and |d mu_g| <= {TOL_MU:g}")
 
 
 @dataclass
 class TSCheck:
-    """The time-stepping confirmation of one steady state (see the module docstring)."""
+    """The time-stepper's self-consistency check of one steady state (module docstring;
+    `confirmed`: the state was kept)."""
 
     label: str
     confirmed: bool = False
@@ -79,7 +85,7 @@ class TSCheck:
     def text(self) -> str:
         if self.error:
             return f"{self.label}: FAIL (evaluation error: {self.error.splitlines()[0]})"
-        head = "confirmed" if self.confirmed else "NOT confirmed"
+        head = "kept" if self.confirmed else "NOT kept"
         return (f"{self.label}: {head} ({self.status} after {self.steps} steps; "
                 f"max|d omega'| {self.d_alpha:.1e}, |d mu_g| {self.d_mu_g:.1e}, "
                 f"{self.states_differing} contact state(s) differ at the end"

@@ -150,7 +150,7 @@ class Claim:
     note: str = ""
     error: str = ""
     ts_confirmed: bool | None = None  # None: not a steady-state claim (crosscheck.py)
-    ts: str = ""  # "confirmed by time-stepping": the verdict and the drifts
+    ts: str = ""  # "kept by the toolkit's time-stepper": the verdict and the drifts
     determinacy: str = ""  # certified uniqueness at the steady state(s) (crosscheck.py)
 
     @property

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+import numpy as np
 import pytest
 
 from rigidlcp import models
@@ -96,3 +97,63 @@ def test_command(run_file, tmp_path, capsys):
     assert main(["certify-run", str(tmp_path / "missing.npz"), "--no-progress"]) == 2
     assert main(["certify-run", str(path), "--events", "x", "--out", str(tmp_path / "o"),
                  "--no-progress"]) == 2
+
+
+def _no_nan(name):
+    raise ValueError(f"not strict JSON: {name}")
+
+
+def test_lines_are_strict_json_with_witnesses(run_file, tmp_path):
+    """No NaN / Infinity in certificates.jsonl (issue 24.5: face_width was NaN on every line),
+    and every witness is written with its z, which re-checks as a solution of the event."""
+    from rigidlcp.models.event import event_problem
+    from rigidlcp.models.runio import load_run
+    from rigidlcp.verify.certificates.stages import independent_residual
+
+    path, n = run_file
+    certify_run(path, tmp_path / "cert")
+    rows = [json.loads(x, parse_constant=_no_nan)
+            for x in (tmp_path / "cert" / LINES).read_text().splitlines()]
+    run = load_run(path)
+    assert len(rows) == n
+    for r in rows:
+        assert r["certificate"]["verdicts"]["forces"]["face_width"] is None  # ranges not asked
+        # forces are not unique on this row: each row carries its witness
+        assert r["witnesses"] and "forces" in sum((w["questions"] for w in r["witnesses"]), [])
+        ep = event_problem(run.system, run.state_at(r["event"]))
+        for w in r["witnesses"]:
+            z = np.array(w["z"])
+            assert independent_residual(ep.lcp.M, ep.lcp.q, z) <= 1e-8
+            assert w["residual"] <= 1e-8 and max(w["d_R"], w["d_S"]) > 0
+
+
+def test_witness_at_a_steady_event_says_whether_it_is_steady():
+    """A 3x1 row (0.1/0.2/0, gamma 0.16, seed 1) ends steady; at its last event one witness
+    (other accelerations) opens a contact (a_n != 0): not a steady state; another (other
+    forces, same accelerations) is one. Each verdict is checked here from the witness's own
+    accelerations."""
+    from rigidlcp.models.event import event_problem
+
+    system = models.System(models.rectangular(3, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.16)
+    run = models.simulate(system, seed=1)
+    assert run.status == "steady"
+    k = run.n_events - 1
+    row = certify_run(run, None, events=[k]).rows[0]
+    assert row["steady_event"] is True
+    flags = sorted(w["steady"] for w in row["witnesses"])
+    assert flags == [False, True]
+    ep = event_problem(system, run.state_at(k))
+    s_in = run.state_at(k).s
+    for w in row["witnesses"]:
+        es = ep.unpack(np.array(w["z"]))
+        tol = 1e-6 * system.g  # the verdicts are clear-cut here: far above rounding
+        closed = np.all(np.abs(es.a_n) <= tol)
+        # es.s: the states after the event (a contact starting to slide there is sliding)
+        kept = np.all(np.abs(es.a_t[(es.s == 0) & (system.mu > 0) & (es.R > 1e-9)]) <= tol)
+        no_slowing = np.all(s_in * es.a_t >= -tol)
+        assert w["steady"] == bool(closed and kept and no_slowing)
+    # at a non-steady event the question is not asked
+    early = certify_run(run, None, events=[0]).rows[0]
+    assert early["steady_event"] is False
+    assert all(w["steady"] is None for w in early["witnesses"])

@@ -1,5 +1,6 @@
-"""The report's cross-checks of steady states: confirmed by time-stepping, certified determinacy,
-and the Fig. 8-9 "any selection" rows (rigidlcp.reproduce.crosscheck, claims)."""
+"""The report's cross-checks of steady states: kept by the toolkit's time-stepper
+(self-consistency), certified determinacy, and the Fig. 8-9 "any selection" rows
+(rigidlcp.reproduce.crosscheck, claims)."""
 
 import dataclasses
 from types import SimpleNamespace
@@ -34,7 +35,7 @@ def test_a_steady_state_of_both_integrators_is_confirmed():
     assert x.status == "steady" and x.states_differing == 0
     assert x.d_alpha <= 1e-3 * TOL_ALPHA and x.d_mu_g <= 1e-12
     assert x.modes_ts == x.modes_ed and x.ts_valid_event and x.ed_in_step <= 1e-8
-    assert x.text().startswith("row: confirmed")
+    assert x.text().startswith("row: kept")
 
 
 def test_a_state_that_is_not_steady_for_the_integrator_is_not_confirmed():
@@ -48,7 +49,7 @@ def test_a_state_that_is_not_steady_for_the_integrator_is_not_confirmed():
     x = confirm_by_timestepping(run, "row")
     assert not x.error and not x.confirmed
     assert x.d_alpha == pytest.approx(1e-3, rel=1e-6)
-    assert "NOT confirmed" in x.text()
+    assert "NOT kept" in x.text()
 
 
 def test_a_broken_check_is_reported_as_a_fail_not_dropped():
@@ -64,7 +65,7 @@ def test_a_broken_check_is_reported_as_a_fail_not_dropped():
             assert c.ts.startswith("FAIL (evaluation error") and c.ts_confirmed is False, c
             assert "FAIL (evaluation error" in c.determinacy or c.determinacy.startswith(
                 "not certified"), c
-    assert "Moreau-Jean" in TS_DEFINITION and "confirmed when" in TS_DEFINITION
+    assert "Moreau-Jean" in TS_DEFINITION and "kept when" in TS_DEFINITION
 
 
 def _acc_of(ep, z):

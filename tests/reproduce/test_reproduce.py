@@ -132,14 +132,14 @@ def test_reproduce_quick_writes_the_report_with_every_claim(tmp_path, capsys):
         assert f"| {cid} |" in report and f"**{c['verdict']}**" in report
     # Issue 16.5 / 17.4: the columns exist, every steady-state claim was cross-checked (no
     # evaluation error), and each verdict follows from the stated criterion.
-    assert "| confirmed by time-stepping | determinacy (certified) |" in report
+    assert "| kept by the toolkit's time-stepper | determinacy (certified) |" in report
     assert data["timestepping_definition"] in report
     for cid, c in claims.items():
         if cid.startswith("eq"):
             assert c["ts"].startswith("n/a") and c["ts_confirmed"] is None
             continue
         assert "evaluation error" not in c["ts"] + c["determinacy"], c
-        assert c["ts"].startswith("confirmed" if c["ts_confirmed"] else "NOT confirmed"), c
+        assert c["ts"].startswith("kept" if c["ts_confirmed"] else "NOT kept"), c
     for label, x in data["timestepping"].items():
         ok = (x["status"] == "steady" and x["states_differing"] == 0
               and x["d_alpha"] <= 1e-8 and x["d_mu_g"] <= 1e-9)

@@ -36,9 +36,11 @@ from rigidlcp.lcp import LCP, MLCP, NotApplicable, Solution, enumerate_solutions
 from rigidlcp.lcp.residual import check
 
 from .friction import forces_map, friction_certificate
+from .stages import OTHER, UNIQUE, certify_stages
 from .uniqueness import Search, milp_search, p_matrix_test, sign_pattern
 
-#: "auto" enumerates the complementary bases up to this n (2^n bases; singular ones need LPs).
+#: "auto" enumerates the complementary bases up to this n (2^n bases; singular ones need LPs),
+#: and takes the staged path (verify.certificates.stages) beyond it.
 ENUM_AUTO_MAX_N = 10
 UNIQUENESS_METHODS = ("auto", "p-matrix", "enumeration", "milp", "staged", "none")
 
@@ -115,14 +117,17 @@ def certify(
 
     problem: an `lcp.LCP`, an `lcp.MLCP` (reduced by the Schur complement for the uniqueness
     questions), or a `models.EventProblem` (its LCP, with the observables "forces" and
-    "accelerations"). uniqueness: "auto" (P-matrix test; then enumeration for n <= 10, else the
-    MILP), "p-matrix", "enumeration", "milp" or "none". delta: the relative margin by which
-    another solution must differ to count (see uniqueness.milp_search; the MILP raises
-    it to its rounding floor, 1e-4 with the default box; the margin used is reported); bound: the
-    MILP's box (default 1e3 z_s); time_limit: seconds per MILP; objective: "none" (the first
-    other solution HiGHS meets) or "min-sum" (the other solution of least sum z, e.g. the
-    small-force one; slower: optimality must be proved). observables: extra linear maps
-    L (quantity = L z + const) whose uniqueness is asked too.
+    "accelerations"). uniqueness: "auto" (P-matrix test; then enumeration for n <= 10, else
+    the stages of verify.certificates.stages: the face, other solvers, a MILP per open
+    question, as uniqueness="staged"; the MILP instead when objective="min-sum" asks for its
+    least-sum witness), "p-matrix", "enumeration", "milp", "staged" or "none". delta: the
+    relative margin by which another solution must differ to count (see
+    uniqueness.milp_search; the MILP raises it to its rounding floor, 1e-4 with the default
+    box; the margin used is reported); bound: the MILP's box (default 1e3 z_s); time_limit:
+    seconds per MILP; objective: "none" (the first other solution HiGHS meets) or "min-sum"
+    (the other solution of least sum z, e.g. the small-force one; slower: optimality must be
+    proved). observables: extra linear maps L (quantity = L z + const) whose uniqueness is
+    asked too.
     """
     if uniqueness not in UNIQUENESS_METHODS:
         raise ValueError(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
@@ -218,6 +223,11 @@ def certify(
             cert.method = "P-matrix (inconclusive)"
             cert.seconds = time.perf_counter() - t0
             return cert
+        if n > ENUM_AUTO_MAX_N and objective == "none":  # the stages, cheapest first
+            _staged(cert, lcp_form, z, obs, delta, bound, time_limit)
+            cert.method = f"staged (auto, n = {n} > {ENUM_AUTO_MAX_N})"
+            cert.seconds = time.perf_counter() - t0
+            return cert
         method = "enumeration" if n <= ENUM_AUTO_MAX_N else "milp"
     ctx = _Context(cert, M, q, z, w, zs, ws, obs, delta, bound, time_limit, objective)
     if method == "enumeration":
@@ -231,8 +241,6 @@ def certify(
 def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: float,
             bound: float | None, time_limit: float) -> None:
     """uniqueness="staged": the verdicts of verify.certificates.stages.certify_stages."""
-    from .stages import OTHER, UNIQUE, certify_stages
-
     staged = certify_stages(problem, z, delta=delta, bound=bound, time_limit=time_limit,
                             observables={"z": np.eye(problem.n), "w": problem.M, **obs})
     flag = {UNIQUE: True, OTHER: False}

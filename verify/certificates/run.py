@@ -25,6 +25,7 @@ import numpy as np
 
 from rigidlcp.models.engine.records import Run
 from rigidlcp.models.event import event_problem
+from rigidlcp.models.observables import global_friction
 from rigidlcp.models.runio import load_run
 from rigidlcp.models.sweep import ResultsFile, _atomic_write_text
 
@@ -50,10 +51,12 @@ class RunCertificate:
 
 def certify_event(run: Run, k: int, *, time_limit: float = 10.0, tries: int = 8,
                   ranges: bool = False) -> dict:
-    """The JSON row of event k: verdicts, stages, times and the full staged certificate."""
+    """The JSON row of event k: verdicts, stages, times, the full staged certificate and every
+    witness (`witness_row`). steady_event: k is the last event of a run that ended steady."""
     t0 = time.perf_counter()
     rec = run.records[k]
-    ep = event_problem(run.system, run.state_at(k))
+    state = run.state_at(k)
+    ep = event_problem(run.system, state)
     z = event_z(ep, np.r_[rec.R, rec.S])
     cert = certify_stages(ep, z, time_limit=time_limit, tries=tries, ranges=ranges)
     row: dict = {"event": k, "t": float(rec.t), "n": int(ep.lcp.n), "k": int(ep.k),
@@ -63,9 +66,69 @@ def certify_event(run: Run, k: int, *, time_limit: float = 10.0, tries: int = 8,
         row[name] = v.verdict
         row[name + "_stage"] = v.stage
         row[name + "_seconds"] = round(v.seconds, 4)
+    steady_event = bool(run.status == "steady" and k == run.n_events - 1)
+    row["steady_event"] = steady_event
+    row["witnesses"] = []
+    for name in QUESTIONS:
+        w = cert.verdicts[name].witness
+        if w is None:
+            continue
+        same = [x for x in row["witnesses"] if np.array_equal(x["z"], w.z)]
+        if same:
+            same[0]["questions"].append(name)
+            continue
+        row["witnesses"].append({"questions": [name],
+                                 **witness_row(ep, state, z, w.z, w.residual, w.found_by,
+                                               steady_event)})
     row["seconds"] = round(time.perf_counter() - t0, 4)
     row["certificate"] = cert.to_dict()
     return row
+
+
+def witness_row(ep, state, z: np.ndarray, y: np.ndarray, residual: float, found_by: str,
+                steady_event: bool) -> dict:
+    """A witness y (another solution of the event LCP) beside the run's z: y itself, its
+    independent scaled residual, how the observables differ (max |d| of the angular
+    accelerations, R, S; d mu_g = mu_g(y) - mu_g(z)) and, at a steady event, whether y is
+    itself a steady state (`steady_state`; None elsewhere)."""
+    system = ep.system
+    a, b = ep.unpack(z), ep.unpack(y)
+    weight = system.total_mass * system.g or 1.0
+    d_mu_g = (global_friction(system, b.S) - global_friction(system, a.S)) / weight
+    ok, why = steady_state(ep, state, b) if steady_event else (None, "not a steady event")
+    return {"z": y.tolist(), "residual": float(residual), "found_by": found_by,
+            "d_omega_dot": float(np.max(np.abs(b.omega_dot - a.omega_dot), initial=0.0)),
+            "d_R": float(np.max(np.abs(b.R - a.R), initial=0.0)),
+            "d_S": float(np.max(np.abs(b.S - a.S), initial=0.0)),
+            "d_mu_g": float(d_mu_g), "steady": ok, "steady_reason": why}
+
+
+def steady_state(ep, state, es, rtol: float = 1e-8) -> tuple[bool, str]:
+    """Is the event solution `es` at `state` a steady state (docs/verification.md)? Constant
+    contact states and forces from the event on need: every contact closed with a_n = 0; a
+    non-sliding frictional transmitting (R > 0) contact keeps a_t = 0; a sliding contact never
+    decelerates, sgn(v_t) a_t >= 0. Sliding: v_t != 0 at the event (state.s), or starting to
+    slide there (v_t = 0, a_t != 0: es.s, which the event's laws allow only at |S| = mu R).
+    Zero tests: rtol of max(g, |gamma|, max|a|) for accelerations, of max R for forces."""
+    system = ep.system
+    s_in, s = np.asarray(state.s, dtype=int), np.asarray(es.s, dtype=int)
+    a_tol = rtol * max(system.g, abs(system.gamma), float(np.max(np.abs(es.a_n), initial=0.0)),
+                       float(np.max(np.abs(es.a_t), initial=0.0)))
+    r_tol = rtol * max(float(np.max(es.R, initial=0.0)), 1e-300)
+    why = []
+    opening = np.flatnonzero(np.abs(es.a_n) > a_tol)
+    if opening.size:
+        why.append(f"{opening.size} contacts with a_n != 0 (e.g. {opening[:5].tolist()})")
+    starting = np.flatnonzero((s == 0) & (system.mu > 0) & (es.R > r_tol)
+                              & (np.abs(es.a_t) > a_tol))
+    if starting.size:
+        why.append(f"{starting.size} non-sliding transmitting contacts with a_t != 0 "
+                   f"(e.g. {starting[:5].tolist()})")
+    slowing = np.flatnonzero((s_in != 0) & (s_in * es.a_t < -a_tol))
+    if slowing.size:
+        why.append(f"{slowing.size} sliding contacts decelerate (e.g. {slowing[:5].tolist()})")
+    return (not why), ("; ".join(why) or "steady: a_n = 0, non-sliding a_t = 0, no sliding "
+                       "contact decelerating")
 
 
 class _EventTask:
@@ -75,7 +138,7 @@ class _EventTask:
         self.run, self.options = run, options
 
     def __call__(self, k: int) -> dict:
-        return certify_event(self.run, k, **self.options)
+        return strict_json(certify_event(self.run, k, **self.options))
 
 
 def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = None, *,
@@ -130,8 +193,8 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
     totals = summarize(rows)
     if out is not None:
         every = {**done, **new}
-        text = "".join(json.dumps(every[k], separators=(", ", ": "), default=_plain) + "\n"
-                       for k in sorted(every))
+        text = "".join(json.dumps(strict_json(every[k]), separators=(", ", ": "),
+                                  default=_plain, allow_nan=False) + "\n" for k in sorted(every))
         _atomic_write_text(out / LINES, text)
         _atomic_write_text(out / SUMMARY, json.dumps(totals, indent=1) + "\n")
         if figure:
@@ -169,6 +232,22 @@ def _prepare(out: Path, options: dict, resume: bool, force: bool, notes: list[st
                 notes.append("ignored a torn or corrupt line")
     _atomic_write_text(saved, json.dumps(options) + "\n")
     return done
+
+
+def strict_json(obj):
+    """obj with every non-finite float (NaN, +-inf) replaced by None, numpy scalars and arrays
+    by plain Python: what json.dumps(..., allow_nan=False) accepts (strict JSON has no NaN)."""
+    if isinstance(obj, dict):
+        return {k: strict_json(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [strict_json(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return strict_json(obj.tolist())
+    if isinstance(obj, (np.integer, np.bool_)):
+        return obj.item()
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if np.isfinite(obj) else None
+    return obj
 
 
 def _plain(obj):

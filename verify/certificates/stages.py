@@ -5,8 +5,9 @@ lambda = G z and the accelerations nu' = M^-1 (H^T G z + f), Sec. III A of the p
 LCP: z and w), whether L z is the same for every solution. Stages, each verdict checked before
 it is returned:
 
-0. residual (verify.certify, tol 1e-8): a rejected solution gets no verdict; the P-matrix test
-   (verify.uniqueness.p_matrix_test): P => every observable unique.
+0. residual (lcp.residual.check, verify.certify's test, tol 1e-8): a rejected solution gets
+   no verdict; the P-matrix test (verify.certificates.pmatrix.p_matrix_test): P => every
+   observable unique.
 a. the face (verify.certificates.faces): with the contact states of z* kept (degenerate pairs
    free), the directions N of the affine set A(z*). Where L N != 0, linear programs over the two
    faces F_D, F_0 give the range [min, max] of each moving row of L; a vertex where L differs
@@ -40,9 +41,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp.lcp import LCP, Solution, solve
+from rigidlcp.lcp.residual import check
 
 from .bounds import no_solution_beyond
-from .certify import certify
 from .faces import FaceLP, null_directions
 from .uniqueness import BOUND_FACTOR, milp_search, p_matrix_test, scales, sign_pattern
 
@@ -96,9 +97,13 @@ class Verdict:
         return float(np.max(self.hi - self.lo, initial=0.0))
 
     def to_dict(self) -> dict:
+        """Strict JSON: face_width is null when the ranges were not computed (NaN) and
+        "unbounded" is true when a range is infinite (JSON has neither NaN nor Infinity)."""
+        width = self.face_width
         return {"verdict": self.verdict, "stage": self.stage, "reason": self.reason,
                 "seconds": round(self.seconds, 4), "scope": self.scope,
-                "face_width": self.face_width,
+                "face_width": width if np.isfinite(width) else None,
+                "face_unbounded": bool(np.isinf(width)),
                 "witness": None if self.witness is None else self.witness.to_dict()}
 
 
@@ -176,7 +181,7 @@ def certify_stages(
     if observables is not None:
         obs = {k: np.atleast_2d(np.asarray(v, dtype=float)) for k, v in observables.items()}
     z = np.asarray(solution.z if isinstance(solution, Solution) else solution, dtype=float)
-    base = certify(lcp, z, tol=tol, uniqueness="none")
+    base = check(lcp, z, None, tol=tol, lcp_form=lcp)  # verify.certify's acceptance test
     out = StagedCertificate(base.accepted, base.scaled_residual, lcp.n,
                             {k: Verdict(k) for k in obs})
     if not base.accepted:

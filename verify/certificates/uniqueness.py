@@ -6,7 +6,8 @@ complement of alpha); every P_alpha lies in the orthant z >= 0, so it is pointed
 
 Three tools, from cheapest to most general:
 
-* ``p_matrix_test``: M is a P-matrix (every principal minor positive) iff the LCP has exactly one
+* ``p_matrix_test`` (verify/certificates/pmatrix.py, re-exported here): M is a P-matrix
+  (every principal minor positive) iff the LCP has exactly one
   solution for every q (Samelson, Thrall & Wesler 1958; Cottle, Pang & Stone 1992, Thm 3.3.7).
   Checked by all 2^n - 1 principal minors for small n, and for any n by the sufficient condition
   that the symmetric part (M + M^T)/2 be positive definite (necessary too when M is symmetric).
@@ -23,7 +24,6 @@ Every margin below is relative to these scales.
 from __future__ import annotations
 
 import contextlib
-import itertools
 import time
 import warnings
 from collections.abc import Iterator
@@ -36,13 +36,11 @@ from scipy.optimize import Bounds, LinearConstraint, linprog, milp
 from rigidlcp.lcp.quiet import quiet_stdout
 from rigidlcp.lcp.residual import scaled_residual, scales
 
-__all__ = ["PMatrixTest", "Search", "milp_search", "p_matrix_test", "quiet_highs",
-           "scaled_residual", "scales", "sign_pattern"]
+from .pmatrix import P_MINORS_MAX_N, RCOND, PMatrixTest, p_matrix_test
 
-#: Largest n for the principal-minor test (2^n - 1 determinants).
-P_MINORS_MAX_N = 12
-#: A principal submatrix with sigma_min <= RCOND * sigma_max is treated as numerically singular.
-RCOND = 1e-10
+__all__ = ["P_MINORS_MAX_N", "RCOND", "PMatrixTest", "Search", "milp_search", "p_matrix_test",
+           "quiet_highs", "scaled_residual", "scales", "sign_pattern"]
+
 #: Default box for the MILP: 0 <= z <= BOUND_FACTOR * z_s.
 BOUND_FACTOR = 1e3
 #: HiGHS tolerances for the MILP and the polishing LP (its defaults are 1e-6 / 1e-7). Options
@@ -75,78 +73,6 @@ def sign_pattern(z: np.ndarray, w: np.ndarray, zs: float, ws: float, delta: floa
     out[(zr > delta) & (zr >= wr)] = 1
     out[(wr > delta) & (wr > zr)] = -1
     return out
-
-
-# --------------------------------------------------------------------------------------------
-# P-matrix test
-# --------------------------------------------------------------------------------------------
-
-@dataclass
-class PMatrixTest:
-    """is_p: True (proved, to the stated conditioning margin), False (a principal minor is
-    <= 0), None (undecided: near-singular minors, or n too large for the minors)."""
-
-    is_p: bool | None
-    how: str
-    witness: tuple[int, ...] | None = None
-    minors_checked: int = 0
-    message: str = ""
-
-
-def p_matrix_test(M: np.ndarray, max_n: int = P_MINORS_MAX_N, rcond: float = RCOND) -> PMatrixTest:
-    """Is M a P-matrix? (every principal minor det M_aa > 0).
-
-    1 x 1 minors (the diagonal) are data and are compared with 0 exactly. A larger minor counts
-    as positive when its LU determinant is positive and its submatrix is well conditioned
-    (sigma_min > rcond sigma_max), so that the sign is not an artefact of rounding; a negative
-    determinant of a well-conditioned submatrix proves M is not P; a near-singular submatrix
-    leaves the question undecided. For n > max_n only the sufficient test runs: the symmetric
-    part (M + M^T)/2 positive definite (smallest eigenvalue > rcond times the largest |.|)
-    implies P; for symmetric M a negative eigenvalue disproves it.
-    """
-    M = np.asarray(M, dtype=float)
-    n = M.shape[0]
-    diag = np.diagonal(M)
-    if np.any(diag <= 0):
-        i = int(np.flatnonzero(diag <= 0)[0])
-        return PMatrixTest(False, "principal minors", (i,), i + 1,
-                           f"diagonal entry M[{i},{i}] = {diag[i]:.3g} <= 0: not a P-matrix")
-    Hs = 0.5 * (M + M.T)
-    eig = np.linalg.eigvalsh(Hs)
-    big = max(float(np.max(np.abs(eig))), 1e-300)
-    symmetric = bool(np.max(np.abs(M - M.T)) <= 1e-14 * max(float(np.max(np.abs(M))), 1e-300))
-    if eig[0] > rcond * big:
-        return PMatrixTest(True, "symmetric part positive definite", None, 0,
-                           f"lambda_min((M + M^T)/2) = {eig[0]:.3g} > 0 implies P")
-    if symmetric and eig[0] < -rcond * big:
-        return PMatrixTest(False, "symmetric: eigenvalues", None, 0,
-                           f"M symmetric with eigenvalue {eig[0]:.3g} < 0: not P")
-    if n > max_n:
-        return PMatrixTest(None, "none", None, 0,
-                           f"n = {n} > {max_n}: principal minors not enumerated, and the "
-                           "sufficient test (symmetric part positive definite) fails")
-    checked = n
-    undecided: tuple[int, ...] | None = None
-    for k in range(2, n + 1):
-        idx = np.array(list(itertools.combinations(range(n), k)), dtype=np.intp)
-        subs = M[idx[:, :, None], idx[:, None, :]]
-        sign, _ = np.linalg.slogdet(subs)
-        sv = np.linalg.svd(subs, compute_uv=False)
-        well = sv[:, -1] > rcond * sv[:, 0]
-        checked += idx.shape[0]
-        bad = np.flatnonzero(well & (sign <= 0))
-        if bad.size:
-            a = tuple(int(j) for j in idx[bad[0]])
-            return PMatrixTest(False, "principal minors", a, checked,
-                               f"principal minor on {list(a)} is negative: not a P-matrix")
-        if undecided is None and not np.all(well):
-            undecided = tuple(int(j) for j in idx[np.flatnonzero(~well)[0]])
-    if undecided is not None:
-        return PMatrixTest(None, "principal minors", undecided, checked,
-                           f"principal submatrix on {list(undecided)} is singular to rounding "
-                           f"(sigma_min <= {rcond:g} sigma_max): P-property undecided")
-    return PMatrixTest(True, "principal minors", None, checked,
-                       f"all {checked} principal minors positive (well conditioned)")
 
 
 # --------------------------------------------------------------------------------------------
@@ -221,95 +147,140 @@ def milp_search(
     M = np.asarray(M, dtype=float)
     q = np.asarray(q, dtype=float)
     z_star = np.asarray(z_star, dtype=float)
-    n = q.size
+    if target not in ("pattern", "values"):
+        raise ValueError(f"target must be 'pattern' or 'values', got {target!r}")
+    if target == "values" and L is None:
+        raise ValueError("target 'values' needs the matrix L")
+    if objective not in ("none", "min-sum"):
+        raise ValueError(f"objective must be 'min-sum' or 'none', got {objective!r}")
     zs, ws = scales(M, q, z_star)
     U = float(bound) if bound is not None else BOUND_FACTOR * zs
     # HiGHS accepts y within 1e-9 of an integer, so z_i <= 1e-9 U "vanishes": a margin below
     # ~100 times this leakage would let rounding pass for a difference. Raise delta to it.
     floor = 100.0 * _HIGHS_MILP["mip_feasibility_tolerance"] * U / zs
     delta = max(float(delta), floor)
-    w_star = M @ z_star + q
-    if target not in ("pattern", "values"):
-        raise ValueError(f"target must be 'pattern' or 'values', got {target!r}")
-    if target == "values" and L is None:
-        raise ValueError("target 'values' needs the matrix L")
     res = Search("unknown", target, bound=U, delta=delta)
+    model = _MilpModel(M, q, z_star, U, delta, zs, ws)
+    if target == "pattern":
+        model.differ_in_pattern()
+    elif not model.differ_in_values(np.atleast_2d(np.asarray(L, dtype=float))):
+        res.status, res.seconds = "none", time.perf_counter() - t0
+        res.message = f"no row of L can move by {delta:g} s_L inside the box z <= {U:.3g}"
+        return res
+    _solve_and_verify(model, res, objective, time_limit, retries, t0)
+    res.seconds = time.perf_counter() - t0
+    res.message += f" [{res.seconds:.2f} s]"
+    return res
 
-    # Columns: zeta (n) | y (n) | extra binaries.
-    rows: list[np.ndarray] = []
-    lo: list[float] = []
-    hi: list[float] = []
 
-    def add(row: np.ndarray, lb: float, ub: float) -> None:
+class _MilpModel:
+    """The rows of milp_search's program (columns: zeta (n) | y (n) | extra binaries), built
+    in two steps: the complementarity of every pair (__init__), then the target's way of
+    differing from z* (differ_in_pattern / differ_in_values)."""
+
+    def __init__(self, M, q, z_star, U: float, delta: float, zs: float, ws: float):
+        self.M, self.q, self.z_star, self.U, self.delta = M, q, z_star, U, delta
+        self.zs, self.ws, self.n = zs, ws, q.size
+        self.rows: list[np.ndarray] = []
+        self.lo: list[float] = []
+        self.hi: list[float] = []
+        self.pat: np.ndarray | None = None  # "pattern": z*'s sign pattern
+        self.L: np.ndarray | None = None  # "values": the observable, its scale s_L
+        self.sL = 1.0
+        self.extra: list[tuple] = []  # "values": (row j, sign) of each extra binary
+        self.wmax = np.maximum(q + U * np.sum(np.maximum(M, 0.0), axis=1), 0.0)
+        self._pairs: list[tuple] = []  # the complementarity rows, added once N is known
+
+    @property
+    def N(self) -> int:
+        return 2 * self.n + (len(self.extra) if self.L is not None else
+                             int(np.sum(self.pat == 0)))
+
+    def add(self, row: np.ndarray, lb: float, ub: float) -> None:
         s = float(np.max(np.abs(row))) or 1.0  # normalize each row to max |coefficient| 1
-        rows.append(row / s)
-        lo.append(lb / s)
-        hi.append(ub / s)
+        self.rows.append(row / s)
+        self.lo.append(lb / s)
+        self.hi.append(ub / s)
 
-    UM = U * M
-    wmax = np.maximum(q + U * np.sum(np.maximum(M, 0.0), axis=1), 0.0)
-    extra: list[tuple] = []  # description of each extra binary
-    if target == "pattern":
-        pat = sign_pattern(z_star, w_star, zs, ws, delta)
-        deg = np.flatnonzero(pat == 0)
-        n_extra = deg.size
-    else:
-        L = np.atleast_2d(np.asarray(L, dtype=float))
-        v_star = L @ z_star
-        sL = max(float(np.max(np.sum(np.abs(L), axis=1))) * zs, float(np.max(np.abs(v_star))),
-                 1e-300)
-        dL = delta * sL
-        for j in range(L.shape[0]):
-            for sgn in (1.0, -1.0):
-                gain = sgn * L[j]
-                best = U * float(np.sum(np.maximum(gain, 0.0))) - sgn * v_star[j]
-                if best >= dL:  # the deviation is reachable inside the box
-                    extra.append((j, sgn))
-        n_extra = len(extra)
-    N = 2 * n + n_extra
-    for i in range(n):
-        r = np.zeros(N)
-        r[:n] = UM[i]
-        add(r, -q[i], np.inf)  # w_i >= 0
-        r = np.zeros(N)
-        r[i], r[n + i] = 1.0, -1.0
-        add(r, -np.inf, 0.0)  # zeta_i <= y_i
-        r = np.zeros(N)
-        r[:n] = UM[i]
-        r[n + i] = wmax[i]
-        add(r, -np.inf, wmax[i] - q[i])  # w_i <= wmax_i (1 - y_i)
-    cut = np.zeros(N)
-    if target == "pattern":
-        plus, minus = np.flatnonzero(pat == 1), np.flatnonzero(pat == -1)
+    def complementarity(self) -> None:
+        """w >= 0, zeta_i <= y_i, w_i <= wmax_i (1 - y_i), for every pair i."""
+        n, N, UM, q, wmax = self.n, self.N, self.U * self.M, self.q, self.wmax
+        for i in range(n):
+            r = np.zeros(N)
+            r[:n] = UM[i]
+            self.add(r, -q[i], np.inf)  # w_i >= 0
+            r = np.zeros(N)
+            r[i], r[n + i] = 1.0, -1.0
+            self.add(r, -np.inf, 0.0)  # zeta_i <= y_i
+            r = np.zeros(N)
+            r[:n] = UM[i]
+            r[n + i] = wmax[i]
+            self.add(r, -np.inf, wmax[i] - q[i])  # w_i <= wmax_i (1 - y_i)
+
+    def differ_in_pattern(self) -> None:
+        """Target "pattern": y_i = 0 where z*_i > 0, or y_i = 1 where w*_i > 0, or a degenerate
+        pair of z* leaves 0 (z_i / z_s + w_i / w_s >= delta d_i): at least one."""
+        n, U, zs, ws, M, q = self.n, self.U, self.zs, self.ws, self.M, self.q
+        self.pat = pat = sign_pattern(self.z_star, M @ self.z_star + q, zs, ws, self.delta)
+        self.complementarity()
+        N = self.N
+        plus, minus, deg = (np.flatnonzero(pat == v) for v in (1, -1, 0))
+        cut = np.zeros(N)
         cut[n + plus] = -1.0
         cut[n + minus] = 1.0
         cut[2 * n:] = 1.0
-        add(cut, 1.0 - plus.size, np.inf)
+        self.add(cut, 1.0 - plus.size, np.inf)
         for k, i in enumerate(deg):  # z_i/zs + w_i/ws >= delta d_i
             r = np.zeros(N)
             r[i] = U / zs
-            r[:n] += UM[i] / ws
-            r[2 * n + k] = -delta
-            add(r, -q[i] / ws, np.inf)
-    else:
-        if not extra:
-            res.status, res.seconds = "none", time.perf_counter() - t0
-            res.message = (f"no row of L can move by {delta:g} s_L inside the box z <= {U:.3g}")
-            return res
-        for k, (j, sgn) in enumerate(extra):
+            r[:n] += U * M[i] / ws
+            r[2 * n + k] = -self.delta
+            self.add(r, -q[i] / ws, np.inf)
+
+    def differ_in_values(self, L: np.ndarray) -> bool:
+        """Target "values": |(L (z - z*))_j| >= delta s_L for some row j and sign (binaries
+        e_j+-), only those reachable inside the box; False when none is."""
+        n, U, z_star = self.n, self.U, self.z_star
+        self.L = L
+        v_star = L @ z_star
+        self.sL = max(float(np.max(np.sum(np.abs(L), axis=1))) * self.zs,
+                      float(np.max(np.abs(v_star))), 1e-300)
+        dL = self.delta * self.sL
+        for j in range(L.shape[0]):
+            for sgn in (1.0, -1.0):
+                best = U * float(np.sum(np.maximum(sgn * L[j], 0.0))) - sgn * v_star[j]
+                if best >= dL:  # the deviation is reachable inside the box
+                    self.extra.append((j, sgn))
+        if not self.extra:
+            return False
+        self.complementarity()
+        N = self.N
+        for k, (j, sgn) in enumerate(self.extra):
             gain = sgn * L[j]
             big = dL + sgn * v_star[j] - U * float(np.sum(np.minimum(gain, 0.0)))
             r = np.zeros(N)
             r[:n] = U * gain
             r[2 * n + k] = -big
-            add(r, dL - big + sgn * v_star[j], np.inf)
+            self.add(r, dL - big + sgn * v_star[j], np.inf)
+        cut = np.zeros(N)
         cut[2 * n:] = 1.0
-        add(cut, 1.0, np.inf)
+        self.add(cut, 1.0, np.inf)
+        return True
+
+    def deviation(self, other: np.ndarray) -> float:
+        if self.L is None:
+            return float(np.max(np.abs(other - self.z_star))) / self.zs
+        return float(np.max(np.abs(self.L @ (other - self.z_star)))) / self.sL
+
+
+def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit: float,
+                      retries: int, t0: float) -> None:
+    """Ask HiGHS; polish its basis into an exact solution (`_polish`) or cut the basis off and
+    ask again (at most `retries` times); fill `res` (see milp_search's docstring)."""
+    n, N = model.n, model.N
     c = np.zeros(N)
     if objective == "min-sum":
         c[:n] = 1.0
-    elif objective != "none":
-        raise ValueError(f"objective must be 'min-sum' or 'none', got {objective!r}")
     integrality = np.r_[np.zeros(n), np.ones(N - n)]
     rejected = unproved = 0
     for _attempt in range(retries + 1):
@@ -317,8 +288,8 @@ def milp_search(
         if left <= 0:
             res.message = f"time limit {time_limit:g} s reached"
             break
-        A = sp.csr_matrix(np.array(rows))
-        cons = LinearConstraint(A, np.array(lo), np.array(hi))
+        A = sp.csr_matrix(np.array(model.rows))
+        cons = LinearConstraint(A, np.array(model.lo), np.array(model.hi))
         out, runs = confirmed_milp(c, integrality, cons, left)
         res.info = {"milp_status": int(out.status), "milp_message": str(out.message),
                     "binaries": N - n, "rejected_bases": rejected, "milp_runs": runs}
@@ -331,7 +302,7 @@ def milp_search(
                                "them without proof that they hold no other solution: unknown")
             elif out.status == 2:  # proved infeasible, every cut proved
                 res.status = "none"
-                res.message = (f"no other solution with z <= {U:.3g} (MILP infeasible"
+                res.message = (f"no other solution with z <= {model.U:.3g} (MILP infeasible"
                                + (f" after {rejected} bases, each proved empty by LP, were cut"
                                   if rejected else "") + ")")
             else:
@@ -339,14 +310,11 @@ def milp_search(
             break
         y = out.x[n:2 * n] > 0.5
         chosen = out.x[2 * n:] > 0.5
-        other, proved = _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws,
-                                pat if target == "pattern" else None, extra)
+        other, proved = _polish(model.M, model.q, model.z_star, y, res.target, chosen, model.L,
+                                model.delta, model.zs, model.ws, model.pat, model.extra)
         if other is not None:
             res.status, res.other = "found", other
-            if target == "pattern":
-                res.deviation = float(np.max(np.abs(other - z_star))) / zs
-            else:
-                res.deviation = float(np.max(np.abs(L @ (other - z_star)))) / sL
+            res.deviation = model.deviation(other)
             res.message = ("another solution (max relative difference "
                            f"{res.deviation:.3g}) found"
                            + ("" if out.status == 0 else " (time limit hit)"))
@@ -359,15 +327,12 @@ def milp_search(
         unproved += not proved
         r = np.zeros(N)
         r[n:2 * n] = np.where(y, -1.0, 1.0)
-        add(r, 1.0 - float(np.sum(y)), np.inf)
+        model.add(r, 1.0 - float(np.sum(y)), np.inf)
     else:
         res.message = (f"{rejected} bases proposed by the MILP carried no exact solution with "
                        "the target's difference (rounding): verdict unknown")
     res.info["rejected_bases"] = rejected
     res.info["unproved_cuts"] = unproved
-    res.seconds = time.perf_counter() - t0
-    res.message += f" [{res.seconds:.2f} s]"
-    return res
 
 
 def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, options=None):

@@ -272,7 +272,7 @@ def test_limits_and_bad_options():
     assert run.status == "time_limit" and run.final.t == pytest.approx(0.05)
     with pytest.raises(lcp.InvalidProblem, match="unknown method 'nope'"):
         models.simulate(system, seed=1, method="nope")
-    with pytest.raises(ValueError, match="select must be"):
+    with pytest.raises(ValueError, match="selection must be one of"):
         models.simulate(system, seed=1, select="best")
 
 

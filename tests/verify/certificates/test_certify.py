@@ -169,8 +169,8 @@ def test_2x2_example_solutions(example_2x2):
 
 def test_2x2_example_is_not_unique_in_w(example_2x2):
     ep, natural, hanging = example_2x2
-    cert = certify(ep, natural)
-    assert cert.accepted and cert.method == "milp"
+    cert = certify(ep, natural)  # n = 18 > 10: "auto" takes the staged path
+    assert cert.accepted and cert.method.startswith("staged (auto")
     assert cert.w_unique is False and cert.z_unique is False and cert.pattern_unique is False
     assert cert.observables["accelerations"] is False
     # The evidence, whichever other solutions the MILP returns (HiGHS versions differ): each
@@ -200,3 +200,25 @@ def test_repr_and_bad_arguments():
         certify(problem, np.zeros(3))
     with pytest.raises(ValueError):
         certify(problem, np.zeros(2), uniqueness="guess")
+
+
+def test_defaults_decide_fig9_events():
+    """verify.certify at its defaults (uniqueness="auto") decides every question at events of
+    Fig. 9's run (n = 84 and more: beyond the enumeration, the staged path; issue 21.5), and
+    each "another solution exists" rests on a witness that is itself accepted."""
+    from rigidlcp import models
+    from rigidlcp.verify.forces.polyhedra import event_z
+
+    system = models.System(models.rectangular(10, 4), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.16)
+    run = models.simulate(system, seed=1, max_events=10)
+    for k in (0, run.n_events - 1):
+        ep = models.event_problem(system, run.state_at(k))
+        z = event_z(ep, np.r_[run.records[k].R, run.records[k].S])
+        cert = certify(ep, z)
+        assert cert.accepted and cert.method.startswith("staged (auto")
+        flags = [cert.w_unique, cert.z_unique, cert.pattern_unique, *cert.observables.values()]
+        assert None not in flags, cert
+        if False in flags:
+            assert cert.others and all(certify(ep, o, uniqueness="none").accepted
+                                       for o in cert.others)
