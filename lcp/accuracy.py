@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .residual import TOL
+from .residual import TOL, lcp_measure
 
 _EPS = float(np.finfo(float).eps)
 _EPS_LD = float(np.finfo(np.longdouble).eps)
@@ -249,3 +249,15 @@ def assess_mlcp(problem, v: np.ndarray, u: np.ndarray, basis=None,
     K = np.block([[problem.A, problem.C], [problem.D, problem.B]])
     k = np.concatenate([problem.a, problem.b])
     return assess(K, k, np.concatenate([u, v]), problem.nu, basis, polish)
+
+
+def judge_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None
+              ) -> tuple[bool, np.ndarray, np.ndarray, float, float, Accuracy]:
+    """The verdict on an LCP answer, as lcp.trust gives it (the fast paths and solve_many call
+    this same function): (accepted, z (polished when that helped), w, max|min(z, w)|, scaled
+    residual of lcp.residual, Accuracy)."""
+    acc = assess_lcp(M, q, z, basis)
+    if acc.refined:
+        z = acc.v
+    w, raw, scaled, _, _ = lcp_measure(M, q, z)
+    return bool(scaled <= TOL and acc.accepted), z, w, raw, scaled, acc

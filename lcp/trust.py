@@ -108,7 +108,8 @@ class Run:
         return assess_lcp(self.lcp.M, self.lcp.q, z, basis)
 
     def judge(self, sol: Solution) -> tuple[bool, Check, Accuracy]:
-        """Polish sol on its basis and measure it (module doc, step 2); sol.z is updated."""
+        """Polish sol on its basis and measure it (module doc, step 2); sol.z is updated.
+        On an LCP this is lcp.accuracy.judge_lcp's verdict (the fast paths call that)."""
         acc = self.accuracy(np.asarray(sol.z, dtype=float), sol.basis)
         z = acc.v if acc.refined else np.asarray(sol.z, dtype=float)
         c = self.measure(z, acc.u if (acc.refined and isinstance(self.problem, MLCP)) else None)
