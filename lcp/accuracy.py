@@ -39,7 +39,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import rigidlcp.lcp._lemke_kernel as _kernel
+
 from .residual import TOL, lcp_measure
+
+try:
+    from . import _accuracy_c
+except ImportError:  # not built (no C compiler at install): the numpy code runs
+    _accuracy_c = None
 
 _EPS = float(np.finfo(float).eps)
 _EPS_LD = float(np.finfo(np.longdouble).eps)
@@ -238,8 +245,21 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
 
 def assess_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None,
                polish: bool = True) -> Accuracy:
-    """`assess` for an LCP (no u)."""
+    """`assess` for an LCP (no u). With a basis, in C when the extension is built and the
+    kernels are on (lcp/_accuracy_c.c: the same steps; RIGIDLCP_NO_KERNEL=1 runs numpy)."""
+    if basis is not None and polish and _accuracy_c is not None and _kernel.enabled():
+        a = basis if type(basis) is np.ndarray and basis.dtype == _I64 else np.asarray(
+            basis, dtype=np.int64).reshape(-1)  # C: 1 (numpy runs) unless strictly increasing
+        out = np.empty(q.size)
+        code, berr, ferr, refined = _accuracy_c.assess(M, q, z, a, out)
+        if code == 0:
+            return Accuracy(berr=berr, ferr=ferr, pattern=a, refined=bool(refined),
+                            u=_NO_U, v=out if refined else z)
     return assess(M, q, z, 0, basis, polish)
+
+
+_NO_U = np.zeros(0)
+_I64 = np.dtype(np.int64)
 
 
 def assess_mlcp(problem, v: np.ndarray, u: np.ndarray, basis=None,
