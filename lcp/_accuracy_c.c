@@ -6,9 +6,10 @@
  * the polished point kept when its backward error is not larger.
  *
  * assess(M, q, z, basis, out) -> (code, berr, ferr, refined)
- *   M n x n, q, z, out n (float64, C-contiguous), basis int64 (the basic indices a, m of them).
+ *   M n x n, q, z, out n (float64, C-contiguous), basis int64 (the basic indices a, m of them,
+ *   distinct, in any order: they are sorted here).
  *   code 0: done (out holds the answer: the polished point when refined, else z);
- *   code 1: not handled here (basis out of range, m > MAX_M, M_aa singular to working
+ *   code 1: not handled here (basis out of range or repeated, m > MAX_M, M_aa singular to working
  *   precision by the numpy code's test, a number not finite): the numpy code runs.
  * Only the buffer protocol is used (no numpy headers).
  */
@@ -111,8 +112,23 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     for (idx i = 0; i < n; i++)
         if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
     if (!isfinite(mmax)) return 1;
-    for (idx i = 0; i < m; i++)
-        if (a[i] < 0 || a[i] >= n || (i && a[i] <= a[i - 1])) return 1;
+    char *mark = (char *)calloc((size_t)n, 1);
+    if (!mark) return 1;
+    for (idx i = 0; i < m; i++) {
+        if (a[i] < 0 || a[i] >= n || mark[a[i]]) {
+            free(mark);
+            return 1;
+        }
+        mark[a[i]] = 1;
+    }
+    int64_t *sorted = (int64_t *)malloc(((size_t)m + 1) * sizeof(int64_t));
+    if (!sorted) {
+        free(mark);
+        return 1;
+    }
+    for (idx i = 0, k = 0; i < n; i++)
+        if (mark[i]) sorted[k++] = i;
+    a = sorted;  /* the pattern in increasing order, whatever order the basis came in */
     double berr = backward_error(n, M, q, z, mmax, qmax);
     double ferr = 0.0;
     int refined = 0;
@@ -121,6 +137,8 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     if (!buf || !perm) {
         free(buf);
         free(perm);
+        free(mark);
+        free(sorted);
         return 1;
     }
     double *K = buf, *A = K + m * m, *inv = A + m * m, *kp = inv + m * m, *y = kp + m,
@@ -199,13 +217,8 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             for (idx i = 0; i < n; i++) xs = fmax(xs, fabs(z[i]));
             xs = fmax(xs, 1e-300);
             for (idx i = 0; i < m; i++) gap = fmax(gap, fabs(z[a[i]] - y[i]));
-            for (idx i = 0, k = 0; i < n; i++) {
-                if (k < m && a[k] == i) {
-                    k++;
-                    continue;
-                }
-                gap = fmax(gap, fabs(z[i]));
-            }
+            for (idx i = 0; i < n; i++)
+                if (!mark[i]) gap = fmax(gap, fabs(z[i]));
             ferr = ferr + gap / xs;
             if (!isfinite(ferr)) ferr = INFINITY;
             memcpy(out, z, (size_t)n * sizeof(double));
@@ -213,6 +226,8 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     }
     free(buf);
     free(perm);
+    free(mark);
+    free(sorted);
     res[0] = berr;
     res[1] = ferr;
     res[2] = refined;

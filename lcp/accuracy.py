@@ -215,8 +215,9 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
     x = np.asarray(x, dtype=float)
     berr = backward_error(K, k, x, nu) if np.all(np.isfinite(x)) else np.inf
     if basis is not None:
-        P = np.unique(np.asarray(basis, dtype=np.intp).reshape(-1))
-        if P.size and (P.min() < 0 or P.max() >= x.size - nu):
+        P = np.sort(np.asarray(basis, dtype=np.intp).reshape(-1))
+        if P.size and (P.min() < 0 or P.max() >= x.size - nu
+                       or np.unique(P).size < P.size):
             P = pattern_of(K, k, x, nu)
     else:
         P = pattern_of(K, k, x, nu) if np.all(np.isfinite(x)) else np.zeros(0, np.intp)
@@ -248,8 +249,9 @@ def assess_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None,
     """`assess` for an LCP (no u). With a basis, in C when the extension is built and the
     kernels are on (lcp/_accuracy_c.c: the same steps; RIGIDLCP_NO_KERNEL=1 runs numpy)."""
     if basis is not None and polish and _accuracy_c is not None and _kernel.enabled():
-        a = basis if type(basis) is np.ndarray and basis.dtype == _I64 else np.asarray(
-            basis, dtype=np.int64).reshape(-1)  # C: 1 (numpy runs) unless strictly increasing
+        a = basis if (type(basis) is np.ndarray and basis.dtype == _I64
+                      and basis.flags.c_contiguous) else np.ascontiguousarray(
+            basis, dtype=np.int64).reshape(-1)  # C: 1 (numpy runs) on a repeated index
         out = np.empty(q.size)
         code, berr, ferr, refined = _accuracy_c.assess(M, q, z, a, out)
         if code == 0:

@@ -28,9 +28,9 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from . import api
+from .accuracy import judge_lcp
 from .lemke import DEFAULT_TOL
 from .lemke import lemke as _lemke
-from .accuracy import judge_lcp
 from .scaling import ruiz
 from .solution import Solution, solved_lcp
 

@@ -31,8 +31,8 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from . import api
-from .pivoting import solve_pivoting as _pivoting
 from .accuracy import judge_lcp
+from .pivoting import solve_pivoting as _pivoting
 from .scaling import ruiz
 from .solution import Solution, solved_lcp
 
