@@ -124,8 +124,8 @@ def solved_lcp(z: np.ndarray, w: np.ndarray, method: str, iterations: int, resid
     residual=residual, eq_residual=0.0, scaled_residual=scaled_residual, basis=basis, u=None,
     message=message, info=info, backward_error=..., forward_error=...)``, its fields set
     directly, in the dataclass's order, without its generated __init__ (half the cost: the
-    fast paths of `lcp.solve` and `lcp.solve_many` build one per small problem). tests/lcp/test_fast_lemke.py checks that the objects agree,
-    field for field."""
+    fast paths of `lcp.solve` and `lcp.solve_many` build one per small problem).
+    tests/lcp/test_fast_lemke.py checks that the objects agree, field for field."""
     sol = _new(Solution)
     sol.__dict__ = {
         "z": z, "w": w, "status": "solved", "method": method, "iterations": iterations,
