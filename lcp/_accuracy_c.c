@@ -27,7 +27,7 @@ typedef Py_ssize_t idx;
 
 /* berr of lcp/accuracy.py (nu = 0). */
 static double backward_error(idx n, const double *M, const double *q, const double *x,
-                             double mmax, double qmax)
+                             double mmax, double qmax, double floor)
 {
     double xmax = 0.0;
     for (idx i = 0; i < n; i++) xmax = fmax(xmax, fabs(x[i]));
@@ -41,6 +41,7 @@ static double backward_error(idx n, const double *M, const double *q, const doub
             res += row[j] * x[j];
             s += fabs(row[j]) * fabs(x[j]);
         }
+        s = fmax(s, floor);
         double wr = s > 0 ? res / s : (res == 0 ? 0.0 : copysign(INFINITY, res));
         double v = x[i] / vs, mn = v < wr ? v : wr;
         if (isnan(mn)) return INFINITY;
@@ -112,6 +113,14 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     for (idx i = 0; i < n; i++)
         if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
     if (!isfinite(mmax)) return 1;
+    /* the data's scale (lcp/accuracy.py's data_scale): |q| + ||M||_inf |q| / |M|_max */
+    double norm = 0.0;
+    for (idx i = 0; i < n; i++) {
+        double s = 0.0;
+        for (idx j = 0; j < n; j++) s += fabs(M[i * n + j]);
+        norm = fmax(norm, s);
+    }
+    double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
     char *mark = (char *)calloc((size_t)n, 1);
     if (!mark) return 1;
     for (idx i = 0; i < m; i++) {
@@ -129,7 +138,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     for (idx i = 0, k = 0; i < n; i++)
         if (mark[i]) sorted[k++] = i;
     a = sorted;  /* the pattern in increasing order, whatever order the basis came in */
-    double berr = backward_error(n, M, q, z, mmax, qmax);
+    double berr = backward_error(n, M, q, z, mmax, qmax, floor);
     double ferr = 0.0;
     int refined = 0;
     double *buf = (double *)malloc(((size_t)3 * m * m + 6 * (size_t)m + 1) * sizeof(double));
@@ -208,7 +217,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             if (!isfinite(y[i])) finite = 0;
             out[a[i]] = y[i] > 0.0 ? y[i] : 0.0;
         }
-        double bp = finite ? backward_error(n, M, q, out, mmax, qmax) : INFINITY;
+        double bp = finite ? backward_error(n, M, q, out, mmax, qmax, floor) : INFINITY;
         if (finite && bp <= berr) {
             berr = bp;
             refined = 1;

@@ -7,20 +7,25 @@ The problem is written as one system in x = [u; v] (an LCP has no u):
 
     K x + k = [A u + C v + a; D u + B v + b] = [0; w],      0 <= v perp w >= 0.
 
-**Backward error** (Oettli-Prager, row by row). With s = |K| |x| + |k| (the size of the terms
-that make up each row, the scale of the rounding of K x + k):
+**Backward error** (Oettli-Prager, row by row). With s = max(|K| |x| + |k|, s_d) (the size of
+the terms that make up each row, the scale of the rounding of K x + k, floored by the data's
+scale s_d = |k|_inf + ||K||_inf |k|_inf / |K|_max, where x is at the data's own scale):
 
     berr = max( max_eq |(K x + k)_i| / s_i,  max_comp |min(v_i / v_s, w_i / s_i)| ),
 
 v_s = max(|v|_inf, |b|_inf / |B|_max) as in lcp.residual. Unlike the normwise measure, w_i is
-judged against its own row's terms: inflating z cannot hide a row that z does not touch
-(M = [[1,-1,0],[-1,1,0],[0,0,1]], q = (-1,1,-100), z = (1e15,1e15,0): berr = 1 on row 3).
+judged against its own row's terms and the data, never against |z|: inflating z cannot hide a
+row that z does not touch (M = [[1,-1,0],[-1,1,0],[0,0,1]], q = (-1,1,-100),
+z = (1e15,1e15,0): berr = 1/3 on row 3). s <= lcp.residual's w_s, so berr is never below
+lcp.residual's scaled residual. (The z side stays normwise: a z_i that is 1e-8 of |z|_inf is
+zero to the accuracy the forward error bound speaks of.)
 
 **Forward error bound** of the pattern's system. The pattern P is the basis of the method that
 ended on one, else {i : v_i / v_s > w_i / s_i}; the system is K_PP y = -k_P over the rows and
 unknowns of u and v_P (v_i = 0 off P). Its solution, refined from the answer with residuals in
 extended precision (np.longdouble, "mixed precision" refinement, Higham 2002 Sec. 12.1), is the
-*polished* answer; its bound is LAPACK's
+*polished* answer (for a method that ended on a basis; another answer is judged as it is,
+its bound adding its distance to that exact point); the bound is LAPACK's
 
     ferr = || |K_PP^-1| (|r| + gamma (|K_PP| |y| + |k_P|)) ||_inf / ||y||_inf + eps,
 
@@ -84,7 +89,7 @@ def backward_error(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int) -> floa
         return 0.0
     with np.errstate(all="ignore"):
         res = K @ x + k
-        s = np.abs(K) @ np.abs(x) + np.abs(k)
+        s = np.maximum(np.abs(K) @ np.abs(x) + np.abs(k), data_scale(K, k))
         ratio = np.where(s > 0, np.abs(res) / np.where(s > 0, s, 1.0),
                          np.where(res == 0, 0.0, np.inf))
         out = float(np.max(ratio[:nu], initial=0.0))
@@ -99,6 +104,17 @@ def backward_error(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int) -> floa
                           np.where(w == 0, 0.0, np.sign(w) * np.inf))
             out = max(out, float(np.max(np.abs(np.minimum(v / vs, wr)))))
     return out if np.isfinite(out) else np.inf
+
+
+def data_scale(K: np.ndarray, k: np.ndarray) -> float:
+    """|k|_inf + ||K||_inf x_d with x_d = |k|_inf / |K|_max: the size of K x + k at the data's
+    own scale of x (not the answer's), the floor of every row's scale in `backward_error`."""
+    kmax = float(abs(k).max()) if k.size else 0.0
+    kabs = abs(K)
+    mmax = float(kabs.max()) if K.size else 0.0
+    if not mmax > 0:
+        return kmax
+    return kmax + float(kabs.sum(axis=1).max()) * (kmax / mmax)
 
 
 def pattern_of(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int) -> np.ndarray:
@@ -199,7 +215,7 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
         r = _residual_ld(Kp, kp, y)
         g = np.abs(r) + (m + 1) * _EPS_LD * (absK @ np.abs(y) + np.abs(kp))
         if singular:  # consistent to rounding? else no exact point of this pattern
-            scale = absK @ np.abs(y) + np.abs(kp)
+            scale = np.maximum(absK @ np.abs(y) + np.abs(kp), data_scale(Kp, kp))
             if np.any(np.abs(r) > 1e3 * m * _EPS * np.maximum(scale, 1e-300)):
                 return y, np.inf
         ynorm = max(float(np.max(np.abs(y))), 1e-300)
@@ -208,10 +224,12 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
 
 
 def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
-           basis: np.ndarray | None = None, polish: bool = True) -> Accuracy:
+           basis: np.ndarray | None = None, polish: bool | None = None) -> Accuracy:
     """berr and ferr of x = [u; v] on K x + k (module doc), after polishing x on its pattern
-    (the method's basis when given) when `polish`: the polished point is kept when its
-    backward error is not larger (Accuracy.refined, .u, .v)."""
+    when `polish` (default: when the method gave its final basis -- an answer without one is
+    judged as it is, its bound then includes its distance to the pattern's exact point): the
+    polished point is kept when its backward error is not larger (Accuracy.refined, .u, .v)."""
+    polish = basis is not None if polish is None else polish
     x = np.asarray(x, dtype=float)
     berr = backward_error(K, k, x, nu) if np.all(np.isfinite(x)) else np.inf
     if basis is not None:
@@ -245,10 +263,10 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
 
 
 def assess_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None,
-               polish: bool = True) -> Accuracy:
+               polish: bool | None = None) -> Accuracy:
     """`assess` for an LCP (no u). With a basis, in C when the extension is built and the
     kernels are on (lcp/_accuracy_c.c: the same steps; RIGIDLCP_NO_KERNEL=1 runs numpy)."""
-    if basis is not None and polish and _accuracy_c is not None and _kernel.enabled():
+    if basis is not None and polish is not False and _accuracy_c is not None and _kernel.enabled():
         a = basis if (type(basis) is np.ndarray and basis.dtype == _I64
                       and basis.flags.c_contiguous) else np.ascontiguousarray(
             basis, dtype=np.int64).reshape(-1)  # C: 1 (numpy runs) on a repeated index

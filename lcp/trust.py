@@ -98,14 +98,18 @@ class Run:
         return check(self.problem, z, u, tol=self.tol,
                      lcp_form=self.lcp if isinstance(self.problem, MLCP) else None)
 
+    #: None: polish on the method's basis when it gives one; False: a method's option
+    #: polish=False (e.g. the QP methods' raw answer) is respected
+    polish: bool | None = None
+
     def accuracy(self, z: np.ndarray, basis) -> Accuracy:
         if isinstance(self.problem, MLCP):
             p = self.problem
             if self._K is None:
                 self._K = (np.block([[p.A, p.C], [p.D, p.B]]), np.concatenate([p.a, p.b]))
             u = p.recover_u(z) if np.all(np.isfinite(z)) else np.zeros(p.nu)
-            return assess(*self._K, np.concatenate([u, z]), p.nu, basis)
-        return assess_lcp(self.lcp.M, self.lcp.q, z, basis)
+            return assess(*self._K, np.concatenate([u, z]), p.nu, basis, self.polish)
+        return assess_lcp(self.lcp.M, self.lcp.q, z, basis, self.polish)
 
     def judge(self, sol: Solution) -> tuple[bool, Check, Accuracy]:
         """Polish sol on its basis and measure it (module doc, step 2); sol.z is updated.
@@ -163,6 +167,8 @@ def _errors(c: Check, acc: Accuracy) -> str:
 def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options: dict
                   ) -> Solution:
     """Steps 1-5 of the module docstring."""
+    if options.get("polish") is False:
+        run.polish = False
     sol = run.run(name, equilibrate, options)
     sol.info["equilibrated"] = equilibrate
     if sol.status == "solved":
