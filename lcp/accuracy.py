@@ -301,3 +301,15 @@ def judge_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None
         z = acc.v
     w, raw, scaled, _, _ = lcp_measure(M, q, z)
     return bool(scaled <= TOL and acc.accepted), z, w, raw, scaled, acc
+
+
+def assess_problem(problem, z: np.ndarray, u: np.ndarray | None = None, basis=None,
+                   polish: bool = False) -> Accuracy:
+    """`assess` of an answer to an lcp.LCP or lcp.MLCP as given (no polishing by default):
+    verify.certify reports these bounds and accepts only with them."""
+    z = np.asarray(z, dtype=float).reshape(-1)
+    if hasattr(problem, "M"):
+        return assess_lcp(problem.M, problem.q, z, basis, polish)
+    if u is None:
+        u = problem.recover_u(z)
+    return assess_mlcp(problem, z, np.asarray(u, dtype=float).reshape(-1), basis, polish)
