@@ -272,10 +272,15 @@ def assess_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None,
             basis, dtype=np.int64).reshape(-1)  # C: 1 (numpy runs) on a repeated index
         out = np.empty(q.size)
         code, berr, ferr, refined = _accuracy_c.assess(M, q, z, a, out)
-        if code == 0:
-            return Accuracy(berr=berr, ferr=ferr, pattern=a, refined=bool(refined),
-                            u=_NO_U, v=out if refined else z)
+        if code == 0:  # Accuracy(berr=..., ...) without its generated __init__ (hot path)
+            acc = _new(Accuracy)
+            acc.__dict__ = {"berr": berr, "ferr": ferr, "pattern": a,
+                            "refined": refined == 1, "u": _NO_U, "v": out if refined else z}
+            return acc
     return assess(M, q, z, 0, basis, polish)
+
+
+_new = object.__new__
 
 
 _NO_U = np.zeros(0)
