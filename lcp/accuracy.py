@@ -228,7 +228,8 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
     """berr and ferr of x = [u; v] on K x + k (module doc), after polishing x on its pattern
     when `polish` (default: when the method gave its final basis -- an answer without one is
     judged as it is, its bound then includes its distance to the pattern's exact point): the
-    polished point is kept when its backward error is not larger (Accuracy.refined, .u, .v)."""
+    polished point is kept when its backward error is not larger or at rounding level (8 n eps;
+    Accuracy.refined, .u, .v)."""
     polish = basis is not None if polish is None else polish
     x = np.asarray(x, dtype=float)
     berr = backward_error(K, k, x, nu) if np.all(np.isfinite(x)) else np.inf
@@ -249,7 +250,7 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
         xp[idx] = y
         xp[nu:] = np.maximum(xp[nu:], 0.0)
         bp = backward_error(K, k, xp, nu)
-        if bp <= berr:
+        if bp <= max(berr, 8 * x.size * _EPS):  # not larger, or at rounding level
             x, berr, refined = xp, bp, True
     if not refined:  # the answer as given: |x - y| + the bound of y (triangle inequality)
         with np.errstate(all="ignore"):
