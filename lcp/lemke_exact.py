@@ -21,8 +21,11 @@ import numpy as np
 
 from .solution import Solution
 
-#: Largest n the exact run takes (cost O(n^2) rational operations per pivot, growing entries).
+#: Largest n the exact run takes after a cycling float run (cost O(n^2) rational operations
+#: per pivot, with growing entries: ~0.5 s at n = 60), and after a ray that proves nothing
+#: (rays are common on general M: the rerun is kept cheap there).
 EXACT_MAX_N = 60
+EXACT_RAY_MAX_N = 24
 
 
 def _rationals(values) -> list:
