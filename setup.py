@@ -1,7 +1,8 @@
 """Build hook for the optional C extensions (everything else is in pyproject.toml).
 
-rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c), rigidlcp.lcp._pivot_c the
-block steps of method `pivoting` for lcp.solve's fast path (lcp/_pivot_c.c). Both are
+rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c), rigidlcp.lcp._accuracy_c the
+backward / forward errors of an LCP answer (lcp/_accuracy_c.c), rigidlcp.lcp._pivot_c the
+block steps of method `pivoting` for lcp.solve's fast path (lcp/_pivot_c.c). All are
 `optional`: when no C compiler is available, `pip install` still succeeds and the numpy code
 runs instead (docs/performance.md says why a C extension and what it gains).
 
@@ -27,6 +28,7 @@ setup(
     ext_modules=[
         Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True),
         Extension("rigidlcp.lcp._pivot_c", sources=["lcp/_pivot_c.c"], optional=True),
+        Extension("rigidlcp.lcp._accuracy_c", sources=["lcp/_accuracy_c.c"], optional=True),
     ],
     cmdclass={"build_ext": BuildExt},
 )

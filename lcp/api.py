@@ -114,23 +114,29 @@ def check_options(info: MethodInfo, options: dict) -> None:
 
 
 def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | None = None,
-          repair: bool = True, **options) -> Solution:
+          repair: bool = True, fallback: bool | str | tuple[str, ...] = False,
+          **options) -> Solution:
     """Solve an LCP (w = M z + q, 0 <= z perp w >= 0) or an MLCP by the named method.
 
-    Every answer is checked on the problem passed, with `lcp.residual.check` (the acceptance
-    test of verify.certify, tolerance `lcp.residual.TOL` = 1e-8 on the scaled residual): a
-    "solved" that fails it is repaired or becomes "inaccurate"; an "infeasible" needs a checked
-    Farkas certificate (lcp.farkas). See lcp.trust for the steps.
+    The answer is the method's own: polished on its final basis (extended-precision
+    refinement), then judged on the problem passed by its backward error and forward error
+    bound (lcp.accuracy; tolerances lcp.residual.TOL = 1e-8 and lcp.accuracy.FERR_TOL) and the
+    scaled residual of `lcp.residual.check` (verify.certify's measure). A "solved" that fails
+    is rerun with the other equilibration or becomes "inaccurate"; an "infeasible" needs a
+    checked Farkas certificate (lcp.farkas). See lcp.trust for the steps.
 
     equilibrate: run the method on the Ruiz-equilibrated problem (lcp.scaling); default: the
     method's registered setting (on for lemke, pivoting and enumerate). repair: allow the
-    repairs of lcp.trust (other scaling, fall-back methods); a false "solved" is never returned
-    either way. Other keyword arguments are the method's options.
+    rerun of the method with the other equilibration setting; a false "solved" is never
+    returned either way. fallback: methods to try when this one gives no accepted answer
+    (True: lcp.trust.FALLBACKS, "pivoting" then "lemke"; a name or a tuple of names); their
+    answer is returned under their own name (sol.method) with info["fallback_for"] holding
+    the first method's outcome. Other keyword arguments are the method's options.
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
     if (type(problem) is LCP and method in _FAST_METHODS and not options
-            and (equilibrate is None or equilibrate is True)):
+            and (equilibrate is None or equilibrate is True) and fallback is False):
         sol = _fast(method)(problem)  # the same answer, when the first attempt is accepted
         if sol is not None:
             return sol
@@ -163,10 +169,29 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
             f"method {method!r} is limited to n <= {info.max_n}; this LCP has n = {lcp.n}"
         )
     on = info.equilibrate if equilibrate is None else bool(equilibrate)
-    run = Run(problem, lcp, get_method, TOL)
-    sol = solve_checked(run, method, on, bool(repair), options)
-    sol.method = method
-    return sol
+    run = Run(problem, lcp, get_method, TOL, _fallbacks(fallback))
+    return solve_checked(run, method, on, bool(repair), options)
+
+
+def _fallbacks(fallback) -> tuple[str, ...]:
+    """The fallback= argument of `solve` as a tuple of registered method names."""
+    if fallback is False or fallback is None:
+        return ()
+    if fallback is True:
+        from .trust import FALLBACKS
+
+        return FALLBACKS
+    names = (fallback,) if isinstance(fallback, str) else fallback
+    try:
+        names = tuple(names)
+    except TypeError:
+        raise InvalidProblem(f"fallback must be a bool, a method name or a tuple of names, "
+                             f"got {fallback!r}") from None
+    for name in names:
+        if not isinstance(name, str):
+            raise InvalidProblem(f"fallback names must be strings, got {name!r}")
+        get_method(name)  # InvalidProblem naming the available methods
+    return names
 
 
 _FAST = None

@@ -22,6 +22,7 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
+from .accuracy import judge_lcp
 from .api import check_options, get_method, solve
 from .problem import LCP, MLCP, InvalidProblem
 from .solution import Solution, solved_lcp
@@ -105,7 +106,6 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     method runs on the Ruiz-equilibrated data when it is registered so, and each answer is
     checked on the problem passed (lcp.residual); an answer that is not an accepted "solved"
     is redone by `solve` itself (repairs, certificates of infeasibility)."""
-    from .residual import check
     from .scaling import ruiz
 
     k, n = qs.shape
@@ -126,11 +126,13 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
         z = np.asarray(sol.z, dtype=float)
         if sol.status == "solved" and z.shape == (n,) and np.isfinite(z).all():
             z = eqs[i].z_back(z) if eqs else z
-            chk = check(LCP(Ms[i], qs[i]), z)
-            if chk.accepted:
-                sol.z, sol.w, sol.residual = z, chk.w, chk.residual
-                sol.scaled_residual = chk.scaled_residual
+            ok, z, w, raw, scaled, acc = judge_lcp(Ms[i], qs[i], z, sol.basis)
+            if ok:
+                sol.z, sol.w, sol.residual, sol.scaled_residual = z, w, raw, scaled
+                sol.backward_error, sol.forward_error = acc.berr, acc.ferr
                 sol.info["equilibrated"] = on
+                if acc.refined:
+                    sol.info["polished"] = True
                 out.append(sol)
                 continue
         out.append(solve(problem_of(i), method, repair=repair, **options))
@@ -175,10 +177,15 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     for i, (code, piv, raw, scaled, z, w) in enumerate(zip(
             codes.tolist(), pivots.tolist(), measured[:, 0].tolist(),
             measured[:, 1].tolist(), Z, W)):
-        if code == _kernel.SOLVED and scaled <= TOL:
-            sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, cols[ends[i]:ends[i + 1]],
-                                   "" if piv else "q >= 0: z = 0 solves the LCP",
-                                   {"equilibrated": on}))
+        basis = cols[ends[i]:ends[i + 1]]
+        ok = False
+        if code == _kernel.SOLVED and scaled <= TOL:  # then lcp.trust's verdict, as solve's
+            ok, z, w, raw, scaled, acc = judge_lcp(Ms[i], qs[i], z, basis)
+        if ok:
+            info = {"equilibrated": on, "polished": True} if acc.refined else {"equilibrated": on}
+            sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, basis,
+                                   "" if piv else "q >= 0: z = 0 solves the LCP", info,
+                                   acc.berr, acc.ferr))
         else:  # see the docstring: the single call gives the answer and its evidence
             sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
     return sols

@@ -17,6 +17,15 @@ to the user's problem as R y~ (the sign conditions are invariant under positive 
 When (1)'s y leaves HiGHS's tolerance in M~^T y, it is projected onto the active constraints
 (`_polish`), and failing that the most robust certificate (`_interior`, margin t > 0) is tried.
 
+**Exact re-check.** A certificate that the float test rejects on its radius (M~^T y has
+entries of rounding size, e.g. 3.6e-15, where the exact certificate has 0) is not thrown
+away: `exact_certificate` looks for a rational y >= 0 on y's support with the nearly active
+rows of M~^T y exactly 0 (python-flint's exact row reduction, free unknowns set to y's
+values as small fractions), and checks y >= 0, M^T y <= 0, q^T y < 0 in exact rational
+arithmetic on the float data as given (each double is a rational number). Such a y proves
+that the LCP *as stored* has no feasible point: no tolerance and no radius are involved, and
+the LP's primal check is not needed.
+
 A P-matrix LCP always has a solution, so it never gets a certificate (unless its solution is
 beyond `radius` in the equilibrated units, i.e. M is singular to working precision).
 Copositive-plus M (e.g. M + M^T PSD): a feasible LCP is solvable (Lemke's theorem, Cottle, Pang
@@ -26,6 +35,7 @@ Copositive-plus M (e.g. M + M^T PSD): a feasible LCP is solvable (Lemke's theore
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 
@@ -39,6 +49,8 @@ GAP = 1e-7
 #: n <= 100, so it cannot be certified; a smaller radius would "prove" solvable LCPs whose
 #: solution is merely huge (e.g. |z~| ~ 1e16 for cond(M) ~ 1e16) infeasible.
 RADIUS = 0.1 / np.finfo(float).eps
+#: Largest n for the exact re-check (rational arithmetic, O(n^3) at worst).
+EXACT_MAX_N = 200
 _HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 
 
@@ -49,9 +61,18 @@ class Farkas:
     y: np.ndarray
     gap: float  # -q~^T y~ with sum y~ = 1
     radius: float  # no feasible z~ with |z~|_1 below this (equilibrated units)
+    exact: bool = False  # checked in exact rational arithmetic (then radius = inf)
+
+    @property
+    def how(self) -> str:
+        if self.exact:
+            return (f"checked in exact rational arithmetic: M^T y <= 0 and q^T y < 0 hold "
+                    f"exactly, gap {self.gap:.3g}")
+        return f"gap {self.gap:.3g}, no feasible point within radius {self.radius:.3g}"
 
     def as_info(self) -> dict:
-        return {"farkas": self.y, "farkas_gap": self.gap, "farkas_radius": self.radius}
+        return {"farkas": self.y, "farkas_gap": self.gap, "farkas_radius": self.radius,
+                "farkas_exact": self.exact}
 
 
 def check_certificate(eq: Equilibration, y_tilde: np.ndarray) -> Farkas | None:
@@ -66,8 +87,82 @@ def check_certificate(eq: Equilibration, y_tilde: np.ndarray) -> Farkas | None:
     slack = float(np.max(np.maximum(g, 0.0)))
     radius = np.inf if slack == 0 else gap / slack
     if not (gap >= GAP and radius >= RADIUS):
-        return None
+        return exact_certificate(eq, y) if gap > 0 else None
     return Farkas(y=y * eq.r / float(np.sum(y * eq.r)), gap=gap, radius=float(radius))
+
+
+def _q(x: float):
+    from flint import fmpq  # a dependency (pyproject); imported on first use
+
+    f = Fraction(float(x))
+    return fmpq(f.numerator, f.denominator)
+
+
+def exact_certificate(eq: Equilibration, y: np.ndarray, active_tol: float = 1e-9
+                      ) -> Farkas | None:
+    """A Farkas certificate near the float y (sum y = 1, equilibrated units), checked in exact
+    rational arithmetic (module doc), or None. Candidates: y itself, y as small fractions, and
+    the exact solution of {(M~^T y)_J = 0 on the rows J that y nearly makes active, sum y = 1}
+    on y's support with the free unknowns at y's values (as small fractions)."""
+    n = y.size
+    if n > EXACT_MAX_N:
+        return None
+    from flint import fmpq, fmpq_mat
+
+    MT = fmpq_mat(n, n, [_q(v) for v in eq.M.T.ravel()])
+    qv = [_q(v) for v in eq.q]
+    small = [fmpq(Fraction(float(v)).limit_denominator(10**6).numerator,
+                  Fraction(float(v)).limit_denominator(10**6).denominator) for v in y]
+    cands = [[_q(v) for v in y], small]
+    g = eq.M.T @ y
+    S = np.flatnonzero(y > 1e-12 * y.max())
+    J = np.flatnonzero(g > -active_tol)
+    if S.size and J.size:
+        cands.append(_active_solution(MT, S, J, small, n))
+    for cand in cands:
+        if cand is None or any(v < 0 for v in cand):
+            continue
+        yv = fmpq_mat(n, 1, cand)
+        if not all(v <= 0 for v in (MT * yv).entries()):
+            continue
+        qty = sum((qi * yi for qi, yi in zip(qv, cand)), fmpq(0))
+        if qty >= 0:
+            continue
+        total = sum(cand, fmpq(0))
+        yf = np.array([float(v / total) for v in cand])
+        gap = -float(qty / total)
+        return Farkas(y=yf * eq.r / float(np.sum(yf * eq.r)), gap=gap, radius=np.inf,
+                      exact=True)
+    return None
+
+
+def _active_solution(MT, S: np.ndarray, J: np.ndarray, start: list, n: int):
+    """The rational y with support in S, (M^T y)_J = 0, sum y = 1, free unknowns at `start`
+    (None if the system is inconsistent)."""
+    from flint import fmpq, fmpq_mat
+
+    rows = [[MT[int(j), int(i)] for i in S] + [fmpq(0)] for j in J]
+    rows.append([fmpq(1)] * S.size + [fmpq(1)])
+    A = fmpq_mat(len(rows), S.size + 1, [v for r in rows for v in r])
+    R, rank = A.rref()
+    pivots, col = [], 0
+    for r in range(rank):
+        while col <= S.size and R[r, col] == 0:
+            col += 1
+        if col == S.size:  # a pivot in the right-hand side: inconsistent
+            return None
+        pivots.append(col)
+        col += 1
+    free = [c for c in range(S.size) if c not in pivots]
+    ys = [fmpq(0)] * S.size
+    for c in free:
+        ys[c] = start[int(S[c])]
+    for r, c in enumerate(pivots):
+        ys[c] = R[r, S.size] - sum((R[r, f] * ys[f] for f in free), fmpq(0))
+    y = [fmpq(0)] * n
+    for c, i in enumerate(S):
+        y[int(i)] = ys[c]
+    return y
 
 
 def _polish(eq: Equilibration, y: np.ndarray) -> np.ndarray:
@@ -130,6 +225,8 @@ def find_certificate(eq: Equilibration, candidate: np.ndarray | None = None) -> 
             found = check_certificate(eq, _interior(eq))
         if found is None:
             return None
+    if found.exact:  # a proof in exact arithmetic: no LP has a say
+        return found
     primal = _linprog(np.zeros(n), A_ub=-eq.M, b_ub=eq.q, bounds=[(0, None)] * n,
                      method="highs", options=_HIGHS)
     if primal.status != 2:  # HiGHS finds feasible points (or cannot decide): no claim

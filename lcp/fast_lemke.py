@@ -12,7 +12,8 @@ and returns the answer when it is "solved" and accepted. `solve_lemke` does thes
 with the same roundings, but the first three in one C call (`_lemke_kernel.solve_eq`: the
 equilibration of a balanced M -- `ruiz` then makes no sweep and only changes the unit of q --
 is done there; otherwise `ruiz` runs in numpy and its factors are passed), and the check by
-`lcp.residual.lcp_measure`, the function `check` itself uses on an LCP. So it returns the same
+`lcp.accuracy.judge_lcp`, the verdict `lcp.trust.Run.judge` gives on an LCP (polish on the
+basis, backward and forward errors, `lcp.residual.lcp_measure`). So it returns the same
 Solution (z, w, pivots, basis, residuals, message, info) as the general path, bit for bit
 (tests/lcp/test_fast_lemke.py), and None in every other case -- data that are not plain finite
 float64 arrays, a ray, a pivot limit, a cycle, an answer that fails the acceptance test, or
@@ -27,9 +28,9 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from . import api
+from .accuracy import judge_lcp
 from .lemke import DEFAULT_TOL
 from .lemke import lemke as _lemke
-from .residual import TOL, lcp_measure
 from .scaling import ruiz
 from .solution import Solution, solved_lcp
 
@@ -73,8 +74,9 @@ def solve_lemke(problem) -> Solution | None:
     mmax, qmax, zmax = bounds
     if code != _kernel.SOLVED or not n * mmax * (zmax + 1.0) + qmax < _SAFE:
         return None
-    w, raw, scaled, _, _ = lcp_measure(M, q, z)
-    if not scaled <= TOL:  # lcp.residual.Check.accepted, with no equality part
+    ok, z, w, raw, scaled, acc = judge_lcp(M, q, z, basis[:m])
+    if not ok:  # lcp.trust.Run.judge's verdict, with no equality part
         return None
+    info = {"equilibrated": True, "polished": True} if acc.refined else {"equilibrated": True}
     return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis[:m],
-                      "" if pivots else _Q_NONNEGATIVE, {"equilibrated": True})
+                      "" if pivots else _Q_NONNEGATIVE, info, acc.berr, acc.ferr)

@@ -31,8 +31,8 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from . import api
+from .accuracy import judge_lcp
 from .pivoting import solve_pivoting as _pivoting
-from .residual import TOL, lcp_measure
 from .scaling import ruiz
 from .solution import Solution, solved_lcp
 
@@ -118,9 +118,12 @@ def solve_pivoting(problem) -> Solution | None:
     mmax, qmax, zmax = bounds
     if code != SOLVED or not n * mmax * (zmax + 1.0) + qmax < _SAFE:
         return None
-    w, raw, scaled, _, _ = lcp_measure(M, q, z)
-    if not scaled <= TOL:  # lcp.residual.Check.accepted, with no equality part
+    ok, z, w, raw, scaled, acc = judge_lcp(M, q, z, basis[:m])
+    if not ok:  # lcp.trust.Run.judge's verdict, with no equality part
         return None
     info = {"block_steps": it, "single_pivots": 0, "exchange_pivots": 0, "flips": flips,
             "equilibrated": True}
-    return solved_lcp(z, w, "pivoting", it, raw, scaled, basis[:m], "", info)
+    if acc.refined:
+        info["polished"] = True
+    return solved_lcp(z, w, "pivoting", it, raw, scaled, basis[:m], "", info, acc.berr,
+                      acc.ferr)

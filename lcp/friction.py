@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from .accuracy import judge_lcp
 from .problem import LCP, InvalidProblem, as_vector
 from .solution import Solution
 
@@ -211,6 +212,17 @@ def solve_friction(problem: FrictionContact2D, info, options: dict) -> Solution:
                                 f"Glocker LCP of this problem has n = {lcp_form.n}")
         sol = info.func(lcp_form.M, lcp_form.q, **options)
         z = np.asarray(sol.z, dtype=float)
+        if sol.status == "solved" and z.shape == (lcp_form.n,) and np.all(np.isfinite(z)):
+            # lcp.trust's verdict on the Glocker LCP: polished on the basis, both errors
+            ok, z, _, _, _, acc = judge_lcp(lcp_form.M, lcp_form.q, z, sol.basis)
+            sol.backward_error, sol.forward_error = acc.berr, acc.ferr
+            if acc.refined:
+                sol.info["polished"] = True
+            if not ok:
+                sol.status = "inaccurate"
+                sol.message = (sol.message + "; " if sol.message else "") + (
+                    f"the Glocker LCP answer fails the acceptance test (backward error "
+                    f"{acc.berr:.3g}, forward error bound {acc.ferr:.3g})")
         if z.shape == (lcp_form.n,) and np.all(np.isfinite(z)):
             sol.info["lcp_residual"] = float(np.max(np.abs(np.minimum(z, lcp_form.M @ z
                                                                         + lcp_form.q))))

@@ -29,6 +29,7 @@ import rigidlcp.lcp._lemke_kernel as _kernel
 
 from .api import register
 from .farkas import numerically_psd
+from .lemke_exact import EXACT_MAX_N, EXACT_RAY_MAX_N, lemke_exact
 from .problem import InvalidProblem, as_matrix, as_vector
 from .solution import Solution
 
@@ -93,9 +94,16 @@ def lemke(
             return Solution(z=z, w=M @ z + q, status="solved", method="lemke",
                             iterations=pivots, basis=basis)
     sol = _Lemke(M, q, d, tol).run(max_iter)  # also reruns what the fast path did not solve
-    # Rounding can defeat the lexicographic rule on near-ties (tol too fine for the data):
-    # then restart with ties decided more coarsely, and say so.
-    retry = tol
+    # Near-ties that floats cannot separate (a repeated basis, a ray proving nothing): rerun
+    # with every pivot and tie exact (lcp.lemke_exact: it cannot cycle), and say so.
+    if (sol.info.get("cycling") and n <= EXACT_MAX_N) or (sol.status == "ray"
+                                                          and n <= EXACT_RAY_MAX_N):
+        exact = lemke_exact(M, q, d, max_iter)
+        if exact.status == "solved" or sol.info.get("cycling"):
+            exact.message = f"{sol.message}; rerun in exact rational arithmetic: " + (
+                exact.message or exact.status)
+            return exact
+    retry = tol  # larger n: restart with ties decided more coarsely
     while sol.info.get("cycling") and retry < 1e-6:
         retry *= 100.0
         first = sol.message

@@ -8,8 +8,9 @@ it is not, an LCP method solves the *split* LCP of the full (u, v) system, u = u
 whose first two blocks force A u + C v + a = 0 (both >= 0), so its solutions are exactly the
 MLCP's (u+ = max(u, 0), u- = max(-u, 0) map a solution back). Methods with a native MLCP form
 (newton-*, enumerate-mlcp) get the MLCP itself. Every answer's w and equality residual are
-recomputed here; a "solved" that fails them (relative 1e-8, verify.certify's scaling) is
-downgraded to "not_converged".
+recomputed here, and a "solved" is polished on its pattern and judged as every answer of
+`lcp.solve` is (lcp.accuracy's backward error and forward error bound on the full system,
+verify.certify's scaled residuals, 1e-8): one that fails becomes "inaccurate".
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import itertools
 
 import numpy as np
 
+from .accuracy import assess_mlcp
 from .api import register
 from .problem import LCP, MLCP, NotApplicable
 from .residual import check
@@ -39,8 +41,12 @@ def _norm(X: np.ndarray) -> float:
     return float(np.max(np.sum(np.abs(X), axis=1))) if X.size else 0.0
 
 
-def check_mlcp(problem: MLCP, sol: Solution, tol: float = MLCP_TOL) -> Solution:
-    """Recompute w and the residuals of (u, v); downgrade a "solved" that fails them."""
+def check_mlcp(problem: MLCP, sol: Solution, tol: float = MLCP_TOL,
+               basis: np.ndarray | None = None) -> Solution:
+    """Recompute w and the residuals of (u, v); a "solved" is polished on its pattern (`basis`:
+    the basic v's when the method gives them) and judged as lcp.trust judges every answer
+    (lcp.accuracy: backward error, forward error bound; lcp.residual's scaled residuals); one
+    that fails becomes "inaccurate"."""
     v = np.asarray(sol.z, dtype=float)
     u = np.asarray(sol.u, dtype=float) if sol.u is not None else np.zeros(problem.nu)
     if v.shape != (problem.n,) or u.shape != (problem.nu,) or not (
@@ -48,6 +54,13 @@ def check_mlcp(problem: MLCP, sol: Solution, tol: float = MLCP_TOL) -> Solution:
         sol.status = "failed" if sol.status == "solved" else sol.status
         sol.message = (sol.message + "; " if sol.message else "") + "method returned a bad u, v"
         v, u = np.zeros(problem.n), np.zeros(problem.nu)
+    acc = None
+    if sol.status == "solved":
+        acc = assess_mlcp(problem, v, u, basis)
+        if acc.refined:
+            v, u = acc.v, acc.u
+            sol.info["polished"] = True
+        sol.backward_error, sol.forward_error = acc.berr, acc.ferr
     w, eq = problem.residuals(u, v)
     sol.z, sol.u, sol.w, sol.eq_residual = v, u, w, eq
     sol.residual = complementarity_residual(v, w)
@@ -55,19 +68,22 @@ def check_mlcp(problem: MLCP, sol: Solution, tol: float = MLCP_TOL) -> Solution:
     scaled, scaled_eq = chk.scaled_residual, chk.scaled_eq_residual
     sol.scaled_residual = max(scaled, scaled_eq)
     sol.info["scaled_residual"], sol.info["scaled_eq_residual"] = scaled, scaled_eq
-    if sol.status == "solved" and not (scaled <= tol and scaled_eq <= tol):
-        sol.status = "not_converged"
+    if sol.status == "solved" and not (scaled <= tol and scaled_eq <= tol and acc.accepted):
+        sol.status = "inaccurate"
         sol.message = (sol.message + "; " if sol.message else "") + (
-            f"the answer fails the MLCP check (scaled residual {scaled:.2e}, equality "
-            f"{scaled_eq:.2e} > {tol:g})")
+            f"the answer fails the MLCP check (backward error {acc.berr:.2e}, forward error "
+            f"bound {acc.ferr:.2e}, scaled residual {scaled:.2e}, equality {scaled_eq:.2e}; "
+            f"limits {tol:g} and lcp.accuracy.FERR_TOL), after polishing on its pattern")
     return sol
 
 
 def solve_mlcp_unreduced(problem: MLCP, info, options: dict) -> Solution | None:
     """lcp.solve's MLCP branch: a native MLCP method; else None when the Schur reduction
     applies (the usual path); else the method on the split LCP."""
+    basis = None  # the split LCP's basis indexes [u+; u-; v]: the pattern is read from v
     if "mlcp" in info.native:
         sol = info.native["mlcp"](problem, **options)
+        basis = sol.basis
     else:
         try:
             problem.to_lcp()
@@ -85,7 +101,7 @@ def solve_mlcp_unreduced(problem: MLCP, info, options: dict) -> Solution | None:
             sol.u, sol.z = z[:nu] - z[nu:2 * nu], z[2 * nu:]
         sol.info["reduction"] = "u split into u+ - u- (A not reducible: " + why + ")"
     sol.method = info.name
-    return check_mlcp(problem, sol)
+    return check_mlcp(problem, sol, basis=basis)
 
 
 #: enumerate-mlcp's limit on the number of complementarity pairs (2^m systems)

@@ -9,11 +9,13 @@ import numpy as np
 
 #: Statuses a method may return. Only "solved" carries a solution; the others carry evidence.
 STATUSES = {
-    "solved": "a complementary solution, checked: scaled residual <= lcp.residual.TOL",
+    "solved": "a complementary solution, checked: backward error and scaled residual <= "
+    "lcp.residual.TOL, forward error bound <= lcp.accuracy.FERR_TOL",
     "ray": "Lemke ended on a secondary ray (no conclusion unless M is copositive-plus)",
     "infeasible": "the LCP has no solution (proved: a checked Farkas certificate in info)",
-    "inaccurate": "the answer fails the acceptance test and no repair passed it; z is the best "
-    "point found and scaled_residual the evidence",
+    "inaccurate": "the method's answer fails the acceptance test even after polishing on its "
+    "basis (backward error > lcp.residual.TOL or forward error bound > lcp.accuracy.FERR_TOL); "
+    "z is its best point, backward_error / forward_error / scaled_residual the evidence",
     "max_iter": "the iteration / pivot limit was reached",
     "not_converged": "an iterative method stopped above its tolerance",
     "failed": "the method failed (numerical breakdown); see message",
@@ -37,6 +39,8 @@ class Solution:
     eq_residual: max|A u + C v + a| for an MLCP (0 for an LCP);
     scaled_residual: the acceptance measure of lcp.residual (the larger of the complementarity
     and equality parts), set by `lcp.solve`: "solved" promises it is <= lcp.residual.TOL;
+    backward_error, forward_error: lcp.accuracy's componentwise backward error and forward
+    error bound (LAPACK's BERR / FERR) of a judged answer;
     basis: indices i with z_i basic (the active set), when the method defines one;
     info: evidence (the ray of Lemke, a cycle, ...), method-specific.
     """
@@ -53,6 +57,8 @@ class Solution:
     u: np.ndarray | None = None
     message: str = ""
     info: dict[str, Any] = field(default_factory=dict)
+    backward_error: float = np.nan  # lcp.accuracy (set by lcp.solve for a judged answer)
+    forward_error: float = np.nan
 
     @property
     def success(self) -> bool:
@@ -71,6 +77,9 @@ class Solution:
             f"  residual   : {self.residual:.3e}  (max|min(z, w)|; scaled "
             f"{self.scaled_residual:.3e})",
         ]
+        if np.isfinite(self.backward_error) or np.isfinite(self.forward_error):
+            lines.append(f"  errors     : backward {self.backward_error:.3e}, forward bound "
+                         f"{self.forward_error:.3e}")
         if self.u is not None:
             lines.append(f"  eq_residual: {self.eq_residual:.3e}  (max|A u + C v + a|)")
         if self.basis is not None:
@@ -99,6 +108,7 @@ class Solution:
             "scaled_residual": self.scaled_residual,
             "message": self.message, "z": self.z, "w": self.w,
             "basis": self.basis, "u": self.u, "info": self.info,
+            "backward_error": self.backward_error, "forward_error": self.forward_error,
         }
         return {k: conv(v) for k, v in out.items()}
 
@@ -108,17 +118,19 @@ _new = object.__new__
 
 def solved_lcp(z: np.ndarray, w: np.ndarray, method: str, iterations: int, residual: float,
                scaled_residual: float, basis: np.ndarray | None, message: str,
-               info: dict[str, Any]) -> Solution:
+               info: dict[str, Any], backward_error: float = np.nan,
+               forward_error: float = np.nan) -> Solution:
     """``Solution(z=z, w=w, status="solved", method=method, iterations=iterations,
     residual=residual, eq_residual=0.0, scaled_residual=scaled_residual, basis=basis, u=None,
-    message=message, info=info)``, its fields set directly, in the dataclass's order, without
-    its generated __init__ (half the cost: the fast paths of `lcp.solve` and `lcp.solve_many`
-    build one per small problem). tests/lcp/test_fast_lemke.py checks that the objects agree,
-    field for field."""
+    message=message, info=info, backward_error=..., forward_error=...)``, its fields set
+    directly, in the dataclass's order, without its generated __init__ (half the cost: the
+    fast paths of `lcp.solve` and `lcp.solve_many` build one per small problem).
+    tests/lcp/test_fast_lemke.py checks that the objects agree, field for field."""
     sol = _new(Solution)
     sol.__dict__ = {
         "z": z, "w": w, "status": "solved", "method": method, "iterations": iterations,
         "residual": residual, "eq_residual": 0.0, "scaled_residual": scaled_residual,
         "basis": basis, "u": None, "message": message, "info": info,
+        "backward_error": backward_error, "forward_error": forward_error,
     }
     return sol

@@ -427,6 +427,14 @@ def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
 
     monkeypatch.setattr(lemke_module._Lemke, "run", run_cycling_once)
     monkeypatch.setattr(lemke_module._kernel, "_use", False)  # no whole-run fast path
+    # n <= EXACT_MAX_N: the rerun is exact (lcp/lemke_exact.py; issue 23)
+    sol = lcp.solve(lcp.LCP(M, q), "lemke")
+    assert sol.success and calls["n"] == 1 and sol.info["exact"]
+    assert "exact rational arithmetic" in sol.message
+    np.testing.assert_allclose(sol.z, [1 / 3, 1 / 3], rtol=1e-15)
+    # larger problems restart with coarser ties
+    calls["n"] = 0
+    monkeypatch.setattr(lemke_module, "EXACT_MAX_N", 1)
     sol = lcp.solve(lcp.LCP(M, q), "lemke")
     assert sol.success and calls["n"] == 2
     assert sol.info["tol_used"] == pytest.approx(1e-8) and "restarted" in sol.message

@@ -174,20 +174,36 @@ def test_a_wrong_solved_becomes_inaccurate_with_its_residual(liar):
         assert "acceptance test" in sol.message
 
 
-def test_a_wrong_solved_is_repaired_by_another_method(liar):
+def test_a_wrong_solved_is_not_replaced_by_another_methods_answer(liar):
+    """Issue 23: lcp.solve(problem, method=X) returns X's own answer; another method's answer
+    only with fallback=..., and then under that method's name."""
     rng = np.random.default_rng(5)
     M, q = p_matrix(rng, 6), rng.standard_normal(6)
     q[0] = 10.0  # z = 1 is not a solution
-    sol = lcp.solve(lcp.LCP(M, q), "test-liar")
-    assert sol.status == "solved" and "repaired_by" in sol.info
-    assert certify(lcp.LCP(M, q), sol, uniqueness="none").accepted
+    P = lcp.LCP(M, q)
+    sol = lcp.solve(P, "test-liar")
+    assert sol.status == "inaccurate" and sol.method == "test-liar"
+    assert "fallback_for" not in sol.info and not certify(P, sol, uniqueness="none").accepted
+    assert "method='test-liar'" in repr(sol) and "status='inaccurate'" in repr(sol)
+    got = lcp.solve(P, "test-liar", fallback=True)
+    assert got.status == "solved" and got.method == "pivoting"
+    assert got.info["fallback_for"]["method"] == "test-liar"
+    assert got.info["fallback_for"]["status"] == "solved"  # what the liar claimed
+    assert "method='pivoting'" in repr(got)
+    assert certify(P, got, uniqueness="none").accepted
+    assert lcp.solve(P, "test-liar", fallback="lemke").method == "lemke"
+    with pytest.raises(lcp.InvalidProblem):
+        lcp.solve(P, "test-liar", fallback="no-such-method")
 
 
 def test_a_false_infeasible_is_never_returned(liar):
     rng = np.random.default_rng(6)
     M, q = p_matrix(rng, 6), rng.standard_normal(6)
     P = lcp.LCP(M, q)
-    assert lcp.solve(P, "test-liar", claim="infeasible").status == "solved"
+    sol = lcp.solve(P, "test-liar", claim="infeasible")
+    assert sol.status == "failed" and "not proved" in sol.message and sol.method == "test-liar"
+    got = lcp.solve(P, "test-liar", claim="infeasible", fallback=True)
+    assert got.status == "solved" and got.method == "pivoting"
     sol = lcp.solve(P, "test-liar", claim="infeasible", repair=False)
     assert sol.status == "failed" and "not proved" in sol.message
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP, MLCP, NotApplicable, Solution, enumerate_solutions
+from rigidlcp.lcp.accuracy import assess_problem
 from rigidlcp.lcp.residual import check
 
 from .friction import forces_map, friction_certificate
@@ -72,6 +73,8 @@ class Certificate:
     notes: list[str] = field(default_factory=list)
     seconds: float = 0.0
     staged: object | None = None  # uniqueness="staged": the verify.certificates StagedCertificate
+    backward_error: float = np.nan  # lcp.accuracy's, of the solution as given (lcp.solve's)
+    forward_error: float = np.nan  # lcp.accuracy's bound; accepted needs <= FERR_TOL
 
     @staticmethod
     def verdict(flag: bool | None) -> str:
@@ -87,6 +90,8 @@ class Certificate:
         if self.eq_residual or self.scaled_eq_residual:
             lines.append(f"  eq_residual     : {self.eq_residual:.3e}  (scaled "
                          f"{self.scaled_eq_residual:.3e})")
+        lines.append(f"  errors          : backward {self.backward_error:.3e}, forward bound "
+                     f"{self.forward_error:.3e}  (lcp.accuracy)")
         lines.append(f"  uniqueness by   : {self.method}")
         lines.append(f"  w = M z + q     : {self.verdict(self.w_unique)}")
         lines.append(f"  z               : {self.verdict(self.z_unique)}")
@@ -180,6 +185,12 @@ def certify(
         scaled_eq_residual=chk.scaled_eq_residual, z_scale=zs, w_scale=ws, delta=delta,
         notes=notes,
     )
+    # lcp.accuracy's backward error and forward error bound, as lcp.solve reports them: an
+    # inflated z or an O(1) forward error is not accepted (issue 23)
+    acc = assess_problem(problem, z, chk.u if isinstance(problem, MLCP) else None,
+                         getattr(solution, "basis", None))
+    cert.backward_error, cert.forward_error = acc.berr, acc.ferr
+    cert.accepted = cert.accepted and acc.accepted
     if fc_residual is not None:
         notes.append(f"friction contact: relative natural-map residual {fc_residual:.3e}; "
                      "z is its Glocker LCP's, 'forces' its r")

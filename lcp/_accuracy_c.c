@@ -1,0 +1,360 @@
+/* lcp/accuracy.py's `assess` for an LCP answer with a basis, in C (the common case of
+ * lcp.solve, its fast paths and solve_many: a few microseconds at n = 10 instead of a hundred
+ * numpy calls). The same steps as the numpy code: the componentwise backward error of z, the
+ * pattern's system M_aa y = -q_a refined from z_a with residuals in long double (x86: 64-bit
+ * mantissa, numpy's longdouble) on one LU factorization, LAPACK's forward error bound with
+ * || |K^-1| g || estimated as xGERFS does (Hager's estimator: O(m^2) per step), and
+ * the polished point kept when its backward error is not larger.
+ *
+ * assess(M, q, z, basis, out) -> (code, berr, ferr, refined)
+ *   M n x n, q, z, out n (float64, C-contiguous), basis int64 (the basic indices a, m of them,
+ *   distinct, in any order: they are sorted here).
+ *   code 0: done (out holds the answer: the polished point when refined, else z);
+ *   code 1: not handled here (basis out of range or repeated, m > MAX_M, a pivot of M_aa's LU
+ *   below m eps times the largest, a number not finite): the numpy code runs.
+ * Only the buffer protocol is used (no numpy headers).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef Py_ssize_t idx;
+
+/* max / min of numbers that are not NaN (fmax / fmin are library calls unless inlined) */
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+#define MAX_M 400
+#define STEPS 5
+
+/* berr of lcp/accuracy.py (nu = 0). */
+static double backward_error(idx n, const double *M, const double *q, const double *x,
+                             double mmax, double qmax, double floor)
+{
+    double xmax = 0.0;
+    for (idx i = 0; i < n; i++) xmax = dmax(xmax, fabs(x[i]));
+    double vs = dmax(xmax, mmax > 0 ? qmax / mmax : 0.0);
+    if (!(vs > 0)) vs = 1.0;
+    double out = 0.0;
+    for (idx i = 0; i < n; i++) {
+        const double *row = M + i * n;
+        double res = q[i], s = fabs(q[i]);
+        for (idx j = 0; j < n; j++) {
+            res += row[j] * x[j];
+            s += fabs(row[j]) * fabs(x[j]);
+        }
+        s = dmax(s, floor);
+        double wr = s > 0 ? res / s : (res == 0 ? 0.0 : copysign(INFINITY, res));
+        double v = x[i] / vs, mn = v < wr ? v : wr;
+        if (isnan(mn)) return INFINITY;
+        out = dmax(out, fabs(mn));
+    }
+    return out;
+}
+
+/* LU with partial pivoting of A (m x m, row-major, in place: L below the diagonal, U on and
+ * above; perm[k] the row swapped with k at step k). -1 if U is singular to working precision:
+ * a pivot below m eps times the largest (the numpy code then decides, by its SVD path). */
+static int lu(idx m, double *A, idx *perm)
+{
+    double umax = 0.0, umin = INFINITY;
+    for (idx k = 0; k < m; k++) {
+        idx p = k;
+        for (idx i = k + 1; i < m; i++)
+            if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
+        perm[k] = p;
+        if (A[p * m + k] == 0.0) return -1;
+        if (p != k)
+            for (idx j = 0; j < m; j++) {
+                double t = A[k * m + j];
+                A[k * m + j] = A[p * m + j];
+                A[p * m + j] = t;
+            }
+        double piv = A[k * m + k];
+        for (idx i = k + 1; i < m; i++) {
+            double l = A[i * m + k] / piv;
+            A[i * m + k] = l;
+            if (l != 0.0)
+                for (idx j = k + 1; j < m; j++) A[i * m + j] -= l * A[k * m + j];
+        }
+        umax = dmax(umax, fabs(piv));
+        umin = dmin(umin, fabs(piv));
+    }
+    return (m > 0 && !(umin > (double)m * DBL_EPSILON * umax)) ? -1 : 0;
+}
+
+/* x <- K^-1 x (trans = 0) or K^-T x (trans = 1) from the LU of `lu`. */
+static void lu_solve(idx m, const double *A, const idx *perm, double *x, int trans)
+{
+    if (!trans) {
+        for (idx k = 0; k < m; k++)
+            if (perm[k] != k) {
+                double t = x[k];
+                x[k] = x[perm[k]];
+                x[perm[k]] = t;
+            }
+        for (idx i = 0; i < m; i++)
+            for (idx j = 0; j < i; j++) x[i] -= A[i * m + j] * x[j];
+        for (idx i = m - 1; i >= 0; i--) {
+            for (idx j = i + 1; j < m; j++) x[i] -= A[i * m + j] * x[j];
+            x[i] /= A[i * m + i];
+        }
+    } else {  /* K = P^T L U: K^T x = b  <=>  U^T L^T (P x) = b */
+        for (idx i = 0; i < m; i++) {
+            for (idx j = 0; j < i; j++) x[i] -= A[j * m + i] * x[j];
+            x[i] /= A[i * m + i];
+        }
+        for (idx i = m - 1; i >= 0; i--)
+            for (idx j = i + 1; j < m; j++) x[i] -= A[j * m + i] * x[j];
+        for (idx k = m - 1; k >= 0; k--)
+            if (perm[k] != k) {
+                double t = x[k];
+                x[k] = x[perm[k]];
+                x[perm[k]] = t;
+            }
+    }
+}
+
+/* || |K^-1| g ||_inf = || diag(g) K^-T ||_1, by Hager's 1-norm estimator (Higham 2002,
+ * Alg. 15.4; LAPACK's xLACN2 does the same for xGERFS's FERR): B x = g .* (K^-T x),
+ * B^T x = K^-1 (g .* x). x, y: scratch of length m. */
+static double abs_inv_norm(idx m, const double *A, const idx *perm, const double *g,
+                           double *x, double *y)
+{
+    for (idx i = 0; i < m; i++) x[i] = 1.0 / (double)m;
+    double est = 0.0;
+    idx jprev = -1;  /* x = e_jprev, or 1/m everywhere while -1 */
+    for (int it = 0; it < 5; it++) {
+        memcpy(y, x, (size_t)m * sizeof(double));
+        lu_solve(m, A, perm, y, 1);
+        double norm = 0.0;
+        for (idx i = 0; i < m; i++) {
+            y[i] *= g[i];
+            norm += fabs(y[i]);
+        }
+        if (it > 0 && norm <= est) break;
+        est = norm;
+        for (idx i = 0; i < m; i++) x[i] = g[i] * (y[i] >= 0 ? 1.0 : -1.0);
+        lu_solve(m, A, perm, x, 0);  /* z = B^T sign(y) */
+        idx j = 0;
+        double zx = 0.0;
+        for (idx i = 0; i < m; i++) {
+            if (fabs(x[i]) > fabs(x[j])) j = i;
+            zx += x[i] / (double)m;
+        }
+        if (jprev >= 0) zx = x[jprev];
+        if (fabs(x[j]) <= zx) break;
+        for (idx i = 0; i < m; i++) x[i] = 0.0;
+        x[j] = 1.0;
+        jprev = j;
+    }
+    /* Higham's alternative vector: guards the estimate against special structure */
+    for (idx i = 0; i < m; i++)
+        x[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + (double)i / (double)(m > 1 ? m - 1 : 1));
+    lu_solve(m, A, perm, x, 1);
+    double alt = 0.0;
+    for (idx i = 0; i < m; i++) alt += fabs(g[i] * x[i]);
+    alt = 2.0 * alt / (3.0 * (double)m);
+    return dmax(est, alt);
+}
+
+/* r = K y + k, accumulated in long double, rounded to double. */
+static void residual_ld(idx m, const double *K, const double *k, const double *y, double *r)
+{
+    for (idx i = 0; i < m; i++) {
+        long double s = (long double)k[i];
+        for (idx j = 0; j < m; j++) s += (long double)K[i * m + j] * (long double)y[j];
+        r[i] = (double)s;
+    }
+}
+
+static int assess_one(idx n, const double *M, const double *q, const double *z,
+                      const int64_t *a, idx m, double *out, double *res)
+{
+    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
+    double mmax = 0.0, qmax = 0.0, norm = 0.0;
+    for (idx i = 0; i < n; i++) qmax = dmax(qmax, fabs(q[i]));
+    for (idx i = 0; i < n; i++)
+        if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
+    /* |M|_max and ||M||_inf in one pass, for the data's scale (lcp/accuracy.py's data_scale):
+     * |q| + ||M||_inf |q| / |M|_max */
+    for (idx i = 0; i < n; i++) {
+        double s = 0.0;
+        for (idx j = 0; j < n; j++) {
+            double v = fabs(M[i * n + j]);
+            s += v;
+            mmax = dmax(mmax, v);
+        }
+        norm = dmax(norm, s);
+    }
+    if (!isfinite(norm)) return 1;
+    double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
+    char *mark = (char *)calloc((size_t)n, 1);
+    if (!mark) return 1;
+    for (idx i = 0; i < m; i++) {
+        if (a[i] < 0 || a[i] >= n || mark[a[i]]) {
+            free(mark);
+            return 1;
+        }
+        mark[a[i]] = 1;
+    }
+    int64_t *sorted = (int64_t *)malloc(((size_t)m + 1) * sizeof(int64_t));
+    if (!sorted) {
+        free(mark);
+        return 1;
+    }
+    for (idx i = 0, k = 0; i < n; i++)
+        if (mark[i]) sorted[k++] = i;
+    a = sorted;  /* the pattern in increasing order, whatever order the basis came in */
+    double berr = -1.0;  /* of z as given: computed only when needed (below) */
+    double ferr = 0.0;
+    int refined = 0;
+    double *buf = (double *)malloc(((size_t)3 * m * m + 6 * (size_t)m + 1) * sizeof(double));
+    idx *perm = (idx *)malloc(((size_t)m + 1) * sizeof(idx));
+    if (!buf || !perm) {
+        free(buf);
+        free(perm);
+        free(mark);
+        free(sorted);
+        return 1;
+    }
+    double *K = buf, *A = K + m * m, *inv = A + m * m, *kp = inv + m * m, *y = kp + m,
+           *r = y + m, *d = r + m, *g = d + m, *rows = g + m;
+    for (idx i = 0; i < m; i++) {
+        kp[i] = q[a[i]];
+        y[i] = z[a[i]];
+        rows[i] = 0.0;
+        for (idx j = 0; j < m; j++) {
+            K[i * m + j] = M[a[i] * n + a[j]];
+            rows[i] += fabs(K[i * m + j]);
+        }
+    }
+    memcpy(A, K, (size_t)m * m * sizeof(double));
+    int code = 0;
+    if (m > 0) {
+        if (lu(m, A, perm) < 0) code = 1;  /* singular: numpy's SVD path */
+        if (!code) {
+            double prev = INFINITY;
+            for (int step = 0; step < STEPS; step++) {
+                residual_ld(m, K, kp, y, r);
+                memcpy(d, r, (size_t)m * sizeof(double));
+                lu_solve(m, A, perm, d, 0);
+                double size = 0.0, ymax = 0.0;
+                for (idx i = 0; i < m; i++) size = dmax(size, fabs(d[i]));
+                if (!isfinite(size) || size >= prev) break;
+                for (idx i = 0; i < m; i++) {
+                    y[i] -= d[i];
+                    ymax = dmax(ymax, fabs(y[i]));
+                }
+                prev = size;
+                if (size <= eps * ymax) break;
+            }
+            residual_ld(m, K, kp, y, r);
+            double ymax = 0.0;
+            for (idx i = 0; i < m; i++) {
+                double s = fabs(kp[i]);
+                for (idx j = 0; j < m; j++) s += fabs(K[i * m + j]) * fabs(y[j]);
+                g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * s;
+                ymax = dmax(ymax, fabs(y[i]));
+            }
+            double bound = abs_inv_norm(m, A, perm, g, d, inv);
+            ferr = bound / dmax(ymax, 1e-300) + eps;
+            /* Skeel's condition || |K^-1| |K| 1 ||: singular to working precision beyond
+             * 1 / (m eps), as the numpy code's test (its SVD path decides then) */
+            if (abs_inv_norm(m, A, perm, rows, d, inv) * (double)m * eps > 1.0) code = 1;
+            if (!isfinite(ferr)) ferr = INFINITY;
+        }
+    }
+    if (!code) {
+        for (idx i = 0; i < n; i++) out[i] = 0.0;
+        int finite = 1;
+        for (idx i = 0; i < m; i++) {
+            if (!isfinite(y[i])) finite = 0;
+            out[a[i]] = y[i] > 0.0 ? y[i] : 0.0;
+        }
+        double bp = finite ? backward_error(n, M, q, out, mmax, qmax, floor) : INFINITY;
+        /* kept when its backward error is at rounding level or not larger than z's */
+        if (!(finite && bp <= 8.0 * (double)n * eps))
+            berr = backward_error(n, M, q, z, mmax, qmax, floor);
+        if (finite && (bp <= 8.0 * (double)n * eps || bp <= berr)) {
+            berr = bp;
+            refined = 1;
+        } else {
+            double xs = 0.0, gap = 0.0;
+            for (idx i = 0; i < n; i++) xs = dmax(xs, fabs(z[i]));
+            xs = dmax(xs, 1e-300);
+            for (idx i = 0; i < m; i++) gap = dmax(gap, fabs(z[a[i]] - y[i]));
+            for (idx i = 0; i < n; i++)
+                if (!mark[i]) gap = dmax(gap, fabs(z[i]));
+            ferr = ferr + gap / xs;
+            if (!isfinite(ferr)) ferr = INFINITY;
+            memcpy(out, z, (size_t)n * sizeof(double));
+        }
+    }
+    free(buf);
+    free(perm);
+    free(mark);
+    free(sorted);
+    res[0] = berr;
+    res[1] = ferr;
+    res[2] = refined;
+    return code;
+}
+
+static PyObject *py_assess(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *oz, *oa, *oout;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOO", &oM, &oq, &oz, &oa, &oout)) return NULL;
+    Py_buffer vM, vq, vz, va, vo;
+    int got = 0;
+    if (PyObject_GetBuffer(oM, &vM, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0) got = 1;
+    if (got == 1 && PyObject_GetBuffer(oq, &vq, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0) got = 2;
+    if (got == 2 && PyObject_GetBuffer(oz, &vz, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0) got = 3;
+    if (got == 3 && PyObject_GetBuffer(oa, &va, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0) got = 4;
+    if (got == 4 &&
+        PyObject_GetBuffer(oout, &vo, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS | PyBUF_WRITABLE) == 0)
+        got = 5;
+    PyErr_Clear();
+    int code = 1;
+    double res[3] = {0.0, 0.0, 0.0};
+    if (got == 5) {
+        idx n = vq.len / 8, m = va.len / 8;
+        int ok = vM.itemsize == 8 && vq.itemsize == 8 && vz.itemsize == 8 && va.itemsize == 8 &&
+                 vo.itemsize == 8 && vM.len == n * n * 8 && vz.len == n * 8 &&
+                 vo.len == n * 8 && m <= MAX_M && m <= n;
+        const char *fa = va.format ? va.format : "B";
+        if (*fa == '<' || *fa == '=' || *fa == '@') fa++;
+        ok = ok && (fa[0] == 'q' || fa[0] == 'l') && fa[1] == 0;
+        const char *fs[4] = {vM.format, vq.format, vz.format, vo.format};
+        for (int i = 0; i < 4 && ok; i++) {
+            const char *f = fs[i] ? fs[i] : "B";
+            if (*f == '<' || *f == '=' || *f == '@') f++;
+            ok = f[0] == 'd' && f[1] == 0;
+        }
+        if (ok && n >= 1)
+            code = assess_one(n, (const double *)vM.buf, (const double *)vq.buf,
+                              (const double *)vz.buf, (const int64_t *)va.buf, m,
+                              (double *)vo.buf, res);
+    }
+    if (got >= 5) PyBuffer_Release(&vo);
+    if (got >= 4) PyBuffer_Release(&va);
+    if (got >= 3) PyBuffer_Release(&vz);
+    if (got >= 2) PyBuffer_Release(&vq);
+    if (got >= 1) PyBuffer_Release(&vM);
+    return Py_BuildValue("iddi", code, res[0], res[1], (int)res[2]);
+}
+
+static PyMethodDef methods[] = {
+    {"assess", py_assess, METH_VARARGS,
+     "assess(M, q, z, basis, out) -> (code, berr, ferr, refined): lcp/accuracy.py's assess "
+     "of an LCP answer on its basis (code 1: not handled, run the numpy code)."},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_accuracy_c",
+                                    "lcp/accuracy.py's assess in C.", -1, methods};
+
+PyMODINIT_FUNC PyInit__accuracy_c(void) { return PyModule_Create(&module); }
