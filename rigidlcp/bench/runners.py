@@ -12,7 +12,9 @@ rigidlcp.bench.harness.judge certifies it.
 
 from __future__ import annotations
 
+import inspect
 import json
+import math
 import multiprocessing as mp
 import os
 import queue
@@ -29,6 +31,8 @@ import scipy.sparse as sp
 
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP
+
+from .peers import PEERS, Peer, solve_peer
 
 SYSTEM_PYTHON = "/usr/bin/python3"
 HELPER = Path(__file__).with_name("_siconos_helper.py")
@@ -87,6 +91,9 @@ def _worker_main(conn) -> None:
             problem, method, info = conn.recv()
         except (EOFError, OSError):
             return
+        if isinstance(info, Peer):  # another project's solver (bench.peers)
+            conn.send(solve_peer(problem, method, info))
+            continue
         if info is not None and method not in {m.name for m in lcp.methods()}:
             lcp.register(info.name, accepts=info.accepts, description=info.description,
                          max_n=info.max_n, native=info.native)(info.func)
@@ -96,11 +103,17 @@ def _worker_main(conn) -> None:
             conn.send(_solve_here(problem, method))
 
 
+#: lcp.solve's switch for "the method's own answer, no other method's substituted"
+#: (repair=False where lcp.solve has it; without it, the own answer is the default).
+_OWN = {"repair": False} if "repair" in inspect.signature(lcp.solve).parameters else {}
+
 #: A small P-matrix LCP solved once, untimed, by each method in a fresh worker (imports, caches).
 WARM_UP = LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), name="warm-up")
 
 
 def _solve_here(problem, method: str) -> dict:
+    if method in PEERS:
+        return solve_peer(problem, method, PEERS[method])
     t0 = time.perf_counter()
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -108,7 +121,7 @@ def _solve_here(problem, method: str) -> dict:
             # repair=False: the method's own answer (lcp.solve still checks it: a "solved"
             # that fails becomes "inaccurate", an unproved "infeasible" "failed"), never
             # another method's answer credited to it.
-            sol = lcp.solve(problem, method=method, repair=False)
+            sol = lcp.solve(problem, method=method, **_OWN)
     except lcp.NotApplicable as exc:
         return {"kind": "not_applicable", "message": str(exc), "time": 0.0}
     except Exception as exc:  # noqa: BLE001 - a harness reports, never dies
@@ -121,7 +134,8 @@ def _answer(sol, seconds: float) -> dict:
     """A solution as the harness's raw answer (judged there, never trusted)."""
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
             "iterations": int(sol.iterations), "message": sol.message, "time": seconds,
-            "u": None if sol.u is None else np.asarray(sol.u, dtype=float)}
+            "u": None if sol.u is None else np.asarray(sol.u, dtype=float),
+            "forward_error": (sol.info or {}).get("forward_error")}
 
 
 def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:
@@ -132,7 +146,7 @@ def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            sols = lcp.solve_many(problems, method, repair=False)
+            sols = lcp.solve_many(problems, method, **_OWN)
     except Exception as exc:  # noqa: BLE001 - one by one instead
         return {"kind": "error", "message": f"{type(exc).__name__}: {exc}"}
     mean = (time.perf_counter() - t0) / max(len(problems), 1)
@@ -154,6 +168,8 @@ def _picklable_info(method: str):
 
     from rigidlcp.lcp import api
 
+    if method in PEERS:
+        return PEERS[method]
     if method not in _PICKLED:
         info = api.get_method(method)
         try:
@@ -178,6 +194,8 @@ class LocalRunner:
         self.proc = None
         self.conn = None
         self.warm: set[str] = set()  # methods already run once by the current worker
+        #: {method: seconds of each warm-up solve} (untimed in the results, reported apart)
+        self.warmups: dict[str, list[float]] = {}
 
     def _start(self) -> None:
         ctx = mp.get_context(start_method())
@@ -192,10 +210,16 @@ class LocalRunner:
         if not (parent.poll(STARTUP) and parent.recv() == "ready"):
             raise RuntimeError(f"the bench worker did not start within {STARTUP:g} s")
 
-    def solve(self, problem, method: str, time_limit: float) -> dict:
+    def _warm_up(self, method: str, time_limit: float) -> None:
+        """One untimed solve of WARM_UP per method in a fresh worker (imports, numba's
+        compilation, caches); its wall time is kept in `warmups`."""
         if method not in self.warm:
             self.warm.add(method)
-            self.solve(WARM_UP, method, time_limit)
+            raw = self.solve(WARM_UP, method, time_limit)
+            self.warmups.setdefault(method, []).append(float(raw.get("time", math.nan)))
+
+    def solve(self, problem, method: str, time_limit: float) -> dict:
+        self._warm_up(method, time_limit)
         if not self.isolate:
             return _solve_here(problem, method)
         answer = self._ask(problem, method, time_limit + self.grace)
@@ -225,9 +249,7 @@ class LocalRunner:
         """Raw answers for same-size LCPs solved by one `lcp.solve_many` call (time: the mean
         per problem), or None when the batch failed or took longer than time_limit per problem
         on average (the caller then solves them one at a time, each with its own limit)."""
-        if method not in self.warm:
-            self.warm.add(method)
-            self.solve(WARM_UP, method, time_limit)
+        self._warm_up(method, time_limit)
         raws = (_solve_batch_here(problems, method) if not self.isolate else
                 self._ask(list(problems), method, time_limit * len(problems) + self.grace))
         return raws if isinstance(raws, list) else None  # an error, a timeout, a dead worker
@@ -256,6 +278,8 @@ class SiconosRunner:
         self.reason = ""
         self.version = ""
         self.kinds: set[str] = set()
+        self.warm: set[str] = set()  # methods already run once by the current helper
+        self.warmups: dict[str, list[float]] = {}  # {method: seconds of each warm-up solve}
         self.tmp = tempfile.TemporaryDirectory(prefix="rigidlcp_bench_")
         self.available = self._start()
 
@@ -295,6 +319,10 @@ class SiconosRunner:
         return self.available and spec is not None and spec.kind in self.kinds
 
     def solve(self, problem, method: str, time_limit: float) -> dict:
+        if method not in self.warm and (SICONOS_METHODS[method].kind == "lcp"):
+            self.warm.add(method)  # one untimed solve per helper (as LocalRunner's methods)
+            raw = self.solve(WARM_UP, method, time_limit)
+            self.warmups.setdefault(method, []).append(float(raw.get("time", math.nan)))
         spec = SICONOS_METHODS[method]
         prepared = self._prepare(problem, method, spec)
         if isinstance(prepared, dict) and "kind" in prepared:  # a refusal
@@ -393,6 +421,7 @@ class SiconosRunner:
                 self.proc.kill()
             self.proc.wait(timeout=10)
             self.proc = None
+            self.warm = set()
 
     def close(self) -> None:
         if self.proc is not None and self.proc.poll() is None:
