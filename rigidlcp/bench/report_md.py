@@ -154,7 +154,8 @@ def write_report(results: Sequence[Result], out: str | os.PathLike, *, time_limi
         ran = {r.problem for r in results if r.set == set_name and r.method != "-"}
         bad = {r.problem for r in results if r.set == set_name and r.method == "-"}
         sizes = sorted({r.n for r in results if r.set == set_name and r.method != "-"})
-        count = f"{len(ran)} problems" + (f" ({len(bad)} more unreadable)" if bad else "")
+        count = f"{len(ran)} problem{'s' * (len(ran) != 1)}" + (
+            f" ({len(bad)} more unreadable)" if bad else "")
         if sizes:
             count += f", n = {sizes[0]}..{sizes[-1]}"
         lines += ["", f"## {set_name}", "", f"{set_info.get(set_name, '')} {count}.".strip()]

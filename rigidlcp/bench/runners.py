@@ -319,14 +319,15 @@ class SiconosRunner:
         return self.available and spec is not None and spec.kind in self.kinds
 
     def solve(self, problem, method: str, time_limit: float) -> dict:
-        if method not in self.warm and (SICONOS_METHODS[method].kind == "lcp"):
-            self.warm.add(method)  # one untimed solve per helper (as LocalRunner's methods)
-            raw = self.solve(WARM_UP, method, time_limit)
-            self.warmups.setdefault(method, []).append(float(raw.get("time", math.nan)))
         spec = SICONOS_METHODS[method]
         prepared = self._prepare(problem, method, spec)
         if isinstance(prepared, dict) and "kind" in prepared:  # a refusal
             return prepared
+        if method not in self.warm and spec.kind == "lcp" and problem is not WARM_UP:
+            self.warm.add(method)  # one untimed solve per helper (as LocalRunner's methods)
+            raw = self.solve(WARM_UP, method, time_limit)
+            self.warmups.setdefault(method, []).append(float(raw.get("time", math.nan)))
+            prepared = self._prepare(problem, method, spec)  # the warm-up's files replaced
         req, nu = prepared
         if self.proc is None or self.proc.poll() is not None:
             if not self._start():
