@@ -105,7 +105,7 @@ def _worker_main(conn) -> None:
 
 #: lcp.solve's switch for "the method's own answer, no other method's substituted"
 #: (repair=False where lcp.solve has it; without it, the own answer is the default).
-_OWN = {"repair": False} if "repair" in inspect.signature(lcp.solve).parameters else {}
+OWN_ANSWER = {"repair": False} if "repair" in inspect.signature(lcp.solve).parameters else {}
 
 #: A small P-matrix LCP solved once, untimed, by each method in a fresh worker (imports, caches).
 WARM_UP = LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), name="warm-up")
@@ -121,7 +121,7 @@ def _solve_here(problem, method: str) -> dict:
             # repair=False: the method's own answer (lcp.solve still checks it: a "solved"
             # that fails becomes "inaccurate", an unproved "infeasible" "failed"), never
             # another method's answer credited to it.
-            sol = lcp.solve(problem, method=method, **_OWN)
+            sol = lcp.solve(problem, method=method, **OWN_ANSWER)
     except lcp.NotApplicable as exc:
         return {"kind": "not_applicable", "message": str(exc), "time": 0.0}
     except Exception as exc:  # noqa: BLE001 - a harness reports, never dies
@@ -146,7 +146,7 @@ def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            sols = lcp.solve_many(problems, method, **_OWN)
+            sols = lcp.solve_many(problems, method, **OWN_ANSWER)
     except Exception as exc:  # noqa: BLE001 - one by one instead
         return {"kind": "error", "message": f"{type(exc).__name__}: {exc}"}
     mean = (time.perf_counter() - t0) / max(len(problems), 1)
