@@ -123,10 +123,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
                              f"({', '.join(SETS)}) nor a folder")
         notes: list[str] = []
         siconos_ok = siconos is not None and siconos.available
-        peers_ok = {m: peer_available(m) for m in PEERS}
-        if args.methods:
-            methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-        else:
+        methods = [m.strip() for m in (args.methods or "").split(",") if m.strip()]
+        wanted = [m for m in PEERS if not args.methods and not args.no_peers or m in methods]
+        peers_ok = {m: peer_available(m) for m in wanted}  # imports only the peers asked for
+        if not args.methods:
             methods = DEFAULT_METHODS.split(",") + [m for m in SICONOS_METHODS
                                                     if siconos_ok and siconos.offers(m)]
             if not args.no_peers:
