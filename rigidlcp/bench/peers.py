@@ -12,8 +12,10 @@ Every peer is timed the way rigidlcp's methods are (rigidlcp.bench.runners): the
 from Python, in the bench's worker process, after one untimed warm-up solve per fresh worker
 (numba compiles lcp_lemke there; the warm-up's time is reported apart). Drake's Python
 binding exposes Moby's solver only through `Solve` on a MathematicalProgram (its
-SolveLcpLemke / SolveLcpLemkeRegularized / SolveLcpFast paths are C++ only): building the
-program is part of the natural call, so it is timed. A peer's "solved" is only its claim: the
+SolveLcpLemke / SolveLcpFast / SolveLcpFastRegularized paths are C++ only); Solve runs
+SolveLcpLemkeRegularized (Lemke on M, then on M + lambda I for lambda = 1e-20, 1e-16, ...,
+each answer checked against the matrix it solved, M + lambda I, not M). Building the program
+is part of the natural call, so it is timed. A peer's "solved" is only its claim: the
 harness certifies the z it returns like any other answer (rigidlcp.bench.harness.judge), so a
 false success is reported as `uncertified`. Peers take LCPs only (other kinds are refused).
 """
@@ -73,7 +75,7 @@ PEERS: dict[str, Peer] = {
     "quantecon-lemke": Peer("quantecon", "quantecon.optimize", _quantecon,
                             "QuantEcon's lcp_lemke (numba, lexicographic Lemke)"),
     "drake-moby": Peer("drake", "pydrake.solvers", partial(_drake, "MobyLcpSolver"),
-                       "Drake's MobyLcpSolver (Lemke, regularized fast path) via Solve"),
+                       "Drake's MobyLcpSolver via Solve (SolveLcpLemkeRegularized)"),
     "drake-unrevised-lemke": Peer(
         "drake", "pydrake.solvers", partial(_drake, "UnrevisedLemkeSolver"),
         "Drake's UnrevisedLemkeSolver via Solve"),

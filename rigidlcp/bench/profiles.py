@@ -27,7 +27,7 @@ def style(k: int) -> dict:
     """The k-th curve's matplotlib style: 10 colours x 4 line styles x 10 markers, distinct
     for k < 40 (colour and line style change together, never only one of them repeats)."""
     return {"color": f"C{k % 10}", "linestyle": STYLES[(k // 10 + k) % 4],
-            "marker": MARKERS[k % 10], "markevery": 0.1, "markersize": 4}
+            "marker": MARKERS[(k + 3 * (k // 10)) % 10], "markevery": 0.1, "markersize": 4}
 
 
 def plot_profile(results: Sequence[Result], path: str | os.PathLike, title: str,
