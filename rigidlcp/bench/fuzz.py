@@ -38,7 +38,7 @@ from rigidlcp.lcp.batch import COMPILED_BATCH
 from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
-from .runners import OWN_ANSWER
+from .own import OWN_ANSWER
 
 #: The exhaustive methods (accepts "small-n": enumerate, enumerate-mlcp; 2^n bases) are run
 #: for n up to this in the fuzz.
@@ -100,7 +100,7 @@ def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
 
 def attempt(problem, method: str) -> tuple[lcp.Solution | None, dict]:
     """Solve, timed, the method's own answer (no other method's answer substituted:
-    runners.OWN_ANSWER); (None, result) when the method refused or crashed, else (solution,
+    bench.own.OWN_ANSWER); (None, result) when the method refused or crashed, else (solution,
     {"seconds": ...}) for the judge."""
     t0 = time.perf_counter()
     try:

@@ -12,7 +12,6 @@ rigidlcp.bench.harness.judge certifies it.
 
 from __future__ import annotations
 
-import inspect
 import json
 import math
 import multiprocessing as mp
@@ -32,6 +31,7 @@ import scipy.sparse as sp
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP
 
+from .own import OWN_ANSWER
 from .peers import PEERS, Peer, solve_peer
 
 SYSTEM_PYTHON = "/usr/bin/python3"
@@ -102,10 +102,6 @@ def _worker_main(conn) -> None:
         else:
             conn.send(_solve_here(problem, method))
 
-
-#: lcp.solve's switch for "the method's own answer, no other method's substituted"
-#: (repair=False where lcp.solve has it; without it, the own answer is the default).
-OWN_ANSWER = {"repair": False} if "repair" in inspect.signature(lcp.solve).parameters else {}
 
 #: A small P-matrix LCP solved once, untimed, by each method in a fresh worker (imports, caches).
 WARM_UP = LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-5.0, -6.0]), name="warm-up")
