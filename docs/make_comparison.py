@@ -148,8 +148,9 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
         "and the results per problem, is [comparison/report.md](comparison/report.md); how "
         "answers are judged and timed is in [bench.md](bench.md). Every answer, rigidlcp's "
         "and every peer's, is judged by the same check; every method is timed as the whole "
-        "call from Python after an untimed warm-up; times are indicative (a shared 2-core "
-        "machine).", "", "## The collection", "", "| set | what |", "|---|---|"]
+        "call from Python on M and q (rigidlcp: `lcp.solve(lcp.LCP(M, q), method)`, one call "
+        "per problem, no batches) after an untimed warm-up; times are indicative (a shared "
+        "2-core machine).", "", "## The collection", "", "| set | what |", "|---|---|"]
     lines += [f"| {s} | {w} |" for s, w in rows]
     lines += ["", *(f"- {n}" for n in notes)] if notes else []
     lines += ["", "## Successes per set", "",
@@ -202,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
                                               Path(args.cache) if args.cache else None)
         run = root / "run"
         argv_bench = ["bench", "--set", ",".join(specs), "--out", str(run), "--quiet",
-                      "--time-limit", f"{args.time_limit:g}", "--sizes",
+                      "--no-batch", "--time-limit", f"{args.time_limit:g}", "--sizes",
                       "4" if args.quick else SIZES]
         print("rigidlcp " + " ".join(argv_bench), flush=True)
         if rigidlcp(argv_bench) != 0:

@@ -114,7 +114,9 @@ def _solve_here(problem, method: str) -> dict:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            # repair=False: the method's own answer (lcp.solve still checks it: a "solved"
+            if type(problem) is LCP:  # the natural call on M and q, as the peers are given
+                problem = LCP(problem.M, problem.q, name=problem.name)
+            # OWN_ANSWER: the method's own answer (lcp.solve still checks it: a "solved"
             # that fails becomes "inaccurate", an unproved "infeasible" "failed"), never
             # another method's answer credited to it.
             sol = lcp.solve(problem, method=method, **OWN_ANSWER)
