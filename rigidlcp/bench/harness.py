@@ -84,6 +84,9 @@ class Result:
     #: a bound on the forward error of a claimed solution, where the method or the check
     #: reports one (Solution.info["forward_error"] or the certificate's); nan: none reported
     forward_error: float = math.nan
+    #: the check's backward error where it reports one (verify.certify's backward_error, a
+    #: measure that z's size cannot inflate); nan: none (the scaled residual stands for it)
+    backward_error: float = math.nan
 
 
 def problem_kind(problem) -> str:
@@ -148,7 +151,7 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         return Result(**base, outcome=kind, success=False, status=kind, time=t,
                       iterations=None, residual=math.nan, scaled_residual=math.nan)
     status, t, z = raw["status"], float(raw["time"]), raw["z"]
-    res = scaled = forward = math.nan
+    res = scaled = forward = backward = math.nan
     if z.shape == (problem.n,) and np.all(np.isfinite(z)):
         answer = Solution(z=z, w=np.zeros(0), status=status, method=method, u=raw.get("u"))
         with np.errstate(all="ignore"):
@@ -156,6 +159,7 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         res, scaled = cert.residual, cert.scaled_residual
         accepted = cert.accepted
         forward = _forward_error(raw, cert)
+        backward = float(getattr(cert, "backward_error", math.nan))
     else:
         accepted = False
     if t > time_limit:
@@ -170,13 +174,14 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
     return Result(**base, outcome=outcome, success=outcome in ("solved", "infeasible"),
                   status=status, time=min(t, time_limit) if outcome != "timeout" else time_limit,
                   iterations=raw.get("iterations"), residual=res, scaled_residual=scaled,
-                  forward_error=forward if outcome == "solved" else math.nan)
+                  forward_error=forward if outcome == "solved" else math.nan,
+                  backward_error=backward)
 
 
 def _forward_error(raw: dict, cert) -> float:
     """The forward error bound of an answer: the method's (raw "forward_error", from
-    Solution.info) or the certificate's (an attribute forward_error), whichever is larger;
-    nan when neither reports one."""
+    Solution.forward_error or Solution.info) or the certificate's (its forward_error),
+    whichever is larger; nan when neither reports one."""
     values = [raw.get("forward_error"), getattr(cert, "forward_error", None)]
     values = [float(v) for v in values if v is not None and not math.isnan(float(v))]
     return max(values) if values else math.nan
@@ -292,7 +297,7 @@ def _batched_answers(local: LocalRunner, problems: list, methods: list[str],
 def _row(r: Result) -> dict:
     row = asdict(r)
     row["time"] = f"{r.time:.6g}"
-    for key in ("residual", "scaled_residual", "forward_error"):
+    for key in ("residual", "scaled_residual", "forward_error", "backward_error"):
         row[key] = "" if math.isnan(row[key]) else f"{row[key]:.3e}"
     row["iterations"] = "" if r.iterations is None else r.iterations
     return row
@@ -338,5 +343,7 @@ def read_csv(path: str | os.PathLike) -> list[Result]:
                                  else math.nan),
                 expected=row["expected"], message=row["message"], kind=row.get("kind", ""),
                 forward_error=(float(row["forward_error"]) if row.get("forward_error")
-                               else math.nan)))
+                               else math.nan),
+                backward_error=(float(row["backward_error"]) if row.get("backward_error")
+                                else math.nan)))
     return out

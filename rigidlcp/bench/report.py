@@ -52,11 +52,13 @@ ACCURACIES = (1e-8, 1e-12)  # success rates at these backward / forward errors
 
 
 def at_accuracy(r: Result, accuracy: float, forward: bool = False) -> bool:
-    """Whether `r` succeeded with its backward error (forward=False: the scaled residual) or
-    its forward error bound (forward=True) <= accuracy; a certified infeasibility counts."""
+    """Whether `r` succeeded with its backward error (forward=False: the check's backward
+    error, else the scaled residual) or its forward error bound (forward=True) <= accuracy; a
+    certified infeasibility counts."""
     if r.outcome == "infeasible":
         return True
-    value = r.forward_error if forward else r.scaled_residual
+    backward = r.scaled_residual if math.isnan(r.backward_error) else r.backward_error
+    value = r.forward_error if forward else backward
     return r.outcome == "solved" and value <= accuracy
 
 

@@ -133,7 +133,8 @@ def _answer(sol, seconds: float) -> dict:
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
             "iterations": int(sol.iterations), "message": sol.message, "time": seconds,
             "u": None if sol.u is None else np.asarray(sol.u, dtype=float),
-            "forward_error": (sol.info or {}).get("forward_error")}
+            "forward_error": getattr(sol, "forward_error",
+                                     (sol.info or {}).get("forward_error"))}
 
 
 def _solve_batch_here(problems: list, method: str) -> list[dict] | dict:

@@ -150,6 +150,11 @@ def test_success_at_stated_accuracies_backward_and_forward():
     assert s.at_accuracy == {1e-8: (3, 2), 1e-12: (2, 2)}
     s, = summarize([_r("a", "m", "solved")], time_limit=1.0)
     assert s.at_accuracy[1e-8] == (1, None)  # no forward bound reported: "n/a"
+    # where the check reports a backward error (one that an inflated z cannot meet), it is
+    # the one judged, not the scaled residual
+    inflated = _r("d", "m", "solved", scaled=5e-14)
+    inflated.backward_error = 1e-2
+    assert not at_accuracy(inflated, 1e-8)
     assert "1 / n/a" in summary_table([s])[2]
 
 
