@@ -1,4 +1,4 @@
-"""Helper of rigidlcp.bench.runners, run by the system interpreter (/usr/bin/python3) that has
+"""Helper of rigidlcp.bench.siconos, run by the system interpreter (/usr/bin/python3) that has
 Debian's python3-siconos: Siconos's LCP, MLCP and 2D friction-contact solvers on problems
 passed as .npy files. It imports nothing of rigidlcp (it runs under another interpreter, with
 that interpreter's numpy).
