@@ -157,14 +157,18 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
     lines += [f"| {s} | {w} |" for s, w in rows]
     lines += ["", *(f"- {n}" for n in notes)] if notes else []
     lines += ["", "## Successes per set", "",
-              "Certified answers / problems given; '-': the method takes none of the set.", "",
+              "Certified answers / problems given; '-': the method takes none of the set; "
+              "'k false': k answers the method called solutions that are not (the check "
+              "rejected them; see below).", "",
               "| method | " + " | ".join(sets) + " |", "|---|" + "---:|" * len(sets)]
     for m in methods:
         cells = []
         for s in sets:
             x = by_set[s].get(m)
+            false = x.failures.get("uncertified", 0) if x is not None else 0
             cells.append("-" if x is None or x.refused == x.problems
-                         else f"{x.successes}/{x.problems}")
+                         else f"{x.successes}/{x.problems}" + (f" ({false} false)" if false
+                                                               else ""))
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     fig9 = by_set.get("fig9-events", {})
     if fig9:
@@ -174,6 +178,20 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
                   "them).", "",
                   *summary_table([x for x in fig9.values() if x.refused < x.problems])]
     lines += ["", "## All sets", "", *summary_table(list(summarize(results, time_limit)))]
+    false = [r for r in results if r.outcome == "uncertified"]
+    lines += ["", "## False successes", "",
+              "Answers a method reported as solutions that the check rejected (rigidlcp's own "
+              "methods are checked inside `lcp.solve` and say `inaccurate` instead, so they "
+              "never appear here):", ""]
+    for m in dict.fromkeys(r.method for r in false):
+        mine = [r for r in false if r.method == m]
+        worst = max((r.residual for r in mine if not math.isnan(r.residual)), default=math.nan)
+        names = ", ".join(f"`{r.problem}`" for r in mine[:4]) + (", ..." if len(mine) > 4
+                                                                  else "")
+        lines.append(f"- **{m}**: {len(mine)} (largest residual max|min(z, w)| "
+                     f"{worst:.1e}): {names}")
+    if not false:
+        lines.append("None.")
     lines += ["", "## Performance profiles", ""]
     for kind in ("LCP", "MLCP", "FC2D"):
         if (path.parent / "comparison" / f"profile_{kind}.png").exists():
