@@ -136,7 +136,7 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
     from rigidlcp import lcp
     from rigidlcp.bench.peers import PEERS
     from rigidlcp.bench.report import summarize, summary_table
-    from rigidlcp.bench.siconos import SICONOS_METHODS
+    from rigidlcp.bench.siconos_runner import SICONOS_METHODS
 
     sets = list(dict.fromkeys(r.set for r in results if r.method != "-"))
     methods = list(dict.fromkeys(r.method for r in results if r.method != "-"))

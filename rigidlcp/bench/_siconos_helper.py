@@ -1,5 +1,5 @@
-"""Helper of rigidlcp.bench.siconos, run by the system interpreter (/usr/bin/python3) that has
-Debian's python3-siconos: Siconos's LCP, MLCP and 2D friction-contact solvers on problems
+"""Helper of rigidlcp.bench.siconos_runner, run by the system interpreter (/usr/bin/python3)
+that has Debian's python3-siconos: Siconos's LCP, MLCP and 2D friction-contact solvers on problems
 passed as .npy files. It imports nothing of rigidlcp (it runs under another interpreter, with
 that interpreter's numpy).
 

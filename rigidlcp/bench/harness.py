@@ -51,7 +51,7 @@ from rigidlcp.verify.certificates.certify import certify
 from .peers import PEERS, peer_available
 from .problem_sets import Unreadable
 from .runners import GRACE, LocalRunner
-from .siconos import SICONOS_METHODS, SiconosRunner
+from .siconos_runner import SICONOS_METHODS, SiconosRunner
 
 __all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate", "write_csv",
            "append_csv", "read_csv", "available_methods", "check_methods", "LocalRunner",

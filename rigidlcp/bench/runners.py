@@ -1,7 +1,7 @@
 """The worker runner of the benchmark harness (rigidlcp.bench.harness): rigidlcp's methods and the
 peers (bench.peers) in a worker process (started by "forkserver" or "spawn", never forked from
 this possibly multi-threaded process) that is killed on a timeout. Siconos's solvers have their
-own runner (rigidlcp.bench.siconos).
+own runner (rigidlcp.bench.siconos_runner).
 A method registered at run time (not built in) is sent to the worker with the problem, by
 reference (pickle): it must be a module-level function.
 

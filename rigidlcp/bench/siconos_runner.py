@@ -1,7 +1,8 @@
 """Siconos's LCP, MLCP and 2D friction-contact solvers (SICONOS_METHODS) as bench methods, in a
 long-lived /usr/bin/python3 subprocess (_siconos_helper.py) that has Debian's python3-siconos;
 its answers are raw answers for rigidlcp.bench.harness.judge, like LocalRunner's
-(rigidlcp.bench.runners)."""
+(rigidlcp.bench.runners). (Not named siconos.py: the helper runs as a script from this folder,
+where such a file would shadow the siconos package.)"""
 
 from __future__ import annotations
 
