@@ -5,9 +5,11 @@ on LCPs passed as .npy files.
 Protocol (one JSON object per line): the helper first prints {"ready": true, "numpy": ...} or
 {"ready": false, "error": ...}; then for every request {"M": path, "q": path, "max_iter": k} it
 solves once (or "inner" times in a row, reporting the mean) and prints {"time": wall seconds
-of the solve call only, "cpu": its CPU seconds
-(process time), "iterations": Siconos's pivot
-count, "info": return code, "residual": max|min(z, M z + q)|}. End of input ends it.
+of the solve call only, "cpu": its CPU seconds (process time), "iterations": Siconos's pivot
+count, "info": return code, "residual": max|min(z, M z + q)|, "z": the answer}. End of input
+ends it. The direct lcp_lexicolemke call returns info = 0 on answers that are not solutions
+(27 of Fig. 9's 74 event LCPs; Siconos's driver reports those as failures): the callers judge
+every "z" with rigidlcp's own check (verify.certify), never by info.
 
 Siconos counts the pivots of its main loop, i.e. every pivot except the first (z0 entering).
 """
@@ -54,6 +56,7 @@ def main() -> int:
             "iterations": int(options.iparam[sn.SICONOS_IPARAM_ITER_DONE]),
             "info": int(info) if info is not None else None,
             "residual": residual,
+            "z": [float(v) for v in z],
         }
         print(json.dumps(out), flush=True)
     return 0
@@ -62,7 +65,7 @@ def main() -> int:
 def _batch(np, sn, req: dict) -> dict:
     """A loop of lcp_lexicolemke over stacked problems {"Ms": path (k, n, n), "qs": path}:
     "loop" = wall seconds of the whole loop (problem objects, options, solve), "calls" = the sum
-    of the solver calls only; the pivots and the worst residual."""
+    of the solver calls only; the pivots, the worst residual and the answers "zs" (to judge)."""
     Ms, qs = np.load(req["Ms"]), np.load(req["qs"])
     k, n = qs.shape
     Ms = [np.ascontiguousarray(Ms[i]) for i in range(k)]
@@ -82,7 +85,7 @@ def _batch(np, sn, req: dict) -> dict:
     loop = time.perf_counter() - t0
     res = max(float(np.max(np.abs(np.minimum(Z[i], Ms[i] @ Z[i] + qs[i])))) for i in range(k))
     return {"loop": loop, "calls": calls, "pivots": pivots,
-            "failures": sum(1 for x in infos if x), "residual": res}
+            "failures": sum(1 for x in infos if x), "residual": res, "zs": Z.tolist()}
 
 
 if __name__ == "__main__":

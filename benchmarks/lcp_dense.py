@@ -105,6 +105,19 @@ def _time_solve(problem: lcp.LCP, method: str, inner: int = 1
     return (time.perf_counter() - t0) / inner, (time.process_time() - c0) / inner, sol
 
 
+def judged(problem: lcp.LCP, z: list[float]) -> str:
+    """"ok" when a peer's answer passes rigidlcp's own check (verify.certify, uniqueness
+    "none"), else "NOT": a peer's info = 0 is a claim, not a proof."""
+    from rigidlcp.lcp import Solution
+    from rigidlcp.verify.certificates.certify import certify
+
+    answer = Solution(z=np.asarray(z, dtype=float), w=np.zeros(0), status="solved",
+                      method="siconos")
+    with np.errstate(all="ignore"):
+        ok = certify(problem, answer, uniqueness="none").accepted
+    return "ok" if ok else "NOT"
+
+
 def inner_calls(n: int, inner: str) -> int:
     """Calls per timed sample: --inner N, or "auto": about 20000 / n^2 (200 at n = 10, 1 from
     n = 142 on), so that a sample is not one cold call of a few microseconds."""
@@ -178,6 +191,7 @@ def run(sizes: list[int], repeats: int, seed: int, budget: float, methods: list[
                                   "siconos_cpu": [s["cpu"] for s in sic],
                                   "sic_pivots": sic[-1]["iterations"],
                                   "sic_info": sic[-1]["info"],
+                                  "sic_judged": judged(problem, sic[-1]["z"]),
                                   "sic_residual": sic[-1]["residual"]})
     print()
     _report_siconos(siconos, pairs, use_siconos)
@@ -197,11 +211,13 @@ def _report_siconos(siconos: Siconos | None, pairs: list[dict], use_siconos: boo
           f"{SYSTEM_PYTHON} subprocess, solve call only), runs interleaved, medians")
     print("Siconos counts the pivots after the first one (z0 entering); rigidlcp's lemke counts "
           "all, so equal paths show lemke = Siconos + 1 (pivoting counts its own iterations).")
+    print("checked: Siconos's answer judged by rigidlcp's own check (verify.certify): 'NOT' is")
+    print("an answer that is not a solution, whatever Siconos's info says.")
     print("Wall time: medians and ratio = rigidlcp/Siconos; best = min/min over the runs. CPU: the")
     print("same with process CPU time (less sensitive to other jobs on the machine).")
     header = (f"{'n':>5} {'method':<9} {'rigidlcp [ms]':>14} {'Siconos [ms]':>13} {'ratio':>6} "
               f"{'best':>6} {'CPU ratio':>9} {'pivots':>7} {'Siconos+1':>9} {'info':>5} "
-              f"{'Siconos res':>11}")
+              f"{'Siconos res':>11} {'checked':>7}")
     print(header)
     print("-" * len(header))
     for p in pairs:
@@ -211,7 +227,7 @@ def _report_siconos(siconos: Siconos | None, pairs: list[dict], use_siconos: boo
         print(f"{p['n']:>5} {p['method']:<9} {1e3 * ours:>14.3f} {1e3 * theirs:>13.3f} "
               f"{ours / theirs:>6.2f} {best:>6.2f} {cpu:>9.2f} {p['pivots']:>7} "
               f"{p['sic_pivots'] + 1:>9} "
-              f"{p['sic_info']:>5} {p['sic_residual']:>11.1e}")
+              f"{p['sic_info']:>5} {p['sic_residual']:>11.1e} {p['sic_judged']:>7}")
     print()
 
 

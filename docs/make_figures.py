@@ -37,7 +37,7 @@ COPIES = {
     "run_friction_forces.png": ("plot", "friction_forces.png"),
     "run_mu_g.png": ("plot", "mu_g.png"),
     "run_dissipation.png": ("plot", "dissipation.png"),
-    "bench_profile.png": ("bench", "profile_random-p.png"),
+    "bench_profile.png": ("bench", "profile_LCP.png"),
 }
 
 

@@ -1,5 +1,5 @@
-"""Helper of rigidlcp.bench.runners, run by the system interpreter (/usr/bin/python3) that has
-Debian's python3-siconos: Siconos's LCP, MLCP and 2D friction-contact solvers on problems
+"""Helper of rigidlcp.bench.siconos_runner, run by the system interpreter (/usr/bin/python3)
+that has Debian's python3-siconos: Siconos's LCP, MLCP and 2D friction-contact solvers on problems
 passed as .npy files. It imports nothing of rigidlcp (it runs under another interpreter, with
 that interpreter's numpy).
 
@@ -18,8 +18,9 @@ never mix with the answers): the helper first prints {"ready": true, "version": 
   FrictionContactProblem(2, W, q, mu), W dense or sparse-block (2 x 2 blocks), z = r;
 
 with optional "max_iter" and "tol" (SICONOS_IPARAM_MAX_ITER, SICONOS_DPARAM_TOL), it solves
-once and prints {"z": [...], "time": wall seconds of the driver call only (mlcp: with
-``mlcp_driver_init``), "iterations": SICONOS_IPARAM_ITER_DONE, "info": the return code (0 is
+once and prints {"z": [...], "time": wall seconds of the whole call from Python
+(solver options, problem object, driver; mlcp: with ``mlcp_driver_init``), "iterations":
+SICONOS_IPARAM_ITER_DONE, "info": the return code (0 is
 success), "error": Siconos's own residual (SICONOS_DPARAM_RESIDU)}. End of input ends it.
 """
 
@@ -96,31 +97,33 @@ def main() -> int:
             continue
         req = json.loads(line)
         kind = req.get("kind", "lcp")
+        q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
+        z, w = np.zeros(q.size), np.zeros(q.size)
+        if kind == "fc2d":
+            mu = np.ascontiguousarray(np.load(req["mu"]), dtype=float)
+            W, _keep = _fc2d_matrix(sn, np, req)
+        else:
+            M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
+        # the whole call from Python, as rigidlcp's lcp.solve is timed: options, problem
+        # object, driver (the arrays' transport through .npy files is not timed)
+        t0 = time.perf_counter()
         options = sn.SolverOptions(getattr(sn, solvers[kind][req["solver"]]))
         if req.get("max_iter") is not None:
             options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(req["max_iter"])
         if req.get("tol") is not None:
             options.dparam[sn.SICONOS_DPARAM_TOL] = float(req["tol"])
-        q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
-        z, w = np.zeros(q.size), np.zeros(q.size)
         if kind == "lcp":
-            problem = sn.LCP(np.ascontiguousarray(np.load(req["M"]), dtype=float), q)
-            t0 = time.perf_counter()
+            problem = sn.LCP(M, q)
             info = sn.linearComplementarity_driver(problem, z, w, options)
             elapsed = time.perf_counter() - t0
         elif kind == "mlcp":
-            M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
             problem = sn.MLCP(int(req["nu"]), M, q)
-            t0 = time.perf_counter()
             sn.mlcp_driver_init(problem, options)
             info = sn.mlcp_driver(problem, z, w, options)
             elapsed = time.perf_counter() - t0
             sn.mlcp_driver_reset(problem, options)
         else:
-            mu = np.ascontiguousarray(np.load(req["mu"]), dtype=float)
-            W, _keep = _fc2d_matrix(sn, np, req)
             problem = sn.FrictionContactProblem(2, W, q, mu)
-            t0 = time.perf_counter()
             info = sn.fc2d_driver(problem, z, w, options)
             elapsed = time.perf_counter() - t0
         answer = {

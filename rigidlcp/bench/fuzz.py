@@ -38,6 +38,7 @@ from rigidlcp.lcp.batch import COMPILED_BATCH
 from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
+from .own import OWN_ANSWER
 
 #: The exhaustive methods (accepts "small-n": enumerate, enumerate-mlcp; 2^n bases) are run
 #: for n up to this in the fuzz.
@@ -98,11 +99,12 @@ def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
 
 
 def attempt(problem, method: str) -> tuple[lcp.Solution | None, dict]:
-    """Solve, timed; (None, result) when the method refused or crashed, else (solution,
+    """Solve, timed, the method's own answer (no other method's answer substituted:
+    bench.own.OWN_ANSWER); (None, result) when the method refused or crashed, else (solution,
     {"seconds": ...}) for the judge."""
     t0 = time.perf_counter()
     try:
-        sol = lcp.solve(problem, method, **OPTIONS.get(method, {}))
+        sol = lcp.solve(problem, method, **OWN_ANSWER, **OPTIONS.get(method, {}))
     except lcp.NotApplicable as exc:
         return None, {"outcome": "refused", "reason": str(exc),
                       "seconds": time.perf_counter() - t0}
@@ -124,7 +126,7 @@ def batch_attempt(cases: list[Case], method: str) -> list[tuple[lcp.Solution, di
     problems = [lcp.LCP(c.M, c.q) for c in cases]
     t0 = time.perf_counter()
     try:
-        sols = lcp.solve_many(problems, method, **OPTIONS.get(method, {}))
+        sols = lcp.solve_many(problems, method, **OWN_ANSWER, **OPTIONS.get(method, {}))
     except Exception:  # noqa: BLE001 - one by one instead
         return None
     mean = (time.perf_counter() - t0) / max(len(cases), 1)

@@ -48,12 +48,14 @@ from rigidlcp import lcp
 from rigidlcp.lcp import LCP, MLCP, Solution
 from rigidlcp.verify.certificates.certify import certify
 
+from .peers import PEERS, peer_available
 from .problem_sets import Unreadable
-from .runners import GRACE, SICONOS_METHODS, LocalRunner, SiconosRunner
+from .runners import GRACE, LocalRunner
+from .siconos_runner import SICONOS_METHODS, SiconosRunner
 
 __all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate", "write_csv",
-           "read_csv", "available_methods", "LocalRunner", "SiconosRunner", "SICONOS_METHODS",
-           "GRACE"]
+           "append_csv", "read_csv", "available_methods", "check_methods", "LocalRunner",
+           "PEERS", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
 
 #: Claims that no solution exists.
 NO_SOLUTION = ("infeasible", "ray")
@@ -80,6 +82,12 @@ class Result:
     expected: str
     message: str = ""
     kind: str = ""  # the kind of problem: "LCP", "MLCP", "FC2D" ("-" unreadable, "" unknown)
+    #: a bound on the forward error of a claimed solution, where the method or the check
+    #: reports one (Solution.info["forward_error"] or the certificate's); nan: none reported
+    forward_error: float = math.nan
+    #: the check's backward error where it reports one (verify.certify's backward_error, a
+    #: measure that z's size cannot inflate); nan: none (the scaled residual stands for it)
+    backward_error: float = math.nan
 
 
 def problem_kind(problem) -> str:
@@ -144,13 +152,15 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         return Result(**base, outcome=kind, success=False, status=kind, time=t,
                       iterations=None, residual=math.nan, scaled_residual=math.nan)
     status, t, z = raw["status"], float(raw["time"]), raw["z"]
-    res = scaled = math.nan
+    res = scaled = forward = backward = math.nan
     if z.shape == (problem.n,) and np.all(np.isfinite(z)):
         answer = Solution(z=z, w=np.zeros(0), status=status, method=method, u=raw.get("u"))
         with np.errstate(all="ignore"):
             cert = certify(problem, answer, tol=tol, uniqueness="none")
         res, scaled = cert.residual, cert.scaled_residual
         accepted = cert.accepted
+        forward = _forward_error(raw, cert)
+        backward = float(getattr(cert, "backward_error", math.nan))
     else:
         accepted = False
     if t > time_limit:
@@ -164,7 +174,38 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         outcome = status
     return Result(**base, outcome=outcome, success=outcome in ("solved", "infeasible"),
                   status=status, time=min(t, time_limit) if outcome != "timeout" else time_limit,
-                  iterations=raw.get("iterations"), residual=res, scaled_residual=scaled)
+                  iterations=raw.get("iterations"), residual=res, scaled_residual=scaled,
+                  forward_error=forward if outcome == "solved" else math.nan,
+                  backward_error=backward)
+
+
+def _forward_error(raw: dict, cert) -> float:
+    """The forward error bound of an answer: the method's (raw "forward_error", from
+    Solution.forward_error or Solution.info) or the certificate's (its forward_error),
+    whichever is larger; nan when neither reports one."""
+    values = [raw.get("forward_error"), getattr(cert, "forward_error", None)]
+    values = [float(v) for v in values if v is not None and not math.isnan(float(v))]
+    return max(values) if values else math.nan
+
+
+def check_methods(methods: Iterable[str], siconos: SiconosRunner | None) -> None:
+    """ValueError naming the first method that cannot run: unknown, a Siconos method without
+    Siconos, a peer whose package is not installed."""
+    known = {m.name for m in lcp.methods()}
+    for m in methods:
+        if m not in known and m not in SICONOS_METHODS and m not in PEERS:
+            raise ValueError(f"unknown method {m!r}; available: "
+                             f"{', '.join(sorted(known) + list(SICONOS_METHODS) + list(PEERS))}")
+        if m in SICONOS_METHODS and (siconos is None or not siconos.available):
+            raise ValueError(f"{m} needs Siconos: "
+                             f"{siconos.reason if siconos else 'no Siconos runner given'}")
+        if m in SICONOS_METHODS and not siconos.offers(m):
+            raise ValueError(f"{m} needs Siconos's {SICONOS_METHODS[m].kind} solvers, which "
+                             f"Siconos {siconos.version} at {siconos.python} does not have")
+        if m in PEERS:
+            ok, why = peer_available(m)
+            if not ok:
+                raise ValueError(f"{m} is not available: {why}")
 
 
 def available_methods(siconos: SiconosRunner | None) -> list[str]:
@@ -179,12 +220,16 @@ def run_bench(
     sets: dict[str, list[LCP | MLCP]], methods: Iterable[str], *, time_limit: float = 10.0,
     tol: float = 1e-8, isolate: bool = True, siconos: SiconosRunner | None = None,
     progress: Callable[[Result], None] | None = None, grace: float = GRACE,
-    batch: bool = True,
+    batch: bool = True, skip: Iterable[tuple[str, str, str]] = (),
+    warmups: dict | None = None,
 ) -> list[Result]:
     """Run every method on every problem of `sets` ({set name: problems}); one Result each.
 
-    methods: rigidlcp method names (lcp.methods()) and "siconos-*" names (need `siconos`,
-    an available SiconosRunner). An unknown name raises ValueError before anything runs.
+    methods: rigidlcp method names (lcp.methods()), "siconos-*" names (need `siconos`,
+    an available SiconosRunner) and peers (bench.peers.PEERS, need their package). A name
+    that cannot run raises ValueError before anything runs (check_methods).
+    skip: (set, problem, method) triples already done (a resumed run): not run again.
+    warmups: a dict filled with {method: [seconds of each untimed warm-up solve]}.
     time_limit: seconds per solve; grace: extra seconds allowed for passing data to and from
     the worker before it is killed (a solve measured above time_limit fails either way).
     batch: the LCPs of a set that share a size are given to a method with a compiled batch
@@ -193,29 +238,26 @@ def run_bench(
     solved one problem at a time instead.
     """
     methods = list(methods)
-    known = {m.name for m in lcp.methods()}
-    for m in methods:
-        if m not in known and m not in SICONOS_METHODS:
-            raise ValueError(f"unknown method {m!r}; available: "
-                             f"{', '.join(sorted(known) + list(SICONOS_METHODS))}")
-        if m in SICONOS_METHODS and (siconos is None or not siconos.available):
-            raise ValueError(f"{m} needs Siconos: "
-                             f"{siconos.reason if siconos else 'no Siconos runner given'}")
-        if m in SICONOS_METHODS and not siconos.offers(m):
-            raise ValueError(f"{m} needs Siconos's {SICONOS_METHODS[m].kind} solvers, which "
-                             f"Siconos {siconos.version} at {siconos.python} does not have")
+    check_methods(methods, siconos)
+    done = set(skip or ())
     local = LocalRunner(isolate, grace)
     results: list[Result] = []
     try:
         for set_name, problems in sets.items():
-            batched = _batched_answers(local, problems, methods, time_limit) if batch else {}
-            for problem in problems:
+            todo = [p for p in problems if isinstance(p, Unreadable) or any(
+                (set_name, p.name, m) not in done for m in methods)]
+            batched = _batched_answers(local, todo, methods, time_limit) if batch else {}
+            for problem in todo:
                 if isinstance(problem, Unreadable):
+                    if (set_name, problem.name, "-") in done:
+                        continue
                     results.append(judge(problem, "-", set_name, {}, time_limit, tol))
                     if progress is not None:
                         progress(results[-1])
                     continue
                 for method in methods:
+                    if (set_name, problem.name, method) in done:
+                        continue
                     runner = siconos if method in SICONOS_METHODS else local
                     raw = batched.get((id(problem), method)) or runner.solve(
                         problem, method, time_limit)
@@ -225,6 +267,10 @@ def run_bench(
                         progress(r)
     finally:
         local.close()
+        if warmups is not None:
+            for runner in (local, siconos):
+                for m, ts in getattr(runner, "warmups", {}).items():
+                    warmups.setdefault(m, []).extend(ts)
     return results
 
 
@@ -249,6 +295,15 @@ def _batched_answers(local: LocalRunner, problems: list, methods: list[str],
     return out
 
 
+def _row(r: Result) -> dict:
+    row = asdict(r)
+    row["time"] = f"{r.time:.6g}"
+    for key in ("residual", "scaled_residual", "forward_error", "backward_error"):
+        row[key] = "" if math.isnan(row[key]) else f"{row[key]:.3e}"
+    row["iterations"] = "" if r.iterations is None else r.iterations
+    return row
+
+
 def write_csv(results: list[Result], path: str | os.PathLike) -> Path:
     """results.csv: one row per (problem, method), the columns of `Result`."""
     path = Path(path)
@@ -257,13 +312,21 @@ def write_csv(results: list[Result], path: str | os.PathLike) -> Path:
         writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
         writer.writeheader()
         for r in results:
-            row = asdict(r)
-            row["time"] = f"{r.time:.6g}"
-            for key in ("residual", "scaled_residual"):
-                row[key] = "" if math.isnan(row[key]) else f"{row[key]:.3e}"
-            row["iterations"] = "" if r.iterations is None else r.iterations
-            writer.writerow(row)
+            writer.writerow(_row(r))
     return path
+
+
+def append_csv(result: Result, path: str | os.PathLike) -> None:
+    """Add one row to results.csv as soon as it is judged (a header first for a new file),
+    so that an interrupted run can be resumed (`rigidlcp bench --resume`)."""
+    path = Path(path)
+    new = not path.exists() or path.stat().st_size == 0
+    with open(path, "a", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=CSV_FIELDS)
+        if new:
+            writer.writeheader()
+        writer.writerow(_row(result))
+        fh.flush()
 
 
 def read_csv(path: str | os.PathLike) -> list[Result]:
@@ -279,5 +342,9 @@ def read_csv(path: str | os.PathLike) -> list[Result]:
                 residual=float(row["residual"]) if row["residual"] else math.nan,
                 scaled_residual=(float(row["scaled_residual"]) if row["scaled_residual"]
                                  else math.nan),
-                expected=row["expected"], message=row["message"], kind=row.get("kind", "")))
+                expected=row["expected"], message=row["message"], kind=row.get("kind", ""),
+                forward_error=(float(row["forward_error"]) if row.get("forward_error")
+                               else math.nan),
+                backward_error=(float(row["backward_error"]) if row.get("backward_error")
+                                else math.nan)))
     return out

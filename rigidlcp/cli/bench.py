@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import datetime
 import os
-import platform
 import shlex
 import sys
 
@@ -57,6 +56,15 @@ def register(sub) -> None:
                    "as the batch's mean)")
     p.add_argument("--force", action="store_true",
                    help="write into an --out directory that is not empty")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the run in --out: the (problem, method) pairs already in "
+                   "its results.csv are kept, not run again")
+    p.add_argument("--problems", default=None, metavar="NAME[,NAME]",
+                   help="only these problems of the sets (names as in results.csv), e.g. "
+                   "to rerun one failure")
+    p.add_argument("--no-peers", action="store_true",
+                   help="do not add the installed peers (quantecon-lemke, drake-moby, "
+                   "drake-unrevised-lemke, lemkelcp) to the default methods")
     p.add_argument("--list", action="store_true", help="list the sets and methods and exit")
     p.add_argument("--quiet", action="store_true", help="no progress lines")
     p.set_defaults(func=cmd_bench)
@@ -64,9 +72,9 @@ def register(sub) -> None:
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from rigidlcp import lcp
-    from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, run_bench, write_csv
-    from rigidlcp.bench.problem_sets import SETS, Unreadable, get_set, list_sets
-    from rigidlcp.bench.report import write_report
+    from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, check_methods, read_csv
+    from rigidlcp.bench.peers import PEERS, peer_available
+    from rigidlcp.bench.problem_sets import SETS, get_set, list_sets
 
     siconos = None if args.no_siconos else SiconosRunner()
     try:
@@ -79,6 +87,10 @@ def cmd_bench(args: argparse.Namespace) -> int:
             print("methods:")
             for m in lcp.methods():
                 print(f"  {m.name}")
+            for m, peer in PEERS.items():
+                ok, why = peer_available(m)
+                print(f"  {m:<24} LCPs: {peer.description} "
+                      f"({'available, ' + why if ok else 'unavailable: ' + why})")
             for m, spec in SICONOS_METHODS.items():
                 if siconos is None or not siconos.available:
                     state = f"unavailable: {siconos.reason if siconos else '--no-siconos'}"
@@ -109,16 +121,18 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if unknown:
             raise ValueError(f"unknown set(s) {', '.join(unknown)}: neither a set name "
                              f"({', '.join(SETS)}) nor a folder")
-        from rigidlcp.lcp.io.files import output_dir
-
-        output_dir(args.out, force=args.force)  # new or empty, unless --force
         notes: list[str] = []
         siconos_ok = siconos is not None and siconos.available
-        if args.methods:
-            methods = [m.strip() for m in args.methods.split(",") if m.strip()]
-        else:
+        methods = [m.strip() for m in (args.methods or "").split(",") if m.strip()]
+        wanted = [m for m in PEERS if not args.methods and not args.no_peers or m in methods]
+        peers_ok = {m: peer_available(m) for m in wanted}  # imports only the peers asked for
+        if not args.methods:
             methods = DEFAULT_METHODS.split(",") + [m for m in SICONOS_METHODS
                                                     if siconos_ok and siconos.offers(m)]
+            if not args.no_peers:
+                methods += [m for m in PEERS if peers_ok[m][0]]
+                notes += [f"peer {m} not run: {why}" for m, (ok, why) in peers_ok.items()
+                          if not ok]
         absent = [m for m in methods if m in SICONOS_METHODS
                   and not (siconos_ok and siconos.offers(m))]
         if absent:
@@ -129,65 +143,134 @@ def cmd_bench(args: argparse.Namespace) -> int:
         elif not siconos_ok and not args.methods:
             why = siconos.reason if siconos is not None else "--no-siconos"
             notes.append(f"Siconos methods not run: {why}")
+        missing_peers = [m for m in methods if m in PEERS and not peers_ok[m][0]]
+        notes += [f"skipped {m}: {peers_ok[m][1]}" for m in missing_peers]
+        methods = [m for m in methods if m not in missing_peers]
+        check_methods(methods, siconos)  # an unknown method: refused before anything is made
         if siconos_ok and any(m in SICONOS_METHODS for m in methods):
             notes.append(f"Siconos: python3-siconos {siconos.version} in a {siconos.python} "
-                         "subprocess; only its driver call is timed; siconos-lemke is given "
+                         "subprocess; timed as the whole call from Python (options, problem "
+                         "object, driver); siconos-lemke is given "
                          "max_iter = 1000 + 100 n (as rigidlcp's lemke), siconos-pgs tol "
                          "1e-10 and 10000 sweeps (as rigidlcp's pgs), siconos-fc2d-nsgs tol "
                          "1e-12 and 10000 sweeps (as rigidlcp's nsgs); the enumerations are "
                          "given n <= 20 (LCP), m <= 16 (MLCP), c <= 5 contacts (fc2d); the "
                          "MLCP and fc2d solvers have Siconos's other defaults; a nonzero "
                          "Siconos info is a failure (it proves nothing)")
-        sets, set_info = {}, {}
+        if any(m in PEERS for m in methods):
+            notes.append("peers (rigidlcp.bench.peers) run in the same worker as rigidlcp's "
+                         "methods, timed as the whole call from Python on M and q; "
+                         "their 'solved' is a claim, judged by the same check")
+        sets, set_info, specs_by_name = {}, {}, {}
+        only = {p.strip() for p in (args.problems or "").split(",") if p.strip()}
         for spec in specs:
             kw = params if spec in SETS and not spec.startswith("events-") else {}
             problems = get_set(spec, seed=args.seed, cache_dir=args.cache, **kw)
+            if only:
+                problems = [p for p in problems if p.name in only]
             name = spec if spec in SETS else os.path.basename(os.path.normpath(spec))
-            sets[name] = problems
+            sets[name], specs_by_name[name] = problems, spec
             info = SETS.get(spec)
             set_info[name] = (f"{info.problem_class}; expected answer: {info.expected}."
                               if info else f"folder {spec}.")
-        load0 = os.getloadavg()[0]
-        started = datetime.datetime.now().isoformat(timespec="seconds")
-        total = sum(1 if isinstance(p, Unreadable) else len(methods)
-                    for problems in sets.values() for p in problems)
-        done = [0]
-
-        def progress(r) -> None:
-            done[0] += 1
-            if not args.quiet:
-                print(f"[{done[0]}/{total}] {r.problem:<40} {r.method:<14} {r.outcome:<14} "
-                      f"{1e3 * r.time:10.2f} ms", flush=True)
-
-        results = run_bench(sets, methods, time_limit=args.time_limit, tol=args.tol,
-                            isolate=not args.no_isolation, siconos=siconos, progress=progress,
-                            batch=not args.no_batch)
-        import numpy as np
-
-        header = [
-            f"Command: `rigidlcp bench {' '.join(shlex.quote(a) for a in sys.argv[2:])}`"
-            if sys.argv[1:2] == ["bench"] else "Command: `rigidlcp bench` (called from Python)",
-            "",
-            f"Started {started}; Python {platform.python_version()}, numpy {np.__version__}, "
-            f"{os.cpu_count()} CPUs; load average {load0:.2f} at the start, "
-            f"{os.getloadavg()[0]:.2f} at the end. One solve at a time, one BLAS thread; the "
-            "machine may be shared with other jobs, so times are indicative.",
-            "",
-            f"Sets: {', '.join(sets)}; methods: {', '.join(methods)}; time limit "
-            f"{args.time_limit:g} s per solve; seed {args.seed}.",
-        ]
-        if any(r.message.startswith("batch of ") for r in results):
-            header += ["", "Batch: the LCPs of a set that share a size were solved by lemke in "
-                       "one `lcp.solve_many` call each (results.csv: message 'batch of k'); "
-                       "such a row's time is the call's time / k. `--no-batch`: one call per "
-                       "problem."]
-        csv_path = write_csv(results, os.path.join(args.out, "results.csv"))
-        report = write_report(results, args.out, time_limit=args.time_limit, tol=args.tol,
-                              set_info=set_info, header=header, notes=notes)
-        print(f"wrote {csv_path} and {report}")
-        for line in notes:
-            print(f"note: {line}")
-        return 0
+        if only:
+            found = {p.name for ps in sets.values() for p in ps}
+            if only - found:
+                raise ValueError(f"--problems: no problem named "
+                                 f"{', '.join(sorted(only - found))} in the sets")
+        csv_path = os.path.join(args.out, "results.csv")
+        done: list = []
+        if args.resume:
+            if not os.path.isfile(csv_path):
+                raise ValueError(f"--resume: {csv_path} does not exist")
+            done = read_csv(csv_path)
+        return _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done,
+                    {m: peers_ok[m][1] for m in methods if m in PEERS})
     finally:
         if siconos is not None:
             siconos.close()
+
+
+def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, peer_versions
+         ) -> int:
+    """Run the bench into args.out (created only now, removed again if the run fails before
+    writing anything), writing results.csv row by row, then report.md and the profiles."""
+    from pathlib import Path
+
+    from rigidlcp.bench.environment import environment
+    from rigidlcp.bench.harness import append_csv, run_bench, write_csv
+    from rigidlcp.bench.problem_sets import SETS, Unreadable
+    from rigidlcp.bench.report_md import write_report
+    from rigidlcp.lcp.io.files import output_dir
+
+    out = Path(args.out)
+    created = not out.exists()
+    output_dir(out, force=args.force or args.resume)  # new or empty, unless --force/--resume
+    csv_path = out / "results.csv"
+    try:
+        if not args.resume and csv_path.exists():
+            csv_path.unlink()  # --force: a fresh results.csv
+        load0 = os.getloadavg()[0]
+        started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+        total = sum(1 if isinstance(p, Unreadable) else len(methods)
+                    for problems in sets.values() for p in problems)
+        count = [len(done)]
+
+        def progress(r) -> None:
+            append_csv(r, csv_path)
+            count[0] += 1
+            if not args.quiet:
+                print(f"[{count[0]}/{total}] {r.problem:<40} {r.method:<14} {r.outcome:<14} "
+                      f"{1e3 * r.time:10.2f} ms", flush=True)
+
+        warmups: dict = {}
+        skip = {(r.set, r.problem, r.method) for r in done}
+        results = done + run_bench(
+            sets, methods, time_limit=args.time_limit, tol=args.tol,
+            isolate=not args.no_isolation, siconos=siconos, progress=progress,
+            batch=not args.no_batch, skip=skip, warmups=warmups)
+    except BaseException:
+        if created and out.is_dir() and not any(out.iterdir()):
+            out.rmdir()  # a refused or interrupted run leaves nothing behind
+        raise
+    command = (f"rigidlcp bench {' '.join(shlex.quote(a) for a in sys.argv[2:])}"
+               if sys.argv[1:2] == ["bench"] else "rigidlcp bench (called from Python)")
+    header = [f"Command: `{command}`", "",
+              f"Sets: {', '.join(sets)}; methods: {', '.join(methods)}; time limit "
+              f"{args.time_limit:g} s per solve; seed {args.seed}."]
+    if any(r.message.startswith("batch of ") for r in results):
+        header += ["", "Batch: the LCPs of a set that share a size were solved by lemke in "
+                   "one `lcp.solve_many` call each (results.csv: message 'batch of k'); "
+                   "such a row's time is the call's time / k. `--no-batch`: one call per "
+                   "problem."]
+    if args.resume and done:
+        header += ["", f"Resumed: {len(done)} rows kept from the earlier run."]
+    generated = []
+    if args.sizes:
+        generated += ["--sizes", args.sizes]
+    if args.per_size is not None:
+        generated += ["--per-size", str(args.per_size)]
+
+    def rerun(r) -> str:
+        spec = specs_by_name.get(r.set, r.set)
+        extra = generated if spec in SETS and not spec.startswith("events-") else []
+        if spec.startswith("events-") and args.cache:
+            extra = ["--cache", args.cache]
+        parts = ["rigidlcp", "bench", "--set", spec, "--problems", r.problem, "--methods",
+                 r.method, "--seed", str(args.seed), *extra, "--time-limit",
+                 f"{args.time_limit:g}", "--out", "rerun-" + _slug(f"{r.problem}-{r.method}")]
+        return " ".join(shlex.quote(p) for p in parts)
+
+    env = environment(peer_versions, started, (load0, os.getloadavg()[0]))
+    write_csv(results, csv_path)
+    report = write_report(results, out, time_limit=args.time_limit, tol=args.tol,
+                          set_info=set_info, header=header, notes=notes, environment=env,
+                          rerun=rerun, warmups=warmups)
+    print(f"wrote {csv_path} and {report}")
+    for line in notes:
+        print(f"note: {line}")
+    return 0
+
+
+def _slug(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name)

@@ -283,6 +283,7 @@ def test_the_kind_survives_the_csv(tmp_path):
     assert [r.kind for r in back] == ["MLCP", "FC2D"]
     # a results.csv of an older run, without the column, still reads (kind unknown)
     text = (tmp_path / "r.csv").read_text().splitlines()
-    old = [",".join(line.split(",")[:-1]) for line in text]
+    at = text[0].split(",").index("kind")
+    old = [",".join(c for k, c in enumerate(line.split(",")) if k != at) for line in text]
     (tmp_path / "old.csv").write_text("\n".join(old) + "\n")
     assert [r.kind for r in read_csv(tmp_path / "old.csv")] == ["", ""]
