@@ -25,6 +25,7 @@ COMMAND_MODULES = (
     "rigidlcp.cli.nullspace",  # nullspace, verify-formulas
     "rigidlcp.cli.forces",  # forces
     "rigidlcp.cli.pack",  # pack (deposition)
+    "rigidlcp.cli.forceset",  # forceset (statics of a packing)
     "rigidlcp.cli.certify_run",  # certify-run
     "rigidlcp.cli.bench",  # bench
     "rigidlcp.cli.fuzz",  # fuzz
