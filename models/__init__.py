@@ -20,14 +20,14 @@ _WHERE = {
     "InvalidSystem": "lattice", "Lattice": "lattice", "make_lattice": "lattice",
     "rectangular": "lattice", "triangular": "lattice",
     "System": "system", "make_system": "system",
-    "packing": "packing", "Overlap": "packing",
+    "make_packing": "packing", "Overlap": "packing",
 }
 
 __all__ = [
     "Dynamics", "EventProblem", "EventSolution", "State", "contact_matrix", "event_problem",
     "initial_state", "Run", "simulate", "Lattice", "InvalidSystem", "rectangular",
     "triangular", "make_lattice", "System", "make_system", "LEFT_WALL", "RIGHT_WALL", "PLANE",
-    "packing", "Overlap",
+    "make_packing", "Overlap",
 ]
 
 

@@ -189,3 +189,7 @@ def report(lattice: Lattice) -> PackingReport:
     clusters = [np.flatnonzero(labels == k).tolist() for k in order]
     floating = [n for n, k in enumerate(order) if not grounded[k]]
     return PackingReport(np.flatnonzero(degree < 2).tolist(), clusters, floating)
+
+
+#: The name under which `rigidlcp.models` exports `packing` (the submodule owns the bare name).
+make_packing = packing
