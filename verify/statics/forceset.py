@@ -12,9 +12,12 @@
   on all of P (an implicit equality: R = 0, S = mu R or S = -mu R on the whole set) is found
   by linear programs maximizing slacks t_k in [0, scale] of the undecided rows (a row whose
   slack can be made positive is not implicit; when no undecided row can, all are: at most one
-  LP per row, a few in practice). Then dim P = (number of unknowns left once the implicit
-  equalities are substituted) - rank of the balance equations on them, by SVD with the standard
-  tolerance max(shape) eps sigma_max (the singular values on either side are reported).
+  LP per row, a few in practice). An interior point of P (HiGHS's IPM without crossover,
+  checked to lie in P) decides most rows first: a clearly positive slack there is a witness.
+  Then dim P = (number of unknowns left once the implicit equalities are substituted) - rank
+  of the balance equations on them: full row rank is settled by the extreme eigenvalues of
+  B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
+  standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
   every optimum checked to lie in P.
 * sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (an LP with
@@ -34,7 +37,7 @@ from scipy.optimize import linprog
 
 from rigidlcp import models
 
-from .model import LP_TOL, ForceLP, StaticProblem
+from .model import LP_TOL, ForceLP, StaticProblem, interior_point
 
 #: A Farkas certificate must exclude every equilibrium with sum R below this many weights.
 RADIUS_WEIGHTS = 1e9
@@ -102,6 +105,13 @@ class ForceSet:
         def end(v: float):
             return None if not np.isfinite(v) else float(v) + 0.0  # no "-0.0"
 
+        if self.lo is None:  # existence and dimension only
+            out["contacts"] = [{"i": int(i), "j": int(j), "implicit": self.implicit[a] or None}
+                               for a, (i, j) in enumerate(zip(lat.i, lat.j))]
+            out.update(unique=self.dimension == 0, rank_gap=list(self.rank_gap),
+                       solution_residuals=list(self.residuals))
+            return out
+
         out["contacts"] = [
             {"i": int(lat.i[a]), "j": int(lat.j[a]),
              "R": [end(self.lo[a]), end(self.hi[a])],
@@ -121,19 +131,24 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
     progress(done, total, stage): called as the LPs of the ranges are solved."""
     prob = StaticProblem(system)
-    lp = ForceLP(prob)
-    status, lam = lp.solve(np.zeros(prob.n))
-    if status != "optimal" or not prob.admissible(lam):
-        y, radius = farkas(prob)
-        if y is None:
-            raise RuntimeError(f"equilibrium LP {status} and no Farkas certificate found "
-                               "(please report)")
-        return ForceSet(system, False, certificate=y, radius=radius, lps=2)
+    weight = float(np.sum(system.masses)) * system.g
+    lam = interior_point(prob, 1e3 * weight)  # fast, and a relative-interior witness
+    interior = lam is not None and prob.admissible(lam)
+    lp = None
+    if not interior:
+        lp = ForceLP(prob)
+        status, lam = lp.solve(np.zeros(prob.n))
+        if status != "optimal" or not prob.admissible(lam):
+            y, radius = farkas(prob)
+            if y is None:
+                raise RuntimeError(f"equilibrium LP {status} and no Farkas certificate found "
+                                   "(please report)")
+            return ForceSet(system, False, certificate=y, radius=radius, lps=3)
     fs = ForceSet(system, True, solution=lam, lps=1, residuals=prob.residuals(lam))
-    fs.implicit = implicit_equalities(prob)
+    fs.implicit = implicit_equalities(prob, lam if interior else None)
     fs.dimension, fs.rank_gap = dimension(prob, fs.implicit)
     if ranges:
-        _ranges(prob, lp, fs, progress)
+        _ranges(prob, lp or ForceLP(prob), fs, progress)
     return fs
 
 
@@ -158,15 +173,24 @@ def farkas(prob: StaticProblem) -> tuple[np.ndarray | None, float | None]:
     return (y, radius) if gap > 0 and radius >= RADIUS_WEIGHTS * weight else (None, None)
 
 
-def implicit_equalities(prob: StaticProblem) -> list[str]:
-    """Per contact: "R=0", "S=+muR", "S=-muR" or "" (module docstring)."""
+def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> list[str]:
+    """Per contact: "R=0", "S=+muR", "S=-muR" or "" (module docstring). x: a point of P
+    near its relative interior, if one is known (else one is computed)."""
     c, k = prob.c, prob.fric.size
     # inequality rows: -R <= 0 (c), then S - mu R <= 0 and -S - mu R <= 0 (k each)
     Gi = sp.vstack([-sp.eye(c, prob.n), prob.G], format="csr")
     m = Gi.shape[0]
-    undecided = np.ones(m, dtype=bool)
-    strict = np.zeros(m, dtype=bool)
     T = prob.scale
+    undecided = np.ones(m, dtype=bool)
+    # One interior point settles most rows at once: a row with a clear positive slack at a
+    # point of P is not an implicit equality; the slack LPs then decide only the rest.
+    if x is None:
+        x = interior_point(prob, 1e3 * float(np.sum(prob.system.masses)) * prob.system.g)
+    if x is not None:
+        weight = float(np.sum(prob.system.masses)) * prob.system.g
+        eq, viol = prob.residuals(x)
+        if eq <= 1e-9 * weight and viol <= 1e-9 * weight:
+            undecided &= ~(-(Gi @ x) > 1e-6 * T)
     while undecided.any():
         cost = np.r_[np.zeros(prob.n), -undecided.astype(float)]
         A_ub = sp.hstack([Gi, sp.eye(m)], format="csr")
@@ -179,11 +203,10 @@ def implicit_equalities(prob: StaticProblem) -> list[str]:
                       options={"primal_feasibility_tolerance": LP_TOL})
         if res.status != 0:
             raise RuntimeError(f"slack LP failed: {res.message}")
-        t = res.x[prob.n:]
+        t = np.maximum(res.x[prob.n:], -(Gi @ res.x[:prob.n]))  # the rows' actual slacks
         new = undecided & (t > ZERO * T)
         if not new.any():
             break
-        strict |= new
         undecided &= ~new
     out = [""] * c
     for a in range(c):
@@ -221,10 +244,15 @@ def reduced_balance(prob: StaticProblem, implicit: list[str]) -> sp.csc_matrix:
 
 def dimension(prob: StaticProblem, implicit: list[str]
               ) -> tuple[int | None, tuple[float | None, float | None]]:
-    """(dim P, (smallest singular value kept, largest dropped)); None above the dense limit."""
+    """(dim P, (smallest singular value kept, largest dropped)); None when the rank is not
+    settled (rank deficient above the dense limit)."""
     B = reduced_balance(prob, implicit)
-    if B.shape[1] == 0:
-        return 0, (None, None)
+    B = B[np.flatnonzero(np.diff(B.tocsr().indptr))]  # rows that are exactly zero: rank 0
+    if B.shape[1] == 0 or B.shape[0] == 0:
+        return B.shape[1], (None, None)
+    full = _full_row_rank(B)
+    if full is not None:
+        return B.shape[1] - B.shape[0], (full, None)
     if B.shape[1] > DENSE_RANK_LIMIT:
         return None, (None, None)
     w = np.linalg.svd(B.toarray(), compute_uv=False)
@@ -233,6 +261,36 @@ def dimension(prob: StaticProblem, implicit: list[str]
     kept = float(w[rank - 1]) if rank else None
     dropped = float(w[rank]) if rank < w.size else None
     return B.shape[1] - rank, (kept, dropped)
+
+
+def _full_row_rank(B: sp.csr_matrix) -> float | None:
+    """sigma_min(B) when B (rows <= columns) has full row rank beyond doubt, else None.
+
+    The extreme eigenvalues of B B^T (sparse: shift-invert at 0 for the smallest) give
+    sigma_min and sigma_max; rank = rows by the SVD's own rule (sigma_min > max(shape) eps
+    sigma_max) is accepted only with a wide margin, sigma_min > 1e-6 sigma_max, since the
+    eigenvalues of B B^T carry an absolute error ~ eps sigma_max^2 (else the dense SVD, or
+    None, decides)."""
+    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, eigsh
+
+    rows, cols = B.shape
+    if rows > cols:
+        return None
+    C = (B @ B.T).tocsc()
+    if rows < 3:
+        ev = np.linalg.eigvalsh(C.toarray())
+        lo, hi = float(ev[0]), float(ev[-1])
+    else:
+        try:
+            hi = float(eigsh(C, k=1, which="LA", return_eigenvectors=False, tol=1e-6)[0])
+            lo = float(eigsh(C, k=1, sigma=0.0, which="LM", return_eigenvectors=False,
+                             tol=1e-6)[0])
+        except (ArpackError, ArpackNoConvergence, RuntimeError, ValueError):
+            return None  # e.g. C exactly singular: the factorization at sigma = 0 fails
+    if hi <= 0 or lo <= 0:
+        return None
+    smin, smax = np.sqrt(lo), np.sqrt(hi)
+    return float(smin) if smin > 1e-6 * smax else None
 
 
 def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:

@@ -128,3 +128,34 @@ class ForceLP:
         """Make cone row `row` (0..2k-1) an equality (S = +-mu R) or restore it (<= 0)."""
         inf = self.hs.kHighsInf
         self.h.changeRowBounds(self.m_eq + row, 0.0 if equality else -inf, 0.0)
+
+
+def interior_point(prob: StaticProblem, bound: float) -> np.ndarray | None:
+    """A point of P inside the box |lambda| <= bound from HiGHS's interior-point method without
+    crossover (zero objective: near the analytic centre), so that every inequality of P that
+    is not an implicit equality has a clearly positive slack there; None if the IPM fails."""
+    import highspy
+
+    inf = highspy.kHighsInf
+    K = sp.vstack([prob.A, prob.G], format="csc")
+    m_eq, m_ub = prob.A.shape[0], prob.G.shape[0]
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = prob.n, m_eq + m_ub
+    lp.col_cost_ = np.zeros(prob.n)
+    lp.col_lower_ = np.maximum(prob.lb, -bound)
+    lp.col_upper_ = np.minimum(prob.ub, bound)
+    lp.row_lower_ = np.r_[prob.b, np.full(m_ub, -inf)]
+    lp.row_upper_ = np.r_[prob.b, np.zeros(m_ub)]
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+        K.indptr, K.indices, K.data)
+    with quiet_highs():
+        h = highspy.Highs()
+    for key, value in (("output_flag", False), ("solver", "ipm"), ("run_crossover", "off"),
+                       ("presolve", "off")):
+        h.setOptionValue(key, value)
+    h.passModel(lp)
+    h.run()
+    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
+        return None
+    return np.asarray(h.getSolution().col_value, dtype=float)
