@@ -1,4 +1,4 @@
-"""Mechanics: lattices of rigid disks, contacts, the MLCP of an event, event-driven evolution.
+"""Mechanics: lattices and packings of rigid disks, contacts, the MLCP of an event, evolution.
 
 Dependencies point lcp <- models <- verify: this package imports `lcp`, never `verify`.
 The names below load on first use (PEP 562), so that a command loads only the modules it uses
@@ -20,12 +20,14 @@ _WHERE = {
     "InvalidSystem": "lattice", "Lattice": "lattice", "make_lattice": "lattice",
     "rectangular": "lattice", "triangular": "lattice",
     "System": "system", "make_system": "system",
+    "make_packing": "packing", "Overlap": "packing",
 }
 
 __all__ = [
     "Dynamics", "EventProblem", "EventSolution", "State", "contact_matrix", "event_problem",
     "initial_state", "Run", "simulate", "Lattice", "InvalidSystem", "rectangular",
     "triangular", "make_lattice", "System", "make_system", "LEFT_WALL", "RIGHT_WALL", "PLANE",
+    "make_packing", "Overlap",
 ]
 
 

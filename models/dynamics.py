@@ -3,12 +3,12 @@
 Generalized velocities nu = [vx (p), vy (p), omega (p)]; contact forces lambda = [R (c), S (c)].
 The relative velocity of body j with respect to body i at contact alpha (docs/mechanics.md) is
 
-    u_alpha = (v_j - v_i - r (omega_i + omega_j) t) . (n, t)  =  (H nu + u_obs)_alpha,
+    u_alpha = (v_j - v_i - (r_i omega_i + r_j omega_j) t) . (n, t)  =  (H nu + u_obs)_alpha,
 
 where u_obs is the prescribed velocity of an obstacle j (the plane moves with -V(t) x in the box
 frame). The contact force on j is R n + S t (on i the opposite), so the generalized contact force
-is H^T lambda (its power is lambda . H nu), and the torque on both disks is -r S.
-Newton-Euler in the box frame, M nu' = H^T lambda + f with f = (-m gamma, -m g, 0) per disk,
+is H^T lambda (its power is lambda . H nu), and the torque on disk i is -r_i S (on j: -r_j S).
+Newton-Euler in the box frame, M nu' = H^T lambda + f with f = (-m_i gamma, -m_i g, 0) per disk,
 gives the relative accelerations of Eqs. (2.13)-(2.14):
 
     a = W lambda + q,    W = H M^-1 H^T,    q = H M^-1 f + u_obs'.
@@ -33,7 +33,7 @@ class Dynamics:
     def __init__(self, system: System):
         self.system = system
         lat = system.lattice
-        p, c, r = lat.p, lat.c, lat.radius
+        p, c, r = lat.p, lat.c, lat.radii
         rows, cols, vals = [], [], []
         disk_j = lat.j >= 0
         for comp, vec in ((0, lat.n), (1, lat.t)):
@@ -43,19 +43,17 @@ class Dynamics:
                 rows += [base + a, base + a[disk_j]]
                 cols += [axis * p + lat.i, axis * p + lat.j[disk_j]]
                 vals += [-vec[:, axis], vec[disk_j, axis]]
-        a = np.arange(c)  # rotations enter the tangential rows only: -r (omega_i + omega_j)
+        a = np.arange(c)  # rotations enter the tangential rows only: -r_i omega_i - r_j omega_j
         rows += [c + a, c + a[disk_j]]
         cols += [2 * p + lat.i, 2 * p + lat.j[disk_j]]
-        vals += [np.full(c, -r), np.full(int(disk_j.sum()), -r)]
+        vals += [-r[lat.i], -r[lat.j[disk_j]]]
         self.H = sp.csr_matrix(
             (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
             shape=(2 * c, 3 * p),
         )
-        m, inertia = system.mass, system.inertia
-        self.Minv = np.concatenate([np.full(2 * p, 1.0 / m), np.full(p, 1.0 / inertia)])
-        self.f = np.concatenate(
-            [np.full(p, -m * system.gamma), np.full(p, -m * system.g), np.zeros(p)]
-        )
+        m, inertia = system.masses, system.inertias  # per disk
+        self.Minv = np.concatenate([1.0 / m, 1.0 / m, 1.0 / inertia])
+        self.f = np.concatenate([-m * system.gamma, -m * system.g, np.zeros(p)])
         self.plane = lat.j == PLANE
         # u_obs = [n . v_obs ; t . v_obs] with v_obs = (-V, 0) on the plane: unit-V coefficients.
         v_plane = np.zeros((c, 2))

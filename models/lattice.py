@@ -1,7 +1,10 @@
-"""Regular arrays of equal rigid disks in a box: two vertical walls and a basal plane.
+"""Disks in a box (two vertical walls and a basal plane) and the regular arrays of equal disks.
 
-Geometry of the paper (Sec. II A, Fig. 1). Units: radius r (default 1). The box spans
-0 <= x <= 2 r Lx; the plane is y = 0.
+A `Lattice` is the geometry every model reads: centres, one radius per disk (and optionally one
+mass and one moment of inertia per disk), the walls x = left, x = right and every contact.
+The regular arrays of the paper (Sec. II A, Fig. 1) are two generators of it; any other set of
+disks is built by models.packing (contacts detected with a stated gap tolerance).
+Units of the arrays: radius r (default 1). The box spans 0 <= x <= 2 r Lx; the plane is y = 0.
 
 * rectangular(Lx, Ly): Ly rows of Lx disks, each row touching both walls; columns stacked.
 * triangular(Lx, Ly): rows alternate between Lx disks (touching both walls) and Lx - 1 disks
@@ -36,9 +39,13 @@ class InvalidSystem(InvalidInput):
 class Lattice:
     """Positions of the disks and every contact (all contacts are closed: interstice zero).
 
-    Arrays: x (p, 2) centres; row, col (p,) indices; for each contact alpha: i[alpha] (disk),
-    j[alpha] (disk index or LEFT_WALL / RIGHT_WALL / PLANE), n[alpha], t[alpha] unit vectors,
-    kind[alpha] in KINDS.
+    Arrays: x (p, 2) centres; row, col (p,) indices (-1 for a packing); for each contact alpha:
+    i[alpha] (disk), j[alpha] (disk index or LEFT_WALL / RIGHT_WALL / PLANE), n[alpha], t[alpha]
+    unit vectors, kind[alpha] in KINDS.
+    Per disk: radii (p,) (default: every disk has `radius`); masses, inertias (p,) or None (then
+    models.System gives them: one mass m, I = m r_i^2 / 2). `radius` is the radius of an array,
+    the mean radius of a packing (a length scale). left, right: the walls' abscissae (None: no
+    such wall; the arrays' are 0 and 2 r Lx). name: "rect", "tri" or "packing".
     """
 
     name: str
@@ -53,6 +60,23 @@ class Lattice:
     n: np.ndarray
     t: np.ndarray
     kind: np.ndarray
+    radii: np.ndarray | None = None
+    masses: np.ndarray | None = None
+    inertias: np.ndarray | None = None
+    left: float | None = 0.0
+    right: float | None = None
+    gap_tol: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.radii is None:
+            object.__setattr__(self, "radii", np.full(self.x.shape[0], float(self.radius)))
+        if self.right is None and self.name in ("rect", "tri"):
+            object.__setattr__(self, "right", 2.0 * self.radius * self.lx)
+
+    @property
+    def regular(self) -> bool:
+        """True for the paper's arrays (rect, tri), False for a general packing."""
+        return self.name in ("rect", "tri")
 
     @property
     def p(self) -> int:
@@ -66,7 +90,12 @@ class Lattice:
 
     @property
     def width(self) -> float:
-        return 2.0 * self.radius * self.lx
+        """The box's width: 2 r Lx for the arrays, right - left (or the disks' extent)."""
+        if self.regular:
+            return 2.0 * self.radius * self.lx
+        lo = self.left if self.left is not None else float(np.min(self.x[:, 0] - self.radii))
+        hi = self.right if self.right is not None else float(np.max(self.x[:, 0] + self.radii))
+        return hi - lo
 
     def label(self, alpha: int) -> str:
         """Human-readable name of contact alpha, e.g. 'disk 3 (row 0, col 3) - plane'."""
@@ -75,6 +104,8 @@ class Lattice:
         return f"#{alpha} {self.disk_label(i)} - {other}"
 
     def disk_label(self, k: int) -> str:
+        if not self.regular:
+            return f"disk {k}"
         return f"disk {k} (row {int(self.row[k])}, col {int(self.col[k])})"
 
     def contacts_of_kind(self, kind: str) -> np.ndarray:
@@ -83,7 +114,12 @@ class Lattice:
         return np.flatnonzero(self.kind == kind)
 
     def __repr__(self) -> str:
-        return f"<Lattice {self.name} {self.lx}x{self.ly}: {self.p} disks, {self.c} contacts>"
+        size = f" {self.lx}x{self.ly}" if self.regular else ""
+        return f"<Lattice {self.name}{size}: {self.p} disks, {self.c} contacts>"
+
+    def title(self) -> str:
+        """'rect 4x3' for an array, 'packing of 120 disks' for a packing (figure titles)."""
+        return f"{self.name} {self.lx}x{self.ly}" if self.regular else f"packing of {self.p} disks"
 
 
 def _check_size(name: str, value, minimum: int) -> int:

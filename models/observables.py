@@ -111,7 +111,9 @@ def regime(status: str) -> dict:
 
 
 def rotational_energy(system: System, omega: np.ndarray) -> float:
-    return 0.5 * system.inertia * float(np.dot(omega, omega))
+    if system.uniform:
+        return 0.5 * system.inertia * float(np.dot(omega, omega))
+    return 0.5 * float(np.dot(system.inertias * omega, omega))  # sum of I_i omega_i^2 / 2
 
 
 def obstacle_force_on_disks(system: System, R: np.ndarray, S: np.ndarray) -> np.ndarray:

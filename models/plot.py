@@ -40,7 +40,7 @@ def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: st
 
     lat = system.lattice
     r = lat.radius
-    patches = [Circle(tuple(x), r) for x in lat.x]
+    patches = [Circle(tuple(x), ri) for x, ri in zip(lat.x, lat.radii)]
     coll = PatchCollection(patches, edgecolor="k", linewidth=0.6)
     if values is not None:
         vmax = max(np.abs(values).max(initial=0.0), 1e-12)
@@ -53,11 +53,14 @@ def draw_lattice(ax, system: System, values: np.ndarray | None = None, label: st
     if values is not None:
         cb = ax.figure.colorbar(coll, ax=ax, shrink=0.8, pad=0.02)
         cb.ax.set_xlabel(label, fontsize="small")  # horizontal, below the bar
-    top = lat.x[:, 1].max() + r
-    ax.plot([0, 0], [0, top], "k-", lw=2)
-    ax.plot([lat.width, lat.width], [0, top], "k-", lw=2)
-    ax.plot([-0.3 * r, lat.width + 0.3 * r], [0, 0], "k-", lw=2)
-    ax.set_xlim(-0.5 * r, lat.width + 0.5 * r)
+    top = float(np.max(lat.x[:, 1] + lat.radii))
+    lo = lat.left if lat.left is not None else float(np.min(lat.x[:, 0] - lat.radii))
+    hi = lo + lat.width
+    for wall in (lat.left, lat.right):
+        if wall is not None:
+            ax.plot([wall, wall], [0, top], "k-", lw=2)
+    ax.plot([lo - 0.3 * r, hi + 0.3 * r], [0, 0], "k-", lw=2)
+    ax.set_xlim(lo - 0.5 * r, hi + 0.5 * r)
     ax.set_ylim(-0.5 * r, top + 0.5 * r)
     ax.set_aspect("equal")
     ax.axis("off")
@@ -67,7 +70,8 @@ def contact_points(system: System) -> tuple[np.ndarray, np.ndarray]:
     """Segment ends of every contact: disk centre to disk centre, or to the obstacle's surface."""
     lat = system.lattice
     a = lat.x[lat.i]
-    b = np.where((lat.j >= 0)[:, None], lat.x[np.maximum(lat.j, 0)], a + lat.radius * lat.n)
+    b = np.where((lat.j >= 0)[:, None], lat.x[np.maximum(lat.j, 0)],
+                 a + lat.radii[lat.i][:, None] * lat.n)
     return a, b
 
 

@@ -43,6 +43,8 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
     if run.final is not None:
         arrays.update(final_omega=run.final.omega, final_s=run.final.s,
                       final_tV=np.array([run.final.t, run.final.V]))
+    if not run.system.lattice.regular:  # a packing: its geometry, per-disk m and I
+        arrays.update(_geometry(run.system))
     meta = {
         "format": FORMAT, "system": run.system.describe(), "status": run.status,
         "message": run.message, "contacts": run.contacts, "method": run.method,
@@ -96,12 +98,16 @@ def _load_run(data_path: Path) -> Run:
             raise InvalidFile(f"{data_path} is not a rigidlcp run (format {fmt!r}, expected "
                               f"{FORMAT!r})")
         cols = {k: data[k] for k in _SCALARS + _ARRAYS}
+        geometry = {k: data[k] for k in _GEOMETRY if k in data.files}
         final = None
         if "final_omega" in data.files:
             t, V = data["final_tV"]
             final = State(float(t), data["final_omega"], float(V), data["final_s"].astype(int))
     params = dict(meta["system"])
-    system = make_system(params.pop("lattice"), params.pop("lx"), params.pop("ly"), **params)
+    if params["lattice"] == "packing":
+        system = _packing_system(params, geometry, data_path)
+    else:
+        system = make_system(params.pop("lattice"), params.pop("lx"), params.pop("ly"), **params)
     methods = meta.get("methods_per_event", [])
     names = {f.name for f in fields(EventRecord)}
     records = []
@@ -117,6 +123,34 @@ def _load_run(data_path: Path) -> Run:
     return Run(system, records, status=meta["status"], message=meta["message"],
                contacts=list(meta.get("contacts", [])), wall_time=float(meta["wall_time"]),
                method=meta["method"], final=final)
+
+
+_GEOMETRY = ("packing_x", "packing_r", "packing_m", "packing_I")
+
+
+def _geometry(system) -> dict[str, np.ndarray]:
+    lat = system.lattice
+    return {"packing_x": lat.x, "packing_r": lat.radii, "packing_m": system.masses,
+            "packing_I": system.inertias}
+
+
+def _packing_system(params: dict, geometry: dict, data_path: Path):
+    """The System of a packing run, rebuilt from the saved geometry (contacts re-detected with
+    the saved gap tolerance, so in the same order)."""
+    from rigidlcp.models.packing import packing
+    from rigidlcp.models.system import System
+
+    missing = [k for k in _GEOMETRY if k not in geometry]
+    if missing:
+        raise InvalidFile(f"{data_path}: a packing run without its geometry ({missing[0]})")
+    lat = packing(geometry["packing_x"], geometry["packing_r"], geometry["packing_m"],
+                  geometry["packing_I"], left=params["left"], right=params["right"],
+                  gap_tol=params["gap_tol"])
+    if lat.c != params["c"]:
+        raise InvalidFile(f"{data_path}: the saved packing has {lat.c} contacts, the run "
+                          f"{params['c']}")
+    keep = ("mu_pp", "mu_plane", "mu_wall", "gamma", "V0", "g")
+    return System(lat, **{k: params[k] for k in keep})
 
 
 def _json_default(obj):

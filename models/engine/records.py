@@ -113,5 +113,5 @@ class Run:
         last = (f", t = {self.records[-1].t:.6g}, "
                 f"mu_g = {reported(self.records[-1].mu_g, 1.0):.6g}"
                 if self.records else "")
-        return (f"<Run {lat.name} {lat.lx}x{lat.ly}: {self.status}, {self.n_events} events"
+        return (f"<Run {lat.title()}: {self.status}, {self.n_events} events"
                 f"{last}, method {self.method!r}>")

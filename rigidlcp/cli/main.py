@@ -25,6 +25,8 @@ COMMAND_MODULES = (
     "rigidlcp.cli.sweep",  # sweep, effective
     "rigidlcp.cli.nullspace",  # nullspace, verify-formulas
     "rigidlcp.cli.forces",  # forces
+    "rigidlcp.cli.pack",  # pack (deposition)
+    "rigidlcp.cli.forceset",  # forceset (statics of a packing)
     "rigidlcp.cli.certify_run",  # certify-run
     "rigidlcp.cli.bench",  # bench
     "rigidlcp.cli.fuzz",  # fuzz

@@ -33,11 +33,20 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
                    help="initial velocity of the box relative to the plane (sqrt(g r))")
     g.add_argument("--inertia", type=float, default=None,
                    help="moment of inertia (default m r^2/2)")
+    g.add_argument("--packing", metavar="FILE", default=None,
+                   help="disks from a packing file (.csv/.npz/LAMMPS dump, docs/packings.md) "
+                   "instead of --lattice/--lx/--ly")
 
 
 def system_from_args(args):
     from rigidlcp.models.system import make_system
 
+    if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
+        from rigidlcp.models.packing_io import read_packing
+        from rigidlcp.models.system import System
+
+        return System(read_packing(args.packing), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
+                      mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
     return make_system(args.lattice, args.lx, args.ly, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                        mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
 

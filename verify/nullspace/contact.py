@@ -193,7 +193,8 @@ def read_states(path: str, lattice: models.Lattice) -> tuple[np.ndarray, np.ndar
             raise InvalidFile(f"{path} is not a states file (JSON: {exc})") from None
         if not isinstance(data, dict):
             raise InvalidFile(f"{path}: expected a JSON object with 'normal' and 'tangential'")
-    names = {"rect": ("rect", "rectangular"), "tri": ("tri", "triangular")}[lattice.name]
+    names = {"rect": ("rect", "rectangular"), "tri": ("tri", "triangular")}.get(
+        lattice.name, (lattice.name,))
     checks = (("lattice", lambda v: str(v).lower() in names, lattice.name),
               ("lx", lambda v: int(v) == lattice.lx, lattice.lx),
               ("ly", lambda v: int(v) == lattice.ly, lattice.ly))

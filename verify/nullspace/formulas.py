@@ -28,6 +28,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import NotApplicable
 
 from .contact import KINDS, paper_states, svd_rank
 
@@ -37,13 +38,30 @@ LATTICES = ("rect", "tri")
 DEFAULT_MU = {"mu_pp": 0.3, "mu_plane": 0.4, "mu_wall": 0.2}
 
 
-def _lattice_name(lattice: str) -> str:
-    key = str(lattice).lower()
+class NoClosedForm(NotApplicable):
+    """Eqs. (3.3)/(3.4) are closed forms of the paper's regular arrays; a general packing has
+    none (count its null spaces with `null_dim`)."""
+
+
+def _lattice_name(lattice: str | models.Lattice) -> str:
+    """'rect' or 'tri' from a name or a Lattice; a general packing is refused by name."""
+    key = str(lattice.name if isinstance(lattice, models.Lattice) else lattice).lower()
     if key in ("rect", "rectangular"):
         return "rect"
     if key in ("tri", "triangular"):
         return "tri"
+    if key == "packing":
+        raise NoClosedForm("Eqs. (3.3)/(3.4) are closed forms of the regular arrays (rect, "
+                           "tri); a general packing has none: count its null space by SVD "
+                           "(null_dim)")
     raise ValueError(f"lattice must be 'rect' or 'tri', got {lattice!r}")
+
+
+def closed_forms(lattice: models.Lattice) -> dict[str, int]:
+    """Eqs. (3.3) and (3.4) of a built array, {"normal": .., "tangential": ..}, as printed in
+    the paper; NoClosedForm for a general packing."""
+    name = _lattice_name(lattice)
+    return {k: paper_formula(name, lattice.lx, lattice.ly, k) for k in ("normal", "tangential")}
 
 
 def _kind(kind: str) -> str:

@@ -1,0 +1,68 @@
+"""Packings at scale (issue 22): deposition, and the statics of deposited piles (a script, not a
+test; it prints a markdown table).
+
+    python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
+                                  [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
+
+deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
+statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
+ranges N: the whole analysis: also the range of every R and S and the sliding contacts.
+Wall-clock seconds and CPU seconds (process time) of one run each.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from rigidlcp import models
+from rigidlcp.models.deposition import deposit
+from rigidlcp.verify.statics.forceset import analyse
+
+
+def _sizes(text: str) -> list[int]:
+    return [int(v) for v in text.split(",") if v]
+
+
+def _timed(fn):
+    t, c = time.perf_counter(), time.process_time()
+    out = fn()
+    return out, time.perf_counter() - t, time.process_time() - c
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--deposit", type=_sizes, default=[1000, 10000])
+    ap.add_argument("--statics", type=_sizes, default=[100, 1000])
+    ap.add_argument("--ranges", type=_sizes, default=[100])
+    ap.add_argument("--mu", type=float, default=0.5)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--radii", default="0.8:1.2")
+    args = ap.parse_args()
+    radii = tuple(float(v) for v in args.radii.split(":"))
+    print(f"radii {radii[0]}:{radii[1]}, seed {args.seed}, mu = {args.mu} on every contact\n")
+    print("| task | disks | contacts | result | wall s | CPU s |")
+    print("|---|---|---|---|---|---|")
+    piles = {}
+    for n in sorted(set(args.deposit) | set(args.statics) | set(args.ranges)):
+        pile, wall, cpu = _timed(lambda n=n: deposit(n, seed=args.seed, radii=radii))
+        piles[n] = pile
+        if n in args.deposit:
+            print(f"| deposition | {n} | {pile.c} | - | {wall:.2f} | {cpu:.2f} |", flush=True)
+    for task, sizes, full in (("existence + dimension", args.statics, False),
+                              ("+ ranges of R, S + sliding", args.ranges, True)):
+        for n in sizes:
+            pile = piles[n]
+            system = models.System(pile, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
+            fs, wall, cpu = _timed(lambda s=system, f=full: analyse(s, ranges=f))
+            result = (f"exists, dim {fs.dimension}" if fs.exists else
+                      f"no equilibrium (Farkas, radius {fs.radius:.2g})")
+            if full and fs.exists:
+                result += f", {fs.lps} LPs, {int(fs.sliding.sum())} can slide"
+            print(f"| {task} | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |",
+                  flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

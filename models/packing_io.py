@@ -1,0 +1,234 @@
+"""Packings read and written: plain CSV / .npz (x, y, r [, m, I]) and LAMMPS text dumps.
+
+* CSV: a header line naming at least the columns x, y, r (any order; m and I optional, other
+  columns ignored), then one disk per line. Lines starting with '#' are comments; a comment
+  `# box: left=L right=R` (written by `write_packing`) gives the walls (a value "none": no
+  such wall).
+* .npz: arrays x, y, r [, m, I] and optional scalars left, right (NaN: no such wall).
+* LAMMPS dump (text, `dump ... custom`): the first snapshot's `ITEM: ATOMS` columns x, y and
+  radius (mass optional); atoms in the file's order. Recognized by its first line
+  `ITEM: TIMESTEP`.
+
+Missing m: m = r^2; missing I: I = m r^2 / 2 (uniform disks; the units of the arrays, where a
+disk of radius 1 has mass 1). Walls not given by the file or the caller: the tight box
+(left = min(x - r), right = max(x + r)). The plane is y = 0. A bad file is refused naming its
+line and field (`InvalidFile`); a file is never read as something else.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rigidlcp.lcp.errors import InvalidFile
+from rigidlcp.lcp.io.files import atomic_write, check_new, open_npz
+
+from .lattice import Lattice
+from .packing import GAP_TOL, packing
+
+REQUIRED = ("x", "y", "r")
+OPTIONAL = ("m", "I")
+
+
+@dataclass
+class Disks:
+    """The disks of a file: centres x (p, 2), radii r, masses m, inertias I (p,), and the walls
+    the file states (None: not stated, or "none": no wall)."""
+
+    x: np.ndarray
+    r: np.ndarray
+    m: np.ndarray
+    I: np.ndarray  # noqa: E741 (the paper's I)
+    left: float | None | str = None
+    right: float | None | str = None
+
+    def box(self, left=None, right=None) -> tuple[float | None, float | None]:
+        """The walls: the caller's, else the file's, else the tight box; "none": no wall."""
+        def pick(given, stated, tight):
+            v = given if given is not None else stated
+            if v is None:
+                return tight
+            return None if v == "none" else float(v)
+
+        return (pick(left, self.left, float(np.min(self.x[:, 0] - self.r))),
+                pick(right, self.right, float(np.max(self.x[:, 0] + self.r))))
+
+
+def read_disks(path: str | os.PathLike) -> Disks:
+    """The disks of a CSV, .npz or LAMMPS dump file (module docstring)."""
+    path = Path(path)
+    if not path.exists():
+        raise FileNotFoundError(2, "No such packing file", str(path))
+    if path.is_dir():
+        raise InvalidFile(f"{path} is a directory, not a packing file (.csv, .npz or a "
+                          "LAMMPS dump)")
+    if path.suffix == ".npz":
+        return _read_npz(path)
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise InvalidFile(f"{path} is not a packing file (not text, not .npz)") from None
+    lines = text.splitlines()
+    if lines and lines[0].strip() == "ITEM: TIMESTEP":
+        return _read_lammps(path, lines)
+    return _read_csv(path, lines)
+
+
+def read_packing(path: str | os.PathLike, left: float | None | str = None,
+                 right: float | None | str = None, gap_tol: float = GAP_TOL) -> Lattice:
+    """The Lattice of a packing file (contacts detected by models.packing)."""
+    d = read_disks(path)
+    lo, hi = d.box(left, right)
+    return packing(d.x, d.r, d.m, d.I, left=lo, right=hi, gap_tol=gap_tol)
+
+
+def _number(path: Path, line: int, field: str, text: str, positive: bool = False) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise InvalidFile(f"{path} line {line}, field {field!r}: {text.strip()!r} is not a "
+                          "number") from None
+    if not math.isfinite(v):
+        raise InvalidFile(f"{path} line {line}, field {field!r}: {text.strip()!r} is not finite")
+    if positive and v <= 0:
+        raise InvalidFile(f"{path} line {line}, field {field!r}: must be > 0, got {v!r}")
+    return v
+
+
+def _finish(path: Path, cols: dict[str, list[float]], left=None, right=None) -> Disks:
+    if not cols["x"]:
+        raise InvalidFile(f"{path}: no disks")
+    x = np.column_stack([cols["x"], cols["y"]])
+    r = np.array(cols["r"])
+    m = np.array(cols["m"]) if cols.get("m") else r**2
+    inertia = np.array(cols["I"]) if cols.get("I") else 0.5 * m * r**2
+    return Disks(x, r, m, inertia, left, right)
+
+
+def _read_csv(path: Path, lines: list[str]) -> Disks:
+    header, cols, box = None, {}, {}
+    for k, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        if line.startswith("#"):
+            if line[1:].strip().startswith("box:"):
+                box = _box_comment(path, k, line[1:].strip()[4:])
+            continue
+        fields = [f.strip() for f in line.split(",")]
+        if header is None:
+            header = fields
+            missing = [c for c in REQUIRED if c not in header]
+            if missing:
+                raise InvalidFile(f"{path} line {k}: the header must name the columns x, y, r "
+                                  f"(missing {', '.join(missing)}; got {line[:60]!r})")
+            dup = [c for c in set(header) if header.count(c) > 1 and c]
+            if dup:
+                raise InvalidFile(f"{path} line {k}: column {dup[0]!r} named twice")
+            cols = {c: [] for c in REQUIRED + OPTIONAL if c in header}
+            continue
+        if len(fields) != len(header):
+            raise InvalidFile(f"{path} line {k}: {len(fields)} fields, the header has "
+                              f"{len(header)}")
+        for c in cols:
+            cols[c].append(_number(path, k, c, fields[header.index(c)],
+                                   positive=c in ("r", "m", "I")))
+    if header is None:
+        raise InvalidFile(f"{path}: no header line naming the columns x, y, r")
+    return _finish(path, cols, **box)
+
+
+def _box_comment(path: Path, k: int, text: str) -> dict:
+    out = {}
+    for item in text.split():
+        key, _, value = item.partition("=")
+        if key not in ("left", "right"):
+            raise InvalidFile(f"{path} line {k}: box comment field {key!r} (expected left=, "
+                              "right=)")
+        out[key] = "none" if value == "none" else _number(path, k, key, value)
+    return out
+
+
+def _read_npz(path: Path) -> Disks:
+    with open_npz(path, "a packing (.npz with arrays x, y, r)") as data:
+        files = set(data.files)
+        missing = [c for c in REQUIRED if c not in files]
+        if missing:
+            raise InvalidFile(f"{path}: array {missing[0]!r} missing (a packing .npz holds x, "
+                              "y, r [, m, I])")
+        arrays = {c: np.asarray(data[c]) for c in REQUIRED + OPTIONAL if c in files}
+        walls = {k: float(data[k]) for k in ("left", "right") if k in files}
+    p = arrays["x"].size
+    cols = {}
+    for c, a in arrays.items():
+        if a.ndim != 1 or a.size != p or a.dtype.kind not in "fiu":
+            raise InvalidFile(f"{path}: array {c!r} must be {p} numbers (like x), got shape "
+                              f"{a.shape} of {a.dtype}")
+        for k, v in enumerate(a.astype(float)):
+            _number(path, k, c, repr(float(v)), positive=c in ("r", "m", "I"))
+        cols[c] = a.astype(float).tolist()
+    box = {k: ("none" if math.isnan(v) else v) for k, v in walls.items()}
+    return _finish(path, cols, **box)
+
+
+def _read_lammps(path: Path, lines: list[str]) -> Disks:
+    start = next((k for k, line in enumerate(lines) if line.startswith("ITEM: ATOMS")), None)
+    count = next((k for k, line in enumerate(lines) if line.startswith("ITEM: NUMBER OF")), None)
+    if start is None or count is None or count + 1 >= len(lines):
+        raise InvalidFile(f"{path}: a LAMMPS dump needs 'ITEM: NUMBER OF ATOMS' and "
+                          "'ITEM: ATOMS ...' lines")
+    n = int(_number(path, count + 2, "number of atoms", lines[count + 1]))
+    names = lines[start].split()[2:]
+    need = {"x": "x", "y": "y", "r": "radius"}
+    missing = [v for v in need.values() if v not in names]
+    if missing:
+        raise InvalidFile(f"{path} line {start + 1}: the ATOMS columns must include x, y and "
+                          f"radius (missing {', '.join(missing)})")
+    if "mass" in names:
+        need["m"] = "mass"
+    cols = {c: [] for c in need}
+    body = lines[start + 1: start + 1 + n]
+    if len(body) < n:
+        raise InvalidFile(f"{path}: {n} atoms announced, {len(body)} lines follow")
+    for k, raw in enumerate(body, start=start + 2):
+        fields = raw.split()
+        if len(fields) != len(names):
+            raise InvalidFile(f"{path} line {k}: {len(fields)} fields, the ATOMS header has "
+                              f"{len(names)}")
+        for c, name in need.items():
+            cols[c].append(_number(path, k, name, fields[names.index(name)],
+                                   positive=c in ("r", "m")))
+    return _finish(path, cols)
+
+
+def write_packing(path: str | os.PathLike, lattice: Lattice, m: np.ndarray | None = None,
+                  inertia: np.ndarray | None = None, force: bool = False) -> Path:
+    """Write a lattice's disks as CSV (or .npz by suffix) with its walls; m, I default to the
+    lattice's own, else r^2 and m r^2 / 2. Refuses an existing file unless force."""
+    path = Path(path)
+    check_new([path], force=force)
+    r = lattice.radii
+    m = np.asarray(m if m is not None else (lattice.masses if lattice.masses is not None
+                                            else r**2), dtype=float)
+    inertia = np.asarray(inertia if inertia is not None else (
+        lattice.inertias if lattice.inertias is not None else 0.5 * m * r**2), dtype=float)
+    walls = {"left": lattice.left, "right": lattice.right}
+    if path.suffix == ".npz":
+        def write(tmp: str) -> None:
+            with open(tmp, "wb") as fh:
+                np.savez(fh, x=lattice.x[:, 0], y=lattice.x[:, 1], r=r, m=m, I=inertia,
+                         **{k: np.nan if v is None else v for k, v in walls.items()})
+    else:
+        box = " ".join(f"{k}={'none' if v is None else repr(float(v))}" for k, v in walls.items())
+        rows = [f"# box: {box}", "x,y,r,m,I"]
+        rows += [f"{a!r},{b!r},{c!r},{d!r},{e!r}" for a, b, c, d, e in
+                 zip(*(v.tolist() for v in (lattice.x[:, 0], lattice.x[:, 1], r, m, inertia)))]
+
+        def write(tmp: str) -> None:
+            Path(tmp).write_text("\n".join(rows) + "\n")
+    atomic_write(path, write)
+    return path

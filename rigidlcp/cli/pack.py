@@ -1,0 +1,85 @@
+"""`rigidlcp pack`: a packing deposited under gravity (models.deposition), written as CSV/.npz.
+
+The interface is fixed (issue 22): `rigidlcp pack --n N --seed S [--radii MIN:MAX] --out FILE`;
+the CSV's header names x, y, r, m, I (m = r^2, I = m r^2 / 2) after a `# box: left= right=`
+comment (models.packing_io).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from rigidlcp.cli.main import seed
+
+
+def radii(text: str) -> tuple[float, float]:
+    """argparse type of --radii: MIN:MAX (or one value: monodisperse)."""
+    parts = text.split(":")
+    try:
+        a, b = (float(parts[0]), float(parts[-1])) if len(parts) <= 2 else (None, None)
+    except ValueError:
+        a = b = None
+    if a is None or not (0 < a <= b < float("inf")):
+        raise argparse.ArgumentTypeError(f"expected MIN:MAX with 0 < MIN <= MAX, got {text!r}")
+    return a, b
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "pack", help="deposit disks under gravity in the box (a packing file)",
+        description="Sequential deposition under gravity: each disk dropped at a random "
+        "abscissa rolls down the pile to a resting position on two supports (disk, wall or "
+        "plane), so its contacts are exact. Writes x, y, r, m, I (m = r^2, I = m r^2 / 2) as "
+        "CSV (or .npz by suffix), the walls in a '# box:' comment.")
+    p.add_argument("--n", type=int, required=True, help="number of disks")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the radii and drop points")
+    p.add_argument("--radii", type=radii, default=(1.0, 1.0), metavar="MIN:MAX",
+                   help="radii uniform in [MIN, MAX] (default 1:1, monodisperse)")
+    p.add_argument("--width", type=float, default=None,
+                   help="box width (default 2 mean(r) round(sqrt(N)))")
+    p.add_argument("--vacancies", type=float, default=0.0, metavar="F",
+                   help="remove a fraction F of the deposited disks at random (the rest keep "
+                   "their contacts; rattlers and floating clusters are reported)")
+    p.add_argument("--out", required=True, metavar="FILE", help="output .csv or .npz")
+    p.add_argument("--force", action="store_true", help="overwrite FILE")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--no-progress", action="store_true")
+    p.set_defaults(func=cmd_pack)
+
+
+def cmd_pack(args: argparse.Namespace) -> int:
+    from rigidlcp.lcp.io.files import check_new
+    from rigidlcp.models.deposition import deposit, with_vacancies
+    from rigidlcp.models.packing import report
+    from rigidlcp.models.packing_io import write_packing
+
+    if args.n < 1:
+        raise ValueError(f"--n must be >= 1, got {args.n}")
+    if not 0 <= args.vacancies < 1:
+        raise ValueError(f"--vacancies must be in [0, 1), got {args.vacancies}")
+    if not str(args.out).endswith((".csv", ".npz")):
+        raise ValueError(f"--out must end in .csv or .npz, got {args.out!r}")
+    check_new([args.out], force=args.force)  # before the work, so nothing is lost
+    bar = None
+    if not args.no_progress and args.n >= 2000:
+        from rigidlcp.models.progress import new_bar
+
+        bar = new_bar(total=args.n, desc="deposition", unit="disk")
+    lat = deposit(args.n, seed=args.seed, radii=args.radii, width=args.width,
+                  progress=(lambda k, n: bar.update(1)) if bar else None)
+    if bar:
+        bar.close()
+    if args.vacancies:
+        lat = with_vacancies(lat, args.vacancies, seed=args.seed)
+    write_packing(args.out, lat, force=args.force)
+    rep = report(lat)
+    summary = {"out": str(args.out), "p": lat.p, "c": lat.c, "width": lat.width,
+               "radii": list(args.radii), "seed": args.seed, **rep.to_dict()}
+    if args.json:
+        summary.pop("floating_clusters")
+        print(json.dumps(summary))
+    else:
+        print(f"{lat.p} disks (radii {args.radii[0]:g}:{args.radii[1]:g}, seed {args.seed}) in "
+              f"a box of width {lat.width:g}: {lat.c} contacts, {rep.text()} -> {args.out}")
+    return 0

@@ -1,0 +1,50 @@
+"""`rigidlcp pack` end to end: the fixed interface, the file it writes, refusals."""
+
+import json
+from contextlib import nullcontext
+
+import numpy as np
+import pytest
+
+from rigidlcp.cli.main import main
+from rigidlcp.models.packing_io import read_disks, read_packing
+
+
+def test_pack_writes_a_packing(tmp_path, capsys):
+    out = tmp_path / "p.csv"
+    code = main(["pack", "--n", "40", "--seed", "3", "--radii", "0.8:1.2", "--out", str(out),
+                 "--json"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["p"] == 40 and summary["rattlers"] == []
+    header = [line for line in out.read_text().splitlines() if not line.startswith("#")][0]
+    assert header.split(",")[:3] == ["x", "y", "r"]
+    d = read_disks(out)
+    assert np.allclose(d.m, d.r**2) and np.allclose(d.I, d.m * d.r**2 / 2)
+    assert read_packing(out).c == summary["c"]
+    assert main(["pack", "--n", "40", "--seed", "3", "--radii", "0.8:1.2", "--out",
+                 str(tmp_path / "q.csv"), "--json"]) == 0
+    capsys.readouterr()
+    assert (tmp_path / "q.csv").read_text() == out.read_text()  # seeded
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--n", "0"], "--n must be >= 1"),
+    (["--n", "5", "--radii", "1:x"], "expected MIN:MAX"),
+    (["--n", "5", "--width", "1"], "width must be >= the largest diameter"),
+    (["--n", "5", "--vacancies", "1.5"], "--vacancies must be in"),
+])
+def test_pack_refusals_leave_nothing(tmp_path, capsys, args, message):
+    out = tmp_path / "p.csv"
+    with pytest.raises(SystemExit) if "MIN:MAX" in message else nullcontext():
+        code = main(["pack", *args, "--out", str(out)])
+        assert code == 2
+    assert message in capsys.readouterr().err
+    assert not out.exists()
+
+
+def test_pack_never_overwrites(tmp_path, capsys):
+    out = tmp_path / "p.csv"
+    out.write_text("mine")
+    assert main(["pack", "--n", "3", "--out", str(out)]) == 2
+    assert "exists" in capsys.readouterr().err and out.read_text() == "mine"
+

@@ -1,0 +1,113 @@
+"""Packing files (issue 22.2): round trips, the LAMMPS reader, bad files refused by line and
+field, and a rectangular array written as a packing file giving the array's event LCPs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidFile, OutputExists
+from rigidlcp.models.deposition import deposit
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.event import State, event_problem, initial_state
+from rigidlcp.models.packing_io import read_disks, read_packing, write_packing
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".npz"])
+def test_round_trip_exact(tmp_path, suffix):
+    lat = deposit(60, seed=3, radii=(0.6, 1.4))
+    path = write_packing(tmp_path / f"p{suffix}", lat)
+    back = read_packing(path)
+    for name in ("x", "radii", "masses", "inertias", "i", "j", "n"):
+        assert np.array_equal(getattr(back, name), getattr(lat, name)), name
+    assert (back.left, back.right) == (lat.left, lat.right)
+    with pytest.raises(OutputExists):
+        write_packing(path, lat)
+
+
+def test_rectangular_file_gives_the_arrays_event_lcps(tmp_path):
+    """rect 5x3 (radius 1, m = 1, I = 1/2 = the file's defaults m = r^2, I = m r^2 / 2) read
+    back from CSV: the same W, q and event LCPs, exactly, up to the order of the contacts."""
+    lat = models.rectangular(5, 3)
+    back = read_packing(write_packing(tmp_path / "rect.csv", lat))
+    where = {(int(i), int(j)): b for b, (i, j) in enumerate(zip(back.i, back.j))}
+    perm = np.array([where[(int(i), int(j))] for i, j in zip(lat.i, lat.j)])
+    sa, sb = models.System(lat, gamma=0.1), models.System(back, gamma=0.1)
+    rows = np.r_[perm, back.c + perm]
+    assert np.array_equal(Dynamics(sb).W[np.ix_(rows, rows)], Dynamics(sa).W)
+    st = initial_state(sa, seed=5)
+    sp = np.zeros(back.c, dtype=int)
+    sp[perm] = st.s
+    ea, eb = event_problem(sa, st), event_problem(sb, State(0.0, st.omega, st.V, sp))
+    cand = {int(a): k for k, a in enumerate(eb.candidates)}
+    kb = np.array([cand[int(perm[a])] for a in ea.candidates], dtype=int)
+    z = np.r_[perm, back.c + kb, back.c + eb.k + kb]
+    assert np.array_equal(eb.lcp.M[np.ix_(z, z)], ea.lcp.M)
+    assert np.array_equal(eb.lcp.q[z], ea.lcp.q)
+
+
+def test_csv_defaults_and_box(tmp_path):
+    f = tmp_path / "a.csv"
+    f.write_text("# two disks\nid,r,x,y\n0,1,1,1\n1,2,6,2\n")
+    d = read_disks(f)
+    assert np.array_equal(d.m, [1.0, 4.0]) and np.array_equal(d.I, [0.5, 8.0])
+    assert d.box() == (0.0, 8.0)  # the tight box
+    lat = read_packing(f, right="none")
+    assert lat.right is None and lat.left == 0.0
+
+
+LAMMPS = """ITEM: TIMESTEP
+0
+ITEM: NUMBER OF ATOMS
+2
+ITEM: BOX BOUNDS pp ff pp
+0 4
+0 10
+-0.5 0.5
+ITEM: ATOMS id type x y z radius mass
+1 1 1.0 1.0 0 1.0 2.0
+2 1 3.0 1.0 0 1.0 2.0
+"""
+
+
+def test_lammps_dump(tmp_path):
+    f = tmp_path / "dump.atoms"
+    f.write_text(LAMMPS)
+    d = read_disks(f)
+    assert np.array_equal(d.x, [[1, 1], [3, 1]]) and np.array_equal(d.m, [2, 2])
+    lat = read_packing(f)
+    assert lat.c == 5  # plane x2, both walls, the pair
+    f.write_text(LAMMPS.replace("2 1 3.0 1.0 0 1.0", "2 1 3.0 1.0 0 abc"))
+    with pytest.raises(InvalidFile, match=r"line 11, field 'radius': 'abc' is not a number"):
+        read_disks(f)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("x,y\n1,1\n", r"line 1: the header must name the columns x, y, r \(missing r"),
+    ("x,y,r\n1,1,1\n2,2\n", r"line 3: 2 fields, the header has 3"),
+    ("x,y,r\n1,1,1\n3,1,-1\n", r"line 3, field 'r': must be > 0"),
+    ("x,y,r\n1,nan,1\n", r"line 2, field 'y': 'nan' is not finite"),
+    ("x,y,r,m\n1,1,1,zero\n", r"line 2, field 'm': 'zero' is not a number"),
+    ("# box: left=0 top=3\nx,y,r\n", r"line 1: box comment field 'top'"),
+    ("x,y,r\n", r"no disks"),
+    ("", r"no header line"),
+])
+def test_bad_csv_refused_by_line_and_field(tmp_path, text, message):
+    f = tmp_path / "bad.csv"
+    f.write_text(text)
+    with pytest.raises(InvalidFile, match=message):
+        read_disks(f)
+
+
+def test_bad_npz_and_binary(tmp_path):
+    f = tmp_path / "bad.npz"
+    np.savez(f, x=np.ones(2), y=np.ones(2))
+    with pytest.raises(InvalidFile, match="array 'r' missing"):
+        read_disks(f)
+    g = tmp_path / "b.csv"
+    g.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(InvalidFile, match="not a packing file"):
+        read_disks(g)
+    with pytest.raises(FileNotFoundError):
+        read_disks(tmp_path / "missing.csv")

@@ -1,0 +1,175 @@
+"""verify.statics: the admissible forces of a packing at rest, against closed forms derived by
+hand and against an independent measure of the dimension.
+
+Conventions (models.lattice, models.dynamics): the force of contact alpha on its disk i is
+-(R n + S t), t = n rotated by +90 degrees, and its torque on i is -r_i S. Unit weights
+(m = 1 for r = 1: the packing files' m = r^2; g = 1). Every case below is a disk of radius 1.
+
+1. A disk in the corner of the left wall and the plane (centre (1, 1)). Forces on the disk:
+   plane (-S_p, R_p), wall (R_w, S_w). Balance: x: R_w = S_p; y: R_p + S_w = 1; torque:
+   S_p + S_w = 0. With s = S_p: R_w = s, S_w = -s, R_p = 1 + s. Coulomb at the wall,
+   |s| <= mu_w s, needs s >= 0 and, if mu_w < 1, s = 0: the forces are unique, R_p = 1 and
+   R_w = 0 on the whole set (an implicit equality). If mu_w >= 1 the plane's cone
+   s <= mu_p (1 + s) bounds s <= mu_p / (1 - mu_p): for mu_p = 1/2, s in [0, 1], so
+   R_p in [1, 2], R_w = S_p in [0, 1], S_w in [-1, 0]: a segment, dimension 1.
+2. A disk on the plane between two walls 2 apart. Forces: plane (-S_p, R_p), left (R_L, S_L),
+   right (-R_R, -S_R). x: R_L - R_R = S_p; y: R_p = 1 - S_L + S_R; torque:
+   S_p = -(S_L + S_R). R_L, R_R can grow together (the walls pinch), so the only binding law
+   is |S_L + S_R| <= mu (1 - S_L + S_R) (one mu < 1 everywhere). Eliminating S_L between its
+   two sides gives S_R >= -1/2, and then S_L <= 1/2 (at S_R = -1/2, where R_p = 0); the other
+   ends are unbounded. So R_p in [0, inf), R_L, R_R in [0, inf), S_L in (-inf, 1/2],
+   S_R in [-1/2, inf), S_p in (-inf, inf); 6 unknowns, 3 independent equations, no implicit
+   equality: dimension 3. Frictionless: S = 0, R_p = 1, R_L = R_R in [0, inf): dimension 1.
+3. Three disks in a pyramid between walls 4 apart, frictionless: bottom disks at (1, 1) and
+   (3, 1) (touching each other, the plane and a wall each), the top one at (2, 1 + sqrt 3).
+   Top: its two contacts push along (+-1/2, sqrt(3)/2): R_1 = R_2, sqrt(3) R_1 = 1, so
+   R_1 = R_2 = 1/sqrt 3. Bottom left: y: R_p1 = 1 + R_1 sqrt(3)/2 = 3/2; x: R_L = R_b + R_1/2
+   (R_b the pair contact); the right one likewise. R_b in [0, inf) is free: dimension 1,
+   R_L = R_R in [1/(2 sqrt 3), inf). Without the walls (and without friction) nothing holds
+   the bottom disks apart: no equilibrium, and a Farkas certificate must say so.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import linprog
+
+from rigidlcp import models
+from rigidlcp.models.deposition import deposit
+from rigidlcp.models.lattice import LEFT_WALL, PLANE, RIGHT_WALL
+from rigidlcp.verify.statics.forceset import analyse
+from rigidlcp.verify.statics.model import StaticProblem
+
+INF = np.inf
+TOL = 1e-8
+
+
+def _system(x, left=None, right=None, **mu) -> models.System:
+    lat = models.make_packing(x, np.ones(len(x)), m=np.ones(len(x)), left=left, right=right)
+    return models.System(lat, **mu)
+
+
+def _range(fs, j_code, i=0, what="R"):
+    lat = fs.system.lattice
+    a = int(np.flatnonzero((lat.i == i) & (lat.j == j_code))[0])
+    k = a if what == "R" else fs.c + a
+    return fs.lo[k], fs.hi[k]
+
+
+def _close(got, want):
+    for g, w in zip(got, want):
+        assert (g == w) if np.isinf(w) else abs(g - w) <= TOL, (got, want)
+
+
+def test_corner_unique_below_mu_wall_one():
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=0.9))
+    assert fs.exists and fs.dimension == 0
+    _close(_range(fs, PLANE), (1, 1))
+    _close(_range(fs, LEFT_WALL), (0, 0))
+    assert fs.implicit[int(np.flatnonzero(fs.system.lattice.j == LEFT_WALL)[0])] == "R=0"
+
+
+def test_corner_segment_above_mu_wall_one():
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=1.5))
+    assert fs.exists and fs.dimension == 1
+    _close(_range(fs, PLANE), (1, 2))
+    _close(_range(fs, PLANE, what="S"), (0, 1))
+    _close(_range(fs, LEFT_WALL), (0, 1))
+    _close(_range(fs, LEFT_WALL, what="S"), (-1, 0))
+
+
+@pytest.mark.parametrize("mu", [0.1, 0.3, 0.8])
+def test_disk_between_two_walls(mu):
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, right=2.0, mu_pp=mu, mu_plane=mu,
+                         mu_wall=mu))
+    assert fs.exists and fs.dimension == 3
+    _close(_range(fs, PLANE), (0, INF))
+    _close(_range(fs, PLANE, what="S"), (-INF, INF))
+    _close(_range(fs, LEFT_WALL), (0, INF))
+    _close(_range(fs, LEFT_WALL, what="S"), (-INF, 0.5))
+    _close(_range(fs, RIGHT_WALL, what="S"), (-0.5, INF))
+    d = fs.to_dict()
+    json.dumps(d, allow_nan=False)  # null for unbounded ends, never Infinity
+    left = next(c for c in d["contacts"] if c["j"] == -1)
+    assert left["R"][1] is None and left["S"][0] is None
+    assert abs(left["R"][0]) <= TOL and abs(left["S"][1] - 0.5) <= TOL
+
+
+def test_disk_between_two_walls_frictionless():
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, right=2.0, mu_pp=0, mu_plane=0, mu_wall=0))
+    assert fs.exists and fs.dimension == 1
+    _close(_range(fs, PLANE), (1, 1))
+    _close(_range(fs, LEFT_WALL), (0, INF))
+
+
+S3 = np.sqrt(3.0)
+PYRAMID = [[1.0, 1.0], [3.0, 1.0], [2.0, 1.0 + S3]]
+
+
+def test_pyramid_between_walls_frictionless():
+    fs = analyse(_system(PYRAMID, left=0.0, right=4.0, mu_pp=0, mu_plane=0, mu_wall=0))
+    assert fs.exists and fs.dimension == 1
+    _close(_range(fs, 2, i=0), (1 / S3, 1 / S3))  # bottom left - top
+    _close(_range(fs, 2, i=1), (1 / S3, 1 / S3))
+    _close(_range(fs, PLANE, i=0), (1.5, 1.5))
+    _close(_range(fs, 1, i=0), (0, INF))  # the bottom pair
+    _close(_range(fs, LEFT_WALL, i=0), (1 / (2 * S3), INF))
+    _close(_range(fs, RIGHT_WALL, i=1), (1 / (2 * S3), INF))
+
+
+def test_pyramid_without_walls_has_a_farkas_certificate():
+    fs = analyse(_system(PYRAMID, mu_pp=0, mu_plane=0, mu_wall=0))
+    assert not fs.exists and fs.radius > 1e9
+    prob = StaticProblem(fs.system)
+    g = prob.A.T @ fs.certificate  # = H y: relative velocities of the virtual motion
+    c = prob.c
+    assert np.all(g[:c] >= -1e-12) and prob.b @ fs.certificate < -0.1  # opens, gravity works
+    floating = analyse(_system([[1.0, 5.0]], left=0.0, right=3.0))
+    assert not floating.exists
+
+
+def _affine_dimension(prob: StaticProblem, fs, draws: int, rng) -> int:
+    """Rank of the differences of LP vertices of P inside a large box, for random costs: an
+    independent lower bound on dim P that reaches it for enough generic costs."""
+    big = 10.0 * (np.abs(fs.solution).max() + prob.scale * prob.p)
+    bounds = [(max(lo, -big), min(hi, big)) for lo, hi in zip(prob.lb, prob.ub)]
+    pts = []
+    for _ in range(draws):
+        res = linprog(rng.standard_normal(prob.n), A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]),
+                      A_eq=prob.A, b_eq=prob.b, bounds=bounds, method="highs")
+        assert res.status == 0
+        pts.append(res.x)
+    D = np.array(pts[1:]) - pts[0]
+    if D.size == 0:
+        return 0
+    w = np.linalg.svd(D, compute_uv=False)
+    return int(np.sum(w > 1e-7 * max(w[0], 1.0)))
+
+
+@settings(max_examples=12)
+@given(n=st.integers(2, 7), seed=st.integers(0, 10**5), mu=st.floats(0.05, 1.2),
+       spread=st.floats(1.0, 1.6))
+def test_properties_on_deposited_packings(n, seed, mu, spread):
+    """Every checked network satisfies balance and the cones; every range contains it; the
+    dimension equals the rank count and the affine rank of many vertices of P."""
+    lat = deposit(n, seed=seed, radii=(1.0, spread), width=6.0)
+    system = models.System(lat, mu_pp=mu, mu_plane=mu, mu_wall=mu)
+    fs = analyse(system)
+    if not fs.exists:
+        return
+    prob = StaticProblem(system)
+    eq, viol = prob.residuals(fs.solution)
+    assert eq <= 1e-9 * prob.scale * prob.p and viol <= 1e-9 * prob.scale * prob.p
+    R, S = fs.solution[: fs.c], fs.solution[fs.c:]
+    assert np.all(R >= -1e-9) and np.all(np.abs(S) <= system.mu * R + 1e-9)
+    assert np.all(fs.lo - 1e-7 <= fs.solution) and np.all(fs.solution <= fs.hi + 1e-7)
+    assert fs.unchecked == 0
+    for a, kind in enumerate(fs.implicit):  # R = 0 on all of P iff its range is {0}
+        assert (kind == "R=0") == (fs.hi[a] <= 1e-9 * prob.scale), a
+    rng = np.random.default_rng(seed)
+    assert _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng) == fs.dimension
