@@ -56,9 +56,23 @@ def simulate(
     during the run (the event problems are small dense matrices, for which one thread is
     fastest, and much faster on a loaded machine); None leaves BLAS alone.
     """
+    select = _one_rule(select, selection)
+    backend = _backend(system, method, select, fallback, warm_start, dump_dir, check_tol)
+    if state is None:
+        state = initial_state(system, omega=omega, seed=seed)
+    limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
+    if progress is True or progress is False:
+        progress = None if progress is False else _print_progress
+    with blas_limit(blas_threads):
+        return selection_note(backend, run_events(system, state, backend, limits, progress or None))
+
+
+def _backend(system: System, method: str, select: str, fallback: str | None, warm_start: bool,
+             dump_dir: str | None, check_tol: float):
+    """The backend of `simulate`: sparse for "sparse-pivoting", else dense (refused first when
+    its matrices cannot fit in memory)."""
     if method != "sparse-pivoting":
         check_dense_memory(system.c, f"the dense event LCP of {system.c} contacts")
-    select = _one_rule(select, selection)
     dyn = Dynamics(system)
     if method == "sparse-pivoting":
         if select != "none":
@@ -69,17 +83,9 @@ def simulate(
         # imported here: a dense run needs no sparse LU (scipy.sparse.linalg, ~0.1 s to load)
         from .sparse import SparseBackend
 
-        backend = SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback)
-    else:
-        backend = DenseBackend(system, dyn, method=method, fallback=fallback, select=select,
-                               warm_start=warm_start, dump_dir=dump_dir, check_tol=check_tol)
-    if state is None:
-        state = initial_state(system, omega=omega, seed=seed)
-    limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
-    if progress is True or progress is False:
-        progress = None if progress is False else _print_progress
-    with blas_limit(blas_threads):
-        return selection_note(backend, run_events(system, state, backend, limits, progress or None))
+        return SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback)
+    return DenseBackend(system, dyn, method=method, fallback=fallback, select=select,
+                        warm_start=warm_start, dump_dir=dump_dir, check_tol=check_tol)
 
 
 def _one_rule(select: str, selection: str | None) -> str:
