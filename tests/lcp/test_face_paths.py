@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from rigidlcp import lcp
 from rigidlcp.lcp import face_coords as fc
 from rigidlcp.lcp import face_reference as fr
-from rigidlcp.lcp.face import face_minimum_norm
+from rigidlcp.lcp.faces.face import face_minimum_norm
 
 
 def rank_deficient(rng, n, r, scale=1.0, symmetric=False):

@@ -17,8 +17,14 @@ from scipy.sparse.linalg import spsolve
 
 from rigidlcp import lcp, models
 from rigidlcp.lcp import state_pivoting
-from rigidlcp.lcp.state_factor import NS, ActiveSystem, ReducedLU, SingularSystem, StateFactor
-from rigidlcp.lcp.state_pivoting import _one_per_component, solve_states
+from rigidlcp.lcp.solvers.state_factor import (
+    NS,
+    ActiveSystem,
+    ReducedLU,
+    SingularSystem,
+    StateFactor,
+)
+from rigidlcp.lcp.solvers.state_pivoting import _one_per_component, solve_states
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import initial_state
 from rigidlcp.models.sparse_event import sparse_delassus

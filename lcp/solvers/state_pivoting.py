@@ -369,8 +369,8 @@ def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contac
     the other states fixed: the LCP of those unknowns is the principal pivot transform
     M_FF - M_Fa M_aa^-1 M_aF, q_F - M_Fa M_aa^-1 q_a (a: the basic unknowns outside F),
     solved by dense lexicographic Lemke. Sets the factor's states; False when it cannot."""
-    from .api import solve
-    from .problem import LCP
+    from ..api import solve
+    from ..problems.problem import LCP
 
     c = ev.c
     F = np.unique(H % c)
