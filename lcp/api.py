@@ -12,11 +12,12 @@ trusted): see lcp.acceptance.trust.
 
 from __future__ import annotations
 
+from . import registry
 from .acceptance.residual import TOL
 from .acceptance.trust import Run, solve_checked
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
-from .registry import _REGISTRY, ACCEPTS, MethodInfo, check_options, lookup, register
+from .registry import ACCEPTS, MethodInfo, check_options, lookup, register
 from .solvers import BUILTIN as _BUILTIN
 
 __all__ = ["solve", "get_method", "methods", "register", "MethodInfo", "ACCEPTS",
@@ -28,7 +29,7 @@ def methods() -> list[MethodInfo]:
     whichever were loaded first by `get_method`)."""
     _load_builtin_methods()
     order = {name: i for i, name in enumerate(_BUILTIN)}
-    infos = list(_REGISTRY.values())
+    infos = list(registry._REGISTRY.values())
     return sorted(infos, key=lambda m: order.get(m.name, len(order)))
 
 
@@ -46,7 +47,7 @@ def get_method(name: str) -> MethodInfo:
         info = lookup(name)
     if info is None:
         raise InvalidProblem(
-            f"unknown method {name!r}; available: {', '.join(sorted(_REGISTRY))}"
+            f"unknown method {name!r}; available: {', '.join(sorted(registry._REGISTRY))}"
         )
     return info
 
@@ -169,3 +170,10 @@ def _load_builtin_methods() -> None:
     for module in dict.fromkeys(_BUILTIN.values()):
         importlib.import_module(f"{__package__}.solvers.{module}")
     _LOADED = True
+
+
+def __getattr__(name: str):
+    # api._REGISTRY: the table itself (lcp.registry._REGISTRY, read where it is now)
+    if name == "_REGISTRY":
+        return registry._REGISTRY
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

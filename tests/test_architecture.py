@@ -169,7 +169,7 @@ def test_engine_functions_are_short():
 def test_no_two_models_modules_import_each_other():
     """Not even inside functions (issue 24.8: models/engine/simulate.py <-> sparse.py through
     blas_limit, now in loop.py below both): a piece two modules share lives below both.
-    (The floor `lcp` keeps its lazy method registry, lcp/api.py <-> the methods it lists.)"""
+    (lcp/ is checked room by room: test_lcp_rooms_import_downwards.)"""
     modules = {n: p for n, p in _modules().items() if _floor(n) == "rigidlcp.models"}
     deps = {name: {t for t in _imports(name, path) if t in modules and t != name}
             for name, path in modules.items()}
@@ -233,3 +233,42 @@ def test_no_new_import_cycles_inside_functions():
     new = [sorted(c) for c in _cycles(graph)
            if not any(c <= known for known in KNOWN_FUNCTION_LEVEL_CYCLES)]
     assert new == []
+
+
+#: The rooms of lcp/ (docs/architecture.md, "The rooms of lcp/"), lowest first: a module imports
+#: only from its own room or a lower level; rooms on one level (solvers, faces) do not import
+#: each other. errors.py, quiet.py, _lemke_kernel.py and io/files.py are leaves every room uses.
+LCP_LEVELS = {
+    "errors": 0, "quiet": 1, "_lemke_kernel": 1, "io.files": 1,
+    "problems": 2, "io": 3, "acceptance": 4, "registry": 5, "solvers": 6, "faces": 6,
+    "api": 7, "batch": 8,
+}
+
+
+def _room(name: str) -> str | None:
+    """The room of an lcp module (None for the package rigidlcp.lcp itself)."""
+    parts = name.split(".")[2:]
+    if not parts:
+        return None
+    return "io.files" if parts[:2] == ["io", "files"] else parts[0]
+
+
+def test_lcp_rooms_import_downwards():
+    """The registry imports only data types, the methods import the registry, `solve` (api)
+    imports them all, and nothing below the facade imports it (issue 23.5): at any depth,
+    imports inside functions included."""
+    modules = _modules()
+    wrong = []
+    for name, path in modules.items():
+        if _floor(name) != "rigidlcp.lcp" or _room(name) is None:
+            continue
+        src = _room(name)
+        for target in _imports(name, path):
+            if target not in modules:
+                target = target.rsplit(".", 1)[0]
+            dst = _room(target) if target in modules else None
+            if dst is None or dst == src:
+                continue
+            if not LCP_LEVELS[dst] < LCP_LEVELS[src]:
+                wrong.append(f"{name} -> {target}")
+    assert wrong == []
