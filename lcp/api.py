@@ -12,7 +12,8 @@ trusted): see lcp.acceptance.trust.
 
 from __future__ import annotations
 
-from . import registry
+import rigidlcp.lcp.registry as registry
+
 from .acceptance.residual import TOL
 from .acceptance.trust import Run, solve_checked
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
