@@ -1,6 +1,6 @@
 """The fast path of `lcp.solve(problem, "pivoting")` on an `lcp.LCP` with default options.
 
-The general path (lcp.api.solve -> lcp.trust.solve_checked) runs, for such a call,
+The general path (lcp.api.solve -> lcp.acceptance.trust.solve_checked) runs, for such a call,
 
     eq = ruiz(M, q)                        lcp.scaling: Ruiz equilibration (pivoting's default)
     sol = solve_pivoting(eq.M, eq.q)       lcp.pivoting: block steps, single pivots, ...
