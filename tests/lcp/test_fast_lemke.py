@@ -15,10 +15,12 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import api, fast_lemke, residual
+from rigidlcp.lcp import api
+from rigidlcp.lcp.acceptance import residual
 from rigidlcp.lcp.acceptance.scaling import _pow2, ruiz
 from rigidlcp.lcp.errors import RigidLCPError
 from rigidlcp.lcp.problems.solution import Solution, solved_lcp
+from rigidlcp.lcp.solvers import fast_lemke
 
 from .test_lemke import degenerate_integer_lcps
 

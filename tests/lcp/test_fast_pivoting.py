@@ -13,8 +13,9 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import api, fast_pivoting
+from rigidlcp.lcp import api
 from rigidlcp.lcp.problems.solution import Solution
+from rigidlcp.lcp.solvers import fast_pivoting
 
 from .test_fast_lemke import outcome, random_lcps, same
 from .test_lemke import degenerate_integer_lcps
