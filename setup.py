@@ -1,8 +1,10 @@
 """Build hook for the optional C extensions (everything else is in pyproject.toml).
 
-rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c), rigidlcp.lcp._accuracy_c the
-backward / forward errors of an LCP answer (lcp/_accuracy_c.c), rigidlcp.lcp._pivot_c the
-block steps of method `pivoting` for lcp.solve's fast path (lcp/_pivot_c.c). All are
+rigidlcp.lcp._lemke_c is Lemke's pivot loop in C (lcp/_lemke_c.c; also the residual measure of
+lcp/acceptance/residual.py, so it stays at the root of lcp/), rigidlcp.lcp.acceptance._accuracy_c
+the backward / forward errors of an LCP answer (lcp/acceptance/_accuracy_c.c),
+rigidlcp.lcp.solvers._pivot_c the block steps of method `pivoting` for lcp.solve's fast path
+(lcp/solvers/_pivot_c.c). Each is built next to the module that loads it. All are
 `optional`: when no C compiler is available, `pip install` still succeeds and the numpy code
 runs instead (docs/performance.md says why a C extension and what it gains).
 
@@ -27,8 +29,10 @@ class BuildExt(build_ext):
 setup(
     ext_modules=[
         Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True),
-        Extension("rigidlcp.lcp._pivot_c", sources=["lcp/_pivot_c.c"], optional=True),
-        Extension("rigidlcp.lcp._accuracy_c", sources=["lcp/_accuracy_c.c"], optional=True),
+        Extension("rigidlcp.lcp.solvers._pivot_c", sources=["lcp/solvers/_pivot_c.c"],
+                  optional=True),
+        Extension("rigidlcp.lcp.acceptance._accuracy_c",
+                  sources=["lcp/acceptance/_accuracy_c.c"], optional=True),
     ],
     cmdclass={"build_ext": BuildExt},
 )

@@ -24,7 +24,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rigidlcp import models
-from rigidlcp.lcp import state_factor, state_pivoting
+from rigidlcp.lcp.solvers import state_factor, state_pivoting
 from rigidlcp.models.engine.sparse import simulate_sparse
 
 VARIANTS = {"issue 13": (True, True), "full-K LU": (False, True),

@@ -28,7 +28,7 @@ import numpy as np
 
 from rigidlcp import lcp, models
 from rigidlcp.lcp import _lemke_kernel
-from rigidlcp.lcp import face as lcp_face
+from rigidlcp.lcp.faces import face as lcp_face
 
 DEFAULT = "face-min-norm:C:small,face-min-norm:C:reference,none:C:-"
 

@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from rigidlcp import models
-from rigidlcp.lcp import face as lcp_face
+from rigidlcp.lcp.faces import face as lcp_face
 from rigidlcp.models.lattice import PLANE
 
 

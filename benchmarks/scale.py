@@ -34,7 +34,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 import numpy as np  # noqa: E402
 
 from rigidlcp import models  # noqa: E402
-from rigidlcp.lcp.state_factor import ReducedLU  # noqa: E402
+from rigidlcp.lcp.solvers.state_factor import ReducedLU  # noqa: E402
 from rigidlcp.models.engine.sparse import simulate_sparse  # noqa: E402
 
 

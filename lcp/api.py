@@ -1,81 +1,28 @@
-"""One entry point, `solve(problem, method=...)`, and the registry of methods.
+"""The facade: one entry point, `solve(problem, method=...)`, over the table of methods.
 
 A method is a function `fn(M, q, **options) -> Solution` on a validated dense LCP; it is
-registered with `@register(name, accepts=..., description=..., equilibrate=False)`. `solve`
-validates the problem, reduces an MLCP to an LCP (Schur complement), calls the method (on the
-Ruiz-equilibrated data when `equilibrate`), and checks the answer on the user's problem with the
-acceptance test of `lcp.residual` (a method's own bookkeeping is never trusted): see lcp.trust.
+registered with `@register(name, accepts=..., description=..., equilibrate=False)` in
+lcp.registry (which imports no method and not this module; the built-in methods live in
+lcp/solvers/ and are loaded here on first use). Nothing in lcp/ below this module imports it.
+`solve` validates the problem, reduces an MLCP to an LCP (Schur complement), calls the
+method (on the Ruiz-equilibrated data when `equilibrate`), and checks the answer on the user's
+problem with the acceptance test of lcp.acceptance (a method's own bookkeeping is never
+trusted): see lcp.acceptance.trust.
 """
 
 from __future__ import annotations
 
-import inspect
-from collections.abc import Callable
-from dataclasses import dataclass, field
+import rigidlcp.lcp.registry as registry
 
-from .problem import LCP, MLCP, InvalidProblem, NotApplicable
-from .residual import TOL
-from .solution import Solution
-from .trust import Run, solve_checked
+from .acceptance.residual import TOL
+from .acceptance.trust import Run, solve_checked
+from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
+from .problems.solution import Solution
+from .registry import ACCEPTS, MethodInfo, check_options, lookup, register
+from .solvers import BUILTIN as _BUILTIN
 
-#: What a method accepts, as shown by `methods()`.
-ACCEPTS = {
-    "any": "any square M",
-    "symmetric-psd": "symmetric positive semidefinite M only",
-    "small-n": "any M, but only small n (exhaustive)",
-    "friction-2d": "2D friction-contact problems (lcp.FrictionContact2D) only",
-}
-
-
-@dataclass(frozen=True)
-class MethodInfo:
-    name: str
-    accepts: str
-    description: str
-    options: tuple[str, ...]
-    max_n: int | None
-    func: Callable[..., Solution]
-    #: problem kind ("mlcp", "friction-2d") -> a function taking that problem object itself
-    native: dict[str, Callable[..., Solution]] = field(default_factory=dict)
-    equilibrate: bool = False  # solve() runs it on Ruiz-equilibrated data by default
-
-    def __str__(self) -> str:
-        limit = f", n <= {self.max_n}" if self.max_n else ""
-        opts = ", ".join(self.options) or "-"
-        accepts = ACCEPTS[self.accepts]
-        return f"{self.name:<12} {accepts}{limit}. {self.description} [options: {opts}]"
-
-
-_REGISTRY: dict[str, MethodInfo] = {}
-
-
-def register(name: str, *, accepts: str, description: str, max_n: int | None = None,
-             native: dict[str, Callable[..., Solution]] | None = None,
-             equilibrate: bool = False):
-    """Decorator adding a method to the registry. `native` maps a problem kind ("mlcp",
-    "friction-2d") to a function `fn(problem, **options)` that solves it without reduction;
-    a method that accepts "friction-2d" is itself such a function. `equilibrate`: whether
-    `solve` runs it on the Ruiz-equilibrated problem by default (for methods whose answer
-    depends on the units)."""
-    if accepts not in ACCEPTS:
-        raise ValueError(f"accepts must be one of {sorted(ACCEPTS)}, got {accepts!r}")
-
-    def deco(func: Callable[..., Solution]) -> Callable[..., Solution]:
-        params = inspect.signature(func).parameters
-        options = tuple(p for p in params if params[p].kind is inspect.Parameter.KEYWORD_ONLY)
-        _REGISTRY[name] = MethodInfo(name, accepts, description, options, max_n, func,
-                                     dict(native or {}), equilibrate)
-        return func
-
-    return deco
-
-
-#: The built-in methods and the module that registers each (`get_method` imports only that one,
-#: so that e.g. lemke never loads the QP solvers).
-#: In the order lcp/methods.py registers them (the order `methods()` lists them in).
-_BUILTIN = {"enumerate": "enumeration", "lemke": "lemke", "enumerate-mlcp": "mlcp_full",
-            "newton-min": "newton", "newton-fb": "newton", "nsgs": "nsgs", "pgs": "pgs",
-            "pivoting": "pivoting", "qp-clarabel": "qp", "qp-osqp": "qp", "states": "states"}
+__all__ = ["solve", "get_method", "methods", "register", "MethodInfo", "ACCEPTS",
+           "check_options"]
 
 
 def methods() -> list[MethodInfo]:
@@ -83,34 +30,27 @@ def methods() -> list[MethodInfo]:
     whichever were loaded first by `get_method`)."""
     _load_builtin_methods()
     order = {name: i for i, name in enumerate(_BUILTIN)}
-    infos = list(_REGISTRY.values())
+    infos = list(registry._REGISTRY.values())
     return sorted(infos, key=lambda m: order.get(m.name, len(order)))
 
 
 def get_method(name: str) -> MethodInfo:
-    if name not in _REGISTRY:
+    """The registered method `name`, importing its built-in module (lcp/solvers/) on first use;
+    InvalidProblem naming the available methods when there is none."""
+    info = lookup(name)
+    if info is None:
         if name in _BUILTIN:
             import importlib
 
-            importlib.import_module(f"{__package__}.{_BUILTIN[name]}")
+            importlib.import_module(f"{__package__}.solvers.{_BUILTIN[name]}")
         else:
             _load_builtin_methods()
-    try:
-        return _REGISTRY[name]
-    except KeyError:
+        info = lookup(name)
+    if info is None:
         raise InvalidProblem(
-            f"unknown method {name!r}; available: {', '.join(sorted(_REGISTRY))}"
-        ) from None
-
-
-def check_options(info: MethodInfo, options: dict) -> None:
-    """Raise InvalidProblem naming the options `info`'s method does not accept."""
-    unknown = set(options) - set(info.options)
-    if unknown:
-        raise InvalidProblem(
-            f"method {info.name!r} does not accept option(s) {sorted(unknown)}; "
-            f"it accepts {list(info.options) or 'none'}"
+            f"unknown method {name!r}; available: {', '.join(sorted(registry._REGISTRY))}"
         )
+    return info
 
 
 def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | None = None,
@@ -142,7 +82,7 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
             return sol
     friction = not isinstance(problem, (LCP, MLCP))
     if friction:  # imported only then: lcp.friction loads scipy.sparse
-        from .friction import FrictionContact2D
+        from .problems.friction import FrictionContact2D
 
         if not isinstance(problem, FrictionContact2D):
             raise InvalidProblem(
@@ -152,13 +92,13 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     info = get_method(method)
     check_options(info, options)
     if friction:
-        from .friction import solve_friction
+        from .acceptance.friction import solve_friction
 
         return solve_friction(problem, info, dict(options))
     if info.accepts == "friction-2d":
         raise NotApplicable(f"method {method!r} solves 2D friction-contact problems only")
     if isinstance(problem, MLCP):
-        from .mlcp_full import solve_mlcp_unreduced
+        from .solvers.mlcp_full import solve_mlcp_unreduced
 
         sol = solve_mlcp_unreduced(problem, info, options)
         if sol is not None:
@@ -178,7 +118,7 @@ def _fallbacks(fallback) -> tuple[str, ...]:
     if fallback is False or fallback is None:
         return ()
     if fallback is True:
-        from .trust import FALLBACKS
+        from .acceptance.trust import FALLBACKS
 
         return FALLBACKS
     names = (fallback,) if isinstance(fallback, str) else fallback
@@ -202,17 +142,17 @@ _FAST_METHODS = ("lemke", "pivoting")
 
 
 def _fast(method: str):
-    """lcp.fast_lemke.solve_lemke or lcp.fast_pivoting.solve_pivoting (imported on first use:
-    they import the method's module, which imports this module)."""
+    """lcp.solvers.fast_lemke.solve_lemke or lcp.solvers.fast_pivoting.solve_pivoting
+    (imported on first use: they load the method's module, hence numpy's LAPACK paths)."""
     global _FAST, _FAST_PIVOTING
     if method == "lemke":
         if _FAST is None:
-            from .fast_lemke import solve_lemke
+            from .solvers.fast_lemke import solve_lemke
 
             _FAST = solve_lemke
         return _FAST
     if _FAST_PIVOTING is None:
-        from .fast_pivoting import solve_pivoting
+        from .solvers.fast_pivoting import solve_pivoting
 
         _FAST_PIVOTING = solve_pivoting
     return _FAST_PIVOTING
@@ -223,16 +163,18 @@ _LOADED = False
 
 def _load_builtin_methods() -> None:
     # Importing the method modules registers them (done lazily to keep import cheap).
-    # `from . import methods` would find the *function* lcp.methods and import nothing, and
-    # importing the submodule rebinds the package attribute `methods` to it: undo that.
     global _LOADED
     if _LOADED:
         return
     import importlib
-    import sys
 
-    importlib.import_module(f"{__package__}.methods")
+    for module in dict.fromkeys(_BUILTIN.values()):
+        importlib.import_module(f"{__package__}.solvers.{module}")
     _LOADED = True
-    package = sys.modules[__package__]
-    if getattr(package, "methods", None) is not methods:
-        package.methods = methods
+
+
+def __getattr__(name: str):
+    # api._REGISTRY: the table itself (lcp.registry._REGISTRY, read where it is now)
+    if name == "_REGISTRY":
+        return registry._REGISTRY
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,10 +22,10 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from .accuracy import judge_lcp
+from .acceptance.accuracy import judge_lcp
 from .api import check_options, get_method, solve
-from .problem import LCP, MLCP, InvalidProblem
-from .solution import Solution, solved_lcp
+from .problems.problem import LCP, MLCP, InvalidProblem
+from .problems.solution import Solution, solved_lcp
 
 #: Methods whose batch path runs the whole loop over the problems in compiled code (the others
 #: are a loop of their Python function with one lookup and one option check).
@@ -54,7 +54,7 @@ def solve_many(
             problems[0], (LCP, MLCP)):
         Ms, qs = _stacked(*problems)
         return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]), repair)
-    from .friction import FrictionContact2D
+    from .problems.friction import FrictionContact2D
 
     problems = list(problems)
     for i, p in enumerate(problems):
@@ -106,7 +106,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     method runs on the Ruiz-equilibrated data when it is registered so, and each answer is
     checked on the problem passed (lcp.residual); an answer that is not an accepted "solved"
     is redone by `solve` itself (repairs, certificates of infeasibility)."""
-    from .scaling import ruiz
+    from .acceptance.scaling import ruiz
 
     k, n = qs.shape
     info = get_method(method)
@@ -140,7 +140,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
 
 
 def _builtin_lemke():
-    from .lemke import lemke
+    from .solvers.lemke import lemke
 
     return lemke
 
@@ -153,8 +153,8 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     C, the same numbers as `check`). A problem not solved or not accepted there -- a ray, a
     limit, a cycle, an M that is not balanced, an answer that fails the test -- is solved by
     `solve` itself, which answers it as a single call does."""
-    from .lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
-    from .residual import TOL
+    from .acceptance.residual import TOL
+    from .solvers.lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
 
     k, n = qs.shape
     d = _covering_vector(options.get("d"), n)

@@ -6,7 +6,7 @@ toolkit's errors. Each class also derives from ValueError where the error is abo
 caller passed, so that `except ValueError` keeps working.
 
 A solver that runs and fails is *not* an exception: it returns a `Solution` whose status says
-what happened, with its evidence (lcp/solution.py).
+what happened, with its evidence (lcp/problems/solution.py).
 """
 
 from __future__ import annotations

@@ -28,7 +28,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidlcp.lcp import LCP, MLCP
-from rigidlcp.lcp.friction import FrictionContact2D
+from rigidlcp.lcp.problems.friction import FrictionContact2D
 
 from .dynamics import Dynamics
 from .system import System

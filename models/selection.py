@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigidlcp.lcp import LCP
-from rigidlcp.lcp.face import face_minimum_norm
+from rigidlcp.lcp.faces.face import face_minimum_norm
 
 from .lattice import InvalidSystem
 

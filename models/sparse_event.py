@@ -11,7 +11,7 @@ fill*: every relative acceleration is a = W lambda + q with the sparse Delassus 
 W = H M^-1 H' (about 17 entries per row for a rectangular array) and lambda = [R; S].
 
 The contact-state solver (the active system K(states), its sparse LU with row updates, the
-constants) lives in rigidlcp.lcp.state_factor and is re-exported here.
+constants) lives in rigidlcp.lcp.solvers.state_factor and is re-exported here.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from rigidlcp.lcp.state_factor import (  # noqa: F401  (re-exported: models' own names)
+from rigidlcp.lcp.solvers.state_factor import (  # noqa: F401  (re-exported: models' own names)
     NS,
     PERMC,
     PIVOT_RATIO,

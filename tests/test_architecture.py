@@ -155,7 +155,7 @@ def test_import_rigidlcp_is_cheap_and_complete():
 def test_engine_functions_are_short():
     """The event engine (the loop, its backends, records, simulate) reads as steps: no function
     over ~60 lines. (The sparse backend's solver, contact-state pivoting, is an algorithm of its
-    own in lcp/state_pivoting.py, re-exported by models/engine/sparse_pivoting.py.)"""
+    own in lcp/solvers/state_pivoting.py, re-exported by models/engine/sparse_pivoting.py.)"""
     long = []
     for path in (ROOT / "models" / "engine").glob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
@@ -169,7 +169,7 @@ def test_engine_functions_are_short():
 def test_no_two_models_modules_import_each_other():
     """Not even inside functions (issue 24.8: models/engine/simulate.py <-> sparse.py through
     blas_limit, now in loop.py below both): a piece two modules share lives below both.
-    (The floor `lcp` keeps its lazy method registry, lcp/api.py <-> the methods it lists.)"""
+    (lcp/ is checked room by room: test_lcp_rooms_import_downwards.)"""
     modules = {n: p for n, p in _modules().items() if _floor(n) == "rigidlcp.models"}
     deps = {name: {t for t in _imports(name, path) if t in modules and t != name}
             for name, path in modules.items()}
@@ -180,16 +180,10 @@ def test_no_two_models_modules_import_each_other():
 
 
 #: Import cycles through imports inside functions, known when this test was written (issue 24.8
-#: names the engine's; the lcp/ and bench/ ones are left to their owners). The test fails on
-#: any other: a new cycle, or a known one that grows. Remove an entry once its cycle is gone.
-KNOWN_FUNCTION_LEVEL_CYCLES = [
-    {"rigidlcp.bench.fuzz", "rigidlcp.bench.fuzz_files"},
-    {"rigidlcp.lcp.api", "rigidlcp.lcp.fast_lemke", "rigidlcp.lcp.fast_pivoting",
-     "rigidlcp.lcp.friction", "rigidlcp.lcp.io.numerics_matrix", "rigidlcp.lcp.io.siconos",
-     "rigidlcp.lcp.io.siconos_fc2d", "rigidlcp.lcp.io.siconos_mlcp", "rigidlcp.lcp.io.text",
-     "rigidlcp.lcp.lemke", "rigidlcp.lcp.mlcp_full", "rigidlcp.lcp.pivoting",
-     "rigidlcp.lcp.problem", "rigidlcp.lcp.trust"},
-]
+#: names the engine's; lcp/'s 14-module one through lcp/api.py went with its rooms, issue 23.5,
+#: and bench.fuzz <-> fuzz_files with bench/fuzz_judge.py below both). The test fails on any
+#: other: a new cycle, or a known one that grows. Remove an entry once its cycle is gone.
+KNOWN_FUNCTION_LEVEL_CYCLES: list[set[str]] = []
 
 
 def _cycles(graph: dict[str, set[str]]) -> list[set[str]]:
@@ -238,3 +232,42 @@ def test_no_new_import_cycles_inside_functions():
     new = [sorted(c) for c in _cycles(graph)
            if not any(c <= known for known in KNOWN_FUNCTION_LEVEL_CYCLES)]
     assert new == []
+
+
+#: The rooms of lcp/ (docs/architecture.md, "The rooms of lcp/"), lowest first: a module imports
+#: only from its own room or a lower level; rooms on one level (solvers, faces) do not import
+#: each other. errors.py, quiet.py, _lemke_kernel.py and io/files.py are leaves every room uses.
+LCP_LEVELS = {
+    "errors": 0, "quiet": 1, "_lemke_kernel": 1, "io.files": 1,
+    "problems": 2, "io": 3, "acceptance": 4, "registry": 5, "solvers": 6, "faces": 6,
+    "api": 7, "batch": 8,
+}
+
+
+def _room(name: str) -> str | None:
+    """The room of an lcp module (None for the package rigidlcp.lcp itself)."""
+    parts = name.split(".")[2:]
+    if not parts:
+        return None
+    return "io.files" if parts[:2] == ["io", "files"] else parts[0]
+
+
+def test_lcp_rooms_import_downwards():
+    """The registry imports only data types, the methods import the registry, `solve` (api)
+    imports them all, and nothing below the facade imports it (issue 23.5): at any depth,
+    imports inside functions included."""
+    modules = _modules()
+    wrong = []
+    for name, path in modules.items():
+        if _floor(name) != "rigidlcp.lcp" or _room(name) is None:
+            continue
+        src = _room(name)
+        for target in _imports(name, path):
+            if target not in modules:
+                target = target.rsplit(".", 1)[0]
+            dst = _room(target) if target in modules else None
+            if dst is None or dst == src:
+                continue
+            if not LCP_LEVELS[dst] < LCP_LEVELS[src]:
+                wrong.append(f"{name} -> {target}")
+    assert wrong == []

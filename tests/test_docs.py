@@ -91,9 +91,9 @@ def test_python_blocks_run(path: Path, tmp_path, monkeypatch):
     # Blocks may register methods (docs/bench.md registers "mine", whose body is `...`): they
     # go into a copy of the registry, dropped after the test, so that later tests that run
     # every registered method do not meet them (they did, in pytest 7.1's collection order).
-    from rigidlcp.lcp import api
+    from rigidlcp.lcp import api, registry
     api._load_builtin_methods()
-    monkeypatch.setattr(api, "_REGISTRY", dict(api._REGISTRY))
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
     namespace: dict = {"__name__": f"docs_{path.stem}"}
     ran = 0
     for line, c, why in code:

@@ -282,7 +282,7 @@ def examine_steady_states(system: models.System, ed: Run, ts: Run, h: float) -> 
     least sum R, then least |lambda|); each integrator is also restarted from the other's
     steady state."""
     from rigidlcp import lcp
-    from rigidlcp.lcp.face import face_minimum_norm
+    from rigidlcp.lcp.faces.face import face_minimum_norm
     from rigidlcp.models.observables import global_friction_coefficient
 
     E, T = ed.last, ts.last

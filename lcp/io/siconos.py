@@ -45,7 +45,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ..problem import LCP, MLCP
+from ..problems.problem import LCP, MLCP
 from .numerics_matrix import STORAGE, read_numerics_matrix, write_numerics_matrix
 from .text import (
     KIND_NAMES,

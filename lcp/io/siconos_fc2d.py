@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..friction import FrictionContact2D
+from ..problems.friction import FrictionContact2D
 from .numerics_matrix import read_numerics_matrix, write_numerics_matrix
 from .text import Tokens, WrongKind, check_kind, write_new
 

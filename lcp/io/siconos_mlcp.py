@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..problem import MLCP
+from ..problems.problem import MLCP
 from .numerics_matrix import read_numerics_matrix, write_numerics_matrix
 from .text import Tokens, UnsupportedProblem, check_kind, write_new
 

@@ -10,7 +10,7 @@ import re
 
 import numpy as np
 
-from ..problem import InvalidProblem, NotApplicable
+from ..problems.problem import InvalidProblem, NotApplicable
 
 
 class FileFormatError(InvalidProblem):

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp import lcp
-from rigidlcp.lcp.face import face_minimum_norm, global_minimum_norm
+from rigidlcp.lcp.faces.face import face_minimum_norm, global_minimum_norm
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import (
     EventProblem,

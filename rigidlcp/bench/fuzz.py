@@ -4,9 +4,9 @@
 in turn), runs every method of `lcp.methods()` on each (enumerate only for n <= ENUM_MAX_N),
 and judges each answer with what is known *without the solvers*:
 
-* "solved": w = M z + q recomputed here and the scaled residual of verify.certify's acceptance
-  test (re-implemented below, not imported from the solver side) <= 1e-8 on the problem as
-  generated (unscaled). Otherwise SILENT WRONG.
+* "solved": w = M z + q recomputed and the scaled residual of verify.certify's acceptance
+  test (re-implemented in rigidlcp.bench.fuzz_judge, not imported from the solver side)
+  <= 1e-8 on the problem as generated (unscaled). Otherwise SILENT WRONG.
 * "infeasible": true only if the LCP has no feasible point, decided by an LP (HiGHS through
   scipy, on the problem as generated, after a Ruiz-free row normalization) and, for n <= 10,
   by the enumeration of every complementary basis finding nothing; it is SILENT WRONG for a
@@ -38,84 +38,22 @@ from rigidlcp.lcp.batch import COMPILED_BATCH
 from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
+from .fuzz_judge import (  # noqa: F401 (judge_residual, lp_feasible: public here too)
+    ENUM_MAX_N,
+    OPTIONS,
+    OUTCOMES,
+    TOL,
+    attempt,
+    judge,
+    judge_residual,
+    lp_feasible,
+    save_case,
+)
 from .own import OWN_ANSWER
 
-#: The exhaustive methods (accepts "small-n": enumerate, enumerate-mlcp; 2^n bases) are run
-#: for n up to this in the fuzz.
-ENUM_MAX_N = 10
-#: Acceptance tolerance of verify.certify.
-TOL = 1e-8
-#: Options per method, to bound the time of slow iterations (pgs sweeps in pure Python).
-OPTIONS = {"pgs": {"max_iter": 2000}}
-OUTCOMES = ("solved", "honest", "refused", "crash", "WRONG")
 #: Cases drawn at a time: the methods with a compiled batch path (lcp.batch.COMPILED_BATCH:
 #: lemke) solve them in one lcp.solve_many call; the others one by one.
 CHUNK = 64
-
-
-def judge_residual(M: np.ndarray, q: np.ndarray, z: np.ndarray) -> float:
-    """max|min(z/z_s, w/w_s)| with z_s = max(|z|, |q|/|M|max), w_s = |q| + ||M||_inf z_s."""
-    z = np.asarray(z, dtype=float)
-    if z.shape != q.shape or not np.all(np.isfinite(z)):
-        return np.inf
-    mmax = float(np.abs(M).max())
-    zs = max(float(np.abs(z).max()), float(np.abs(q).max()) / mmax if mmax else 0.0) or 1.0
-    ws = (float(np.abs(q).max()) + float(np.abs(M).sum(axis=1).max()) * zs) or 1.0
-    return float(np.max(np.abs(np.minimum(z / zs, (M @ z + q) / ws))))
-
-
-def lp_feasible(M: np.ndarray, q: np.ndarray) -> bool | None:
-    """Has {z >= 0 : M z + q >= 0} a point? (HiGHS; rows normalized by their largest entry.)"""
-    from scipy.optimize import linprog  # on first use: `rigidlcp --help` loads no scipy
-
-    s = np.maximum(np.abs(M).max(axis=1), np.abs(q))
-    s[s == 0] = 1.0
-    res = linprog(np.zeros(q.size), A_ub=-M / s[:, None], b_ub=q / s,
-                  bounds=[(0, None)] * q.size, method="highs")
-    return {0: True, 2: False}.get(res.status)
-
-
-def judge(case: Case, status: str, z: np.ndarray) -> tuple[str, str]:
-    """(outcome, reason) of one answer; see the module docstring."""
-    if status == "solved":
-        if case.solvable is False:
-            return "WRONG", "solved, but the problem is infeasible by construction"
-        r = judge_residual(case.M, case.q, z)
-        return ("solved", "") if r <= TOL else ("WRONG", f"solved with scaled residual {r:.3g}")
-    if status != "infeasible":
-        return "honest", status
-    if case.solvable:
-        return "WRONG", "infeasible, but the problem is solvable by construction"
-    if case.solvable is False:
-        return "solved", ""
-    feasible = lp_feasible(case.M, case.q)
-    if feasible is False:
-        return "solved", ""
-    if case.n <= ENUM_MAX_N:
-        if not lcp.enumerate_solutions(lcp.LCP(case.M, case.q)):
-            return "solved", ""
-        return "WRONG", "infeasible, but the enumeration finds a solution"
-    return "WRONG", f"infeasible not confirmed (LP feasible: {feasible})"
-
-
-def attempt(problem, method: str) -> tuple[lcp.Solution | None, dict]:
-    """Solve, timed, the method's own answer (no other method's answer substituted:
-    bench.own.OWN_ANSWER); (None, result) when the method refused or crashed, else (solution,
-    {"seconds": ...}) for the judge."""
-    t0 = time.perf_counter()
-    try:
-        sol = lcp.solve(problem, method, **OWN_ANSWER, **OPTIONS.get(method, {}))
-    except lcp.NotApplicable as exc:
-        return None, {"outcome": "refused", "reason": str(exc),
-                      "seconds": time.perf_counter() - t0}
-    except Exception as exc:  # noqa: BLE001 - a crash is what the harness is looking for
-        return None, {"outcome": "crash", "reason": f"{type(exc).__name__}: {exc}",
-                      "seconds": time.perf_counter() - t0}
-    seconds = time.perf_counter() - t0
-    if "exception" in sol.info:
-        return None, {"outcome": "crash", "reason": sol.info["exception"].strip(),
-                      "seconds": seconds}
-    return sol, {"seconds": seconds, "status": sol.status}
 
 
 def batch_attempt(cases: list[Case], method: str) -> list[tuple[lcp.Solution, dict]] | None:
@@ -155,14 +93,6 @@ def run_case(case: Case, method: str, done: tuple | None = None) -> dict:
     if sol is not None:
         res["outcome"], res["reason"] = judge(case, sol.status, sol.z)
     return res
-
-
-def save_case(case: Case, method: str, result: dict, out: Path) -> Path:
-    meta = {"class": case.kind, "seed": case.seed, "method": method,
-            "outcome": result["outcome"], "reason": result["reason"],
-            "p_matrix": case.p_matrix, "solvable": case.solvable}
-    return lcp.LCP(case.M, case.q, name=f"{case.kind}-{case.seed}-{method}",
-                   meta=meta).save(out / f"{case.kind}-{case.seed}-{method}.npz")
 
 
 def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,

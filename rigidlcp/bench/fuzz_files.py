@@ -19,8 +19,8 @@ import numpy as np
 
 from rigidlcp import lcp
 
-from .fuzz import ENUM_MAX_N, OUTCOMES, TOL, attempt, judge, save_case
 from .fuzz_cases import Case
+from .fuzz_judge import ENUM_MAX_N, OUTCOMES, TOL, attempt, judge, save_case
 
 
 def judge_mlcp(P: lcp.MLCP, status: str, u: np.ndarray | None, v: np.ndarray) -> tuple[str, str]:

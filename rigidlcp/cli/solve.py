@@ -15,7 +15,8 @@ import math
 from typing import Any
 
 from rigidlcp.lcp.api import ACCEPTS, methods, solve
-from rigidlcp.lcp.problem import InvalidProblem, load
+from rigidlcp.lcp.errors import InvalidProblem
+from rigidlcp.lcp.io.load import load
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:

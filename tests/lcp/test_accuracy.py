@@ -19,12 +19,12 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import api
-from rigidlcp.lcp import lemke as lemke_module
-from rigidlcp.lcp.accuracy import FERR_TOL, assess_lcp, backward_error
-from rigidlcp.lcp.farkas import RADIUS, check_certificate, exact_certificate
-from rigidlcp.lcp.lemke_exact import lemke_exact
-from rigidlcp.lcp.residual import TOL, scaled_residual
-from rigidlcp.lcp.scaling import ruiz
+from rigidlcp.lcp.acceptance.accuracy import FERR_TOL, assess_lcp, backward_error
+from rigidlcp.lcp.acceptance.farkas import RADIUS, check_certificate, exact_certificate
+from rigidlcp.lcp.acceptance.residual import TOL, scaled_residual
+from rigidlcp.lcp.acceptance.scaling import ruiz
+from rigidlcp.lcp.solvers import lemke as lemke_module
+from rigidlcp.lcp.solvers.lemke_exact import lemke_exact
 from rigidlcp.verify import certify
 
 SICONOS_MLCP = Path("/work/shared/data/siconos/mlcp")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from rigidlcp import lcp
-from rigidlcp.lcp.face import face_minimum_norm, global_minimum_norm
+from rigidlcp.lcp.faces.face import face_minimum_norm, global_minimum_norm
 
 # w = M z + q with M = [[1, 1], [1, 1]], q = (-1, -1): every z >= 0 with z1 + z2 = 1 solves it.
 SEGMENT = lcp.LCP(np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([-1.0, -1.0]))

@@ -8,9 +8,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rigidlcp import lcp
-from rigidlcp.lcp import face_coords as fc
-from rigidlcp.lcp import face_reference as fr
-from rigidlcp.lcp.face import face_minimum_norm
+from rigidlcp.lcp.faces import face_coords as fc
+from rigidlcp.lcp.faces import face_reference as fr
+from rigidlcp.lcp.faces.face import face_minimum_norm
 
 
 def rank_deficient(rng, n, r, scale=1.0, symmetric=False):
@@ -139,7 +139,7 @@ def test_face_minimum_norm_paths_agree(seed, n, frac, degenerate, symmetric, use
 
 
 def test_small_path_falls_back_to_the_reference(monkeypatch):
-    from rigidlcp.lcp import face
+    from rigidlcp.lcp.faces import face
 
     problem = lcp.LCP(np.array([[1.0, 1.0], [1.0, 1.0]]), np.array([-1.0, -1.0]))
     monkeypatch.setattr(face, "small_qp", lambda *a, **k: None)

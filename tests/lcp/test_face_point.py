@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rigidlcp import lcp
-from rigidlcp.lcp.face import face_is_point, face_minimum_norm
+from rigidlcp.lcp.faces.face import face_is_point, face_minimum_norm
 
 from .test_lemke import degenerate_integer_lcps, friction_lcp
 

@@ -1,4 +1,4 @@
-"""The fast path of `lcp.solve` (lcp/fast_lemke.py), the C measure of lcp.residual and the
+"""The fast path of `lcp.solve` (lcp/solvers/fast_lemke.py), the C measure of lcp.residual and the
 batch path give exactly what the general path gives: the same Solution, field for field and
 bit for bit, on random, degenerate and badly scaled problems; anything else (bad input, other
 options, a ray, no compiled kernel) goes to the general path, which answers or raises as
@@ -15,10 +15,12 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import api, fast_lemke, residual
+from rigidlcp.lcp import api
+from rigidlcp.lcp.acceptance import residual
+from rigidlcp.lcp.acceptance.scaling import _pow2, ruiz
 from rigidlcp.lcp.errors import RigidLCPError
-from rigidlcp.lcp.scaling import _pow2, ruiz
-from rigidlcp.lcp.solution import Solution, solved_lcp
+from rigidlcp.lcp.problems.solution import Solution, solved_lcp
+from rigidlcp.lcp.solvers import fast_lemke
 
 from .test_lemke import degenerate_integer_lcps
 

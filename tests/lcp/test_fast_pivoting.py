@@ -1,8 +1,8 @@
-"""The fast path of `lcp.solve(problem, "pivoting")` (lcp/fast_pivoting.py, lcp/_pivot_c.c)
-gives exactly what the general path gives -- the same Solution, field for field and bit for
-bit -- on random, PSD, P-matrix, badly scaled and degenerate integer problems, and declines
-(None: the general path runs from the start) on everything else: a singular start, a single
-or exchange pivot, bad data, options, Fortran order, no compiled kernel."""
+"""The fast path of `lcp.solve(problem, "pivoting")` (lcp/solvers/fast_pivoting.py,
+lcp/solvers/_pivot_c.c) gives exactly what the general path gives -- the same Solution, field
+for field and bit for bit -- on random, PSD, P-matrix, badly scaled and degenerate integer
+problems, and declines (None: the general path runs from the start) on everything else: a
+singular start, a single or exchange pivot, bad data, options, Fortran order, no compiled kernel."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import api, fast_pivoting
-from rigidlcp.lcp.solution import Solution
+from rigidlcp.lcp import api
+from rigidlcp.lcp.problems.solution import Solution
+from rigidlcp.lcp.solvers import fast_pivoting
 
 from .test_fast_lemke import outcome, random_lcps, same
 from .test_lemke import degenerate_integer_lcps
@@ -255,7 +256,7 @@ def test_rcond_shortcut_bounds_dgecons_estimate(A):
     shortcut fires dgecon would have found rcond >= 10 RCOND, the same 'nonsingular'."""
     from scipy.linalg.lapack import dgecon
 
-    from rigidlcp.lcp.pivoting import RCOND
+    from rigidlcp.lcp.solvers.pivoting import RCOND
 
     bound, lu = fast_pivoting._pivot_c.rcond_shortcut(A)
     m = A.shape[0]
@@ -273,7 +274,7 @@ def test_rcond_shortcut_bounds_dgecons_estimate(A):
 def test_rcond_shortcut_fires_on_well_conditioned_bases():
     """Not vacuous: on well-conditioned matrices the bound is within the limit (dgecon is
     skipped), on a singular-to-rounding one it is not."""
-    from rigidlcp.lcp.pivoting import RCOND
+    from rigidlcp.lcp.solvers.pivoting import RCOND
 
     rng = np.random.default_rng(5)
     for m in (1, 2, 6, 20):

@@ -11,8 +11,8 @@ import pytest
 import scipy.sparse as sp
 
 from rigidlcp import lcp, verify
-from rigidlcp.lcp.enumeration import enumerate_solutions
-from rigidlcp.lcp.friction import natural_residual, project_cone
+from rigidlcp.lcp.problems.friction import natural_residual, project_cone
+from rigidlcp.lcp.solvers.enumeration import enumerate_solutions
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "siconos"
 FC_METHODS = ["lemke", "pivoting", "enumerate", "states", "nsgs", "newton-min", "newton-fb"]

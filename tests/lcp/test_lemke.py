@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rigidlcp import lcp
-from rigidlcp.lcp.lemke import lemke
+from rigidlcp.lcp.solvers.lemke import lemke
 
 # --------------------------------------------------------------------------------------------
 # Exact reference: Lemke's method with the lexicographic ratio test, in rational arithmetic.
@@ -409,7 +409,7 @@ def test_lemke_is_registered():
 def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
     """A basis that repeats proves rounding defeated the lexicographic rule: Lemke says so and
     restarts with coarser ties. Forced here: the first attempt reports a cycle."""
-    import rigidlcp.lcp.lemke as lemke_module
+    import rigidlcp.lcp.solvers.lemke as lemke_module
 
     M = np.array([[2.0, 1.0], [1.0, 2.0]])
     q = np.array([-1.0, -1.0])
@@ -427,7 +427,7 @@ def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
 
     monkeypatch.setattr(lemke_module._Lemke, "run", run_cycling_once)
     monkeypatch.setattr(lemke_module._kernel, "_use", False)  # no whole-run fast path
-    # n <= EXACT_MAX_N: the rerun is exact (lcp/lemke_exact.py; issue 23)
+    # n <= EXACT_MAX_N: the rerun is exact (lcp/solvers/lemke_exact.py; issue 23)
     sol = lcp.solve(lcp.LCP(M, q), "lemke")
     assert sol.success and calls["n"] == 1 and sol.info["exact"]
     assert "exact rational arithmetic" in sol.message

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp.lemke import _Lemke
+from rigidlcp.lcp.solvers.lemke import _Lemke
 
 from .test_lemke import degenerate_integer_lcps, friction_lcp, murty_matrix, murty_q
 

@@ -8,7 +8,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from rigidlcp import lcp
-from rigidlcp.lcp.enumeration import enumerate_solutions
+from rigidlcp.lcp.solvers.enumeration import enumerate_solutions
 from rigidlcp.verify.strategies import degenerate_lcps, lcps, mlcps, p_matrices, symmetric_psd
 
 SETTINGS = settings(max_examples=40, deadline=None,

@@ -16,9 +16,15 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import spsolve
 
 from rigidlcp import lcp, models
-from rigidlcp.lcp import state_pivoting
-from rigidlcp.lcp.state_factor import NS, ActiveSystem, ReducedLU, SingularSystem, StateFactor
-from rigidlcp.lcp.state_pivoting import _one_per_component, solve_states
+from rigidlcp.lcp.solvers import state_pivoting
+from rigidlcp.lcp.solvers.state_factor import (
+    NS,
+    ActiveSystem,
+    ReducedLU,
+    SingularSystem,
+    StateFactor,
+)
+from rigidlcp.lcp.solvers.state_pivoting import _one_per_component, solve_states
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import initial_state
 from rigidlcp.models.sparse_event import sparse_delassus
@@ -217,7 +223,7 @@ def test_reduced_lu_solves_what_the_whole_system_solves(seed):
 def test_reduced_and_whole_factorizations_give_the_same_event(monkeypatch):
     """One event of a frictional array from the same start: the same states and forces with
     the reduced LU and with SuperLU of all of K."""
-    from rigidlcp.lcp import state_factor
+    from rigidlcp.lcp.solvers import state_factor
 
     asys, s = disk_system(2)
     c = asys.c

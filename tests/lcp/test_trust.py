@@ -15,10 +15,10 @@ from hypothesis import strategies as st
 from rigidlcp import lcp
 from rigidlcp.bench.fuzz_cases import robust_infeasible
 from rigidlcp.lcp import api
-from rigidlcp.lcp.enumeration import _Scales, _singular_basis
-from rigidlcp.lcp.farkas import find_certificate
-from rigidlcp.lcp.residual import TOL, check, scaled_residual
-from rigidlcp.lcp.scaling import ruiz
+from rigidlcp.lcp.acceptance.farkas import find_certificate
+from rigidlcp.lcp.acceptance.residual import TOL, check, scaled_residual
+from rigidlcp.lcp.acceptance.scaling import ruiz
+from rigidlcp.lcp.solvers.enumeration import _Scales, _singular_basis
 from rigidlcp.verify import certify
 
 SEEDS = st.integers(0, 2**32 - 1)

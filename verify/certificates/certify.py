@@ -33,8 +33,8 @@ import numpy as np
 
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP, MLCP, NotApplicable, Solution, enumerate_solutions
-from rigidlcp.lcp.accuracy import assess_problem
-from rigidlcp.lcp.residual import check
+from rigidlcp.lcp.acceptance.accuracy import assess_problem
+from rigidlcp.lcp.acceptance.residual import check
 
 from .friction import forces_map, friction_certificate
 from .stages import OTHER, UNIQUE, certify_stages

@@ -41,7 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp.lcp import LCP, Solution, solve
-from rigidlcp.lcp.residual import check
+from rigidlcp.lcp.acceptance.residual import check
 
 from .bounds import no_solution_beyond
 from .faces import FaceLP, null_directions

@@ -33,8 +33,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint, linprog, milp
 
+from rigidlcp.lcp.acceptance.residual import scaled_residual, scales
 from rigidlcp.lcp.quiet import quiet_stdout
-from rigidlcp.lcp.residual import scaled_residual, scales
 
 from .pmatrix import P_MINORS_MAX_N, RCOND, PMatrixTest, p_matrix_test
 

@@ -19,7 +19,7 @@ import pytest
 
 from rigidlcp import lcp, models
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import face as lcp_face
+from rigidlcp.lcp.faces import face as lcp_face
 
 DATA = Path(__file__).parents[2] / "data"
 FIELDS = ("t", "V", "omega", "omega_dot", "R", "S", "s", "s_in", "vt", "at", "mu_g",

@@ -18,9 +18,9 @@ import math
 
 import numpy as np
 
-from .api import register
-from .problem import InvalidProblem, NotApplicable, as_vector
-from .solution import Solution, complementarity_residual
+from ..problems.problem import InvalidProblem, NotApplicable, as_vector
+from ..problems.solution import Solution, complementarity_residual
+from ..registry import register
 
 
 @register(

@@ -33,9 +33,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .api import register
-from .problem import MLCP, InvalidProblem
-from .solution import Solution
+from ..problems.problem import MLCP, InvalidProblem
+from ..problems.solution import Solution
+from ..registry import register
 
 SIGMA, BETA, RHO, P_DFK = 1e-4, 0.5, 1e-10, 2.1
 

@@ -27,10 +27,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .api import register
-from .friction import FrictionContact2D, natural_residual, project_cone
-from .problem import InvalidProblem
-from .solution import Solution
+from ..problems.friction import FrictionContact2D, natural_residual, project_cone
+from ..problems.problem import InvalidProblem
+from ..problems.solution import Solution
+from ..registry import register
 
 
 def _local(Waa: np.ndarray, qt: np.ndarray, mu: float, r: np.ndarray) -> tuple[np.ndarray, bool]:

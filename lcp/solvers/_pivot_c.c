@@ -1,5 +1,5 @@
-/* The common case of method `pivoting` (lcp/pivoting.py) in C, for lcp.solve's fast path
- * (lcp/fast_pivoting.py): the Ruiz equilibration of a balanced M (or the factors of `ruiz`
+/* The common case of method `pivoting` (lcp/solvers/pivoting.py) in C, for lcp.solve's fast path
+ * (lcp/solvers/fast_pivoting.py): the Ruiz equilibration of a balanced M (or the factors of `ruiz`
  * given), then block principal pivoting steps only -- each failing index flipped at once, as
  * long as |H| lowers its record or tries remain, each new basis nonsingular by the same test --
  * until no inequality fails; z in the user's units. Anything else the Python method would do (a
@@ -11,7 +11,7 @@
  * scipy.linalg.cython_lapack and cython_blas, passed once by `init`), called as
  * scipy.linalg.lapack's wrappers and numpy's matmul call them (a matrix-vector product of a
  * C-contiguous matrix: gemv 'T' on its rows; an 1 x 1 one: 0 + ddot); the rest -- sums, maxima,
- * the sign tests -- are the numpy operations in numpy's order. lcp/fast_pivoting.py checks once,
+ * the sign tests -- are the numpy operations in numpy's order. lcp/solvers/fast_pivoting.py checks once,
  * on a probe, that scipy's gemv rounds as numpy's matmul (numpy links its own BLAS), and
  * tests/lcp/test_fast_pivoting.py compares whole Solutions.
  *
@@ -44,9 +44,9 @@ static dot_t *ddot;
 #define DECLINE 1
 #define NEEDS_RUIZ 4
 #define NOT_FINITE 5
-#define BALANCED 16.0 /* lcp/scaling.py */
-#define RCOND 1e-13   /* lcp/pivoting.py */
-#define FLOOR 1e-4    /* lcp/pivoting.py */
+#define BALANCED 16.0 /* lcp/acceptance/scaling.py */
+#define RCOND 1e-13   /* lcp/solvers/pivoting.py */
+#define FLOOR 1e-4    /* lcp/solvers/pivoting.py */
 
 /* y = A x as numpy's matmul computes it for A m x m C-contiguous, x of length m: gemv 'T' on
  * the rows (numpy's DOUBLE_gemv: cblas ColMajor Trans), or 0 + ddot when m = 1. */
@@ -62,7 +62,7 @@ static void matvec(int m, const double *A, const double *x, double *y)
     gemv(&t, &m, &m, &alpha, (double *)A, &m, (double *)x, &one, &beta, y, &one);
 }
 
-/* The power of 2 nearest x > 0 as lcp/scaling.py's `_pow2` (see _lemke_c.c: 0 when undecided) */
+/* The power of 2 nearest x > 0 as lcp/acceptance/scaling.py's `_pow2` (see _lemke_c.c: 0 when undecided) */
 static double pow2_near(double x)
 {
     uint64_t u;
@@ -362,7 +362,7 @@ static int solve_problem(idx n, const double *M, const double *q, const double *
     int code = 0;
     if (!r) code = balanced_units(n, M, q, t, &rs, &cs);
     if (code) goto out;
-    /* lcp/scaling.py: M * r[:, None] * c[None, :] and q * r; max|M|, max|q| of the data */
+    /* lcp/acceptance/scaling.py: M * r[:, None] * c[None, :] and q * r; max|M|, max|q| of the data */
     double mmax = 0.0, qmax = 0.0, mscale = 0.0, qtmax = 0.0;
     int finite = 1;
     for (idx i = 0; i < n; i++) {
@@ -409,7 +409,7 @@ out:
 }
 
 /* solve(M, q, r, c, tol, block_tries, max_iter, z, basis) -> (code, it, nbasis, flips,
- * (max|M|, max|q|, max|z|)): see the top of this file and lcp/fast_pivoting.py. */
+ * (max|M|, max|q|, max|z|)): see the top of this file and lcp/solvers/fast_pivoting.py. */
 static PyObject *py_solve(PyObject *self, PyObject *args)
 {
     PyObject *oM, *oq, *or_, *oc, *oz, *ob;
@@ -463,7 +463,7 @@ done:
     return result;
 }
 
-/* matvec(A, x, y): y = A x by `matvec` (for the probe of lcp/fast_pivoting.py). */
+/* matvec(A, x, y): y = A x by `matvec` (for the probe of lcp/solvers/fast_pivoting.py). */
 static PyObject *py_matvec(PyObject *self, PyObject *args)
 {
     PyObject *oA, *ox, *oy;
@@ -608,7 +608,7 @@ static PyMethodDef methods[] = {
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_pivot_c",
-                                    "pivoting's block steps in C (see lcp/fast_pivoting.py).",
+                                    "pivoting's block steps in C (see lcp/solvers/fast_pivoting.py).",
                                     -1, methods};
 
 PyMODINIT_FUNC PyInit__pivot_c(void) { return PyModule_Create(&module); }

@@ -368,9 +368,14 @@ def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contac
     graph, at least `radius` rings and `min_contacts` contacts, at most max_n LCP unknowns),
     the other states fixed: the LCP of those unknowns is the principal pivot transform
     M_FF - M_Fa M_aa^-1 M_aF, q_F - M_Fa M_aa^-1 q_a (a: the basic unknowns outside F),
-    solved by dense lexicographic Lemke. Sets the factor's states; False when it cannot."""
-    from .api import solve
-    from .problem import LCP
+    solved by dense lexicographic Lemke, checked as `lcp.solve(LCP(...), "lemke")` checks it
+    (the same steps, lcp.acceptance.trust, without importing the facade from below it). Sets
+    the factor's states; False when it cannot."""
+    from ..acceptance.residual import TOL
+    from ..acceptance.trust import Run, solve_checked
+    from ..problems.problem import LCP
+    from ..registry import lookup
+    from . import lemke  # noqa: F401  (registers "lemke")
 
     c = ev.c
     F = np.unique(H % c)
@@ -402,7 +407,8 @@ def local_rescue(factor: StateFactor, ev: EventLCP, H: np.ndarray, *, min_contac
         MFa = M[zF][:, aX]
         MFF -= MFa @ sol[:, :-1]
         qF -= MFa @ sol[:, -1]
-    res = solve(LCP(MFF, qF), method="lemke")
+    sub = LCP(MFF, qF)
+    res = solve_checked(Run(sub, sub, lookup, TOL), "lemke", True, True, {})
     if res.status != "solved":
         return False
     zb = np.zeros(zF.size, dtype=bool)

@@ -19,11 +19,11 @@ import itertools
 
 import numpy as np
 
-from .accuracy import assess_mlcp
-from .api import register
-from .problem import LCP, MLCP, NotApplicable
-from .residual import check
-from .solution import Solution, complementarity_residual
+from ..acceptance.accuracy import assess_mlcp
+from ..acceptance.residual import check
+from ..problems.problem import LCP, MLCP, NotApplicable
+from ..problems.solution import Solution, complementarity_residual
+from ..registry import register
 
 #: relative acceptance of an unreduced MLCP answer (verify.certify's default tol)
 MLCP_TOL = 1e-8

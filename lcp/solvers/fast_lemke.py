@@ -27,12 +27,12 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from . import api
-from .accuracy import judge_lcp
+from .. import registry as api  # the table of methods (lcp.registry), not the facade
+from ..acceptance.accuracy import judge_lcp
+from ..acceptance.scaling import ruiz
+from ..problems.solution import Solution, solved_lcp
 from .lemke import DEFAULT_TOL
 from .lemke import lemke as _lemke
-from .scaling import ruiz
-from .solution import Solution, solved_lcp
 
 _Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it gives it
 #: Above this bound on |M z + q| and the row sums of |M|, numpy's part of the check could

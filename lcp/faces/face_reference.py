@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .quiet import new_highs
+from ..quiet import new_highs
 
 
 def _face_lp(M: np.ndarray, q: np.ndarray, A: np.ndarray, c: np.ndarray) -> np.ndarray | None:

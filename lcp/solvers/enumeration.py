@@ -45,9 +45,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog
 
-from .api import register
-from .problem import LCP, MLCP, InvalidProblem, NotApplicable
-from .solution import Solution, complementarity_residual
+from ..problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
+from ..problems.solution import Solution, complementarity_residual
+from ..registry import register
 
 #: Default largest n for exhaustive enumeration (2^20 = 1,048,576 bases).
 MAX_N = 20

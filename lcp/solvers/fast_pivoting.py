@@ -1,6 +1,6 @@
 """The fast path of `lcp.solve(problem, "pivoting")` on an `lcp.LCP` with default options.
 
-The general path (lcp.api.solve -> lcp.trust.solve_checked) runs, for such a call,
+The general path (lcp.api.solve -> lcp.acceptance.trust.solve_checked) runs, for such a call,
 
     eq = ruiz(M, q)                        lcp.scaling: Ruiz equilibration (pivoting's default)
     sol = solve_pivoting(eq.M, eq.q)       lcp.pivoting: block steps, single pivots, ...
@@ -9,8 +9,8 @@ The general path (lcp.api.solve -> lcp.trust.solve_checked) runs, for such a cal
 
 In the common case the pivoting makes block steps only (each failing index flipped at once,
 every new basis nonsingular) until no inequality fails. `solve_pivoting` below runs that case
-in one C call (lcp/_pivot_c.c: the equilibration of a balanced M, or `ruiz`'s factors passed;
-the block steps with scipy's own LAPACK dgetrf / dgecon / dgetrs and BLAS dgemv, called as
+in one C call (lcp/solvers/_pivot_c.c: the equilibration of a balanced M, or `ruiz`'s factors
+passed; the block steps with scipy's own LAPACK dgetrf / dgecon / dgetrs and BLAS dgemv, called as
 lcp.pivoting's numpy code calls them; z mapped back) and checks the answer with
 `lcp.residual.lcp_measure`, as `check` does. So it returns the same Solution as the general
 path, bit for bit (tests/lcp/test_fast_pivoting.py), and None in every other case -- data that
@@ -30,11 +30,11 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from . import api
-from .accuracy import judge_lcp
+from .. import registry as api  # the table of methods (lcp.registry), not the facade
+from ..acceptance.accuracy import judge_lcp
+from ..acceptance.scaling import ruiz
+from ..problems.solution import Solution, solved_lcp
 from .pivoting import solve_pivoting as _pivoting
-from .scaling import ruiz
-from .solution import Solution, solved_lcp
 
 try:
     from . import _pivot_c

@@ -60,7 +60,7 @@ from scipy.linalg import LinAlgWarning, lu_factor, lu_solve
 from scipy.linalg.lapack import dgecon
 from scipy.sparse.linalg import splu
 
-from .errors import RigidLCPError
+from ..errors import RigidLCPError
 
 #: Tangential state codes: +1 / -1 (S + code mu R = 0; sliding, or a candidate's "+"/"-"),
 #: 0 (S = 0: frictionless) and NS (a_t = 0, candidates only).

@@ -28,12 +28,12 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
+from ..problems.solution import Solution
 from .accuracy import Accuracy, assess, assess_lcp
 from .farkas import find_certificate, numerically_psd
-from .problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .residual import Check, check
 from .scaling import Equilibration, ruiz
-from .solution import Solution
 
 #: The fallback methods of ``fallback=True`` (tried equilibrated, in this order).
 FALLBACKS = ("pivoting", "lemke")

@@ -19,7 +19,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from .solution import Solution
+from ..problems.solution import Solution
 
 #: Largest n the exact run takes after a cycling float run (cost O(n^2) rational operations
 #: per pivot, with growing entries: ~0.5 s at n = 60), and after a ray that proves nothing

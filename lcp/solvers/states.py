@@ -17,10 +17,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .api import register
-from .friction import FrictionContact2D
-from .problem import InvalidProblem
-from .solution import Solution
+from ..problems.friction import FrictionContact2D
+from ..problems.problem import InvalidProblem
+from ..problems.solution import Solution
+from ..registry import register
 
 
 def solve_states_fc2d(problem: FrictionContact2D, *, tol: float = 1e-10,

@@ -27,11 +27,11 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from .api import register
-from .farkas import numerically_psd
+from ..acceptance.farkas import numerically_psd
+from ..problems.problem import InvalidProblem, as_matrix, as_vector
+from ..problems.solution import Solution
+from ..registry import register
 from .lemke_exact import EXACT_MAX_N, EXACT_RAY_MAX_N, lemke_exact
-from .problem import InvalidProblem, as_matrix, as_vector
-from .solution import Solution
 
 #: Zero tolerance, relative to data normalized to max|M| = max|q| = max d = 1.
 DEFAULT_TOL = 1e-10

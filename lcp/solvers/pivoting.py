@@ -47,9 +47,9 @@ import math
 import numpy as np
 from scipy.linalg.lapack import dgecon, dgetrf, dgetrs
 
-from .api import register
-from .problem import InvalidProblem
-from .solution import Solution
+from ..problems.problem import InvalidProblem
+from ..problems.solution import Solution
+from ..registry import register
 
 #: A basis whose estimated reciprocal condition number is below this is treated as singular.
 RCOND = 1e-13

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..problems.problem import LCP
 from .face_coords import _Face, small_lp, small_qp
 from .face_reference import _face_lp, _qp
-from .problem import LCP
 
 SOLVERS = ("small", "reference")
 

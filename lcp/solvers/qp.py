@@ -27,10 +27,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import lstsq
 
-from .api import register
-from .problem import InvalidProblem, NotApplicable
-from .quiet import quiet_stdout
-from .solution import Solution, complementarity_residual
+from ..problems.problem import InvalidProblem, NotApplicable
+from ..problems.solution import Solution, complementarity_residual
+from ..quiet import quiet_stdout
+from ..registry import register
 
 
 def check_symmetric_psd(M: np.ndarray, tol: float = 1e-9) -> np.ndarray:
