@@ -154,6 +154,35 @@ def report(rows: list[dict]) -> None:
         print(f"  n = {r['n']}: rigidlcp solved {r['solved']}/{r['count']}; judged ok: {parts}")
 
 
+def lcp_construction(sizes: list[int]) -> None:
+    """lcp.LCP(M, q)'s quick route for plain finite float64 data against the general
+    validation it skips (forced by switching the quick route off), best of 3 x 5 x 20000 calls,
+    interleaved."""
+    import timeit
+
+    from rigidlcp.lcp import problem as module
+
+    quick = module._check_finite
+    if quick is None:
+        print("lcp.LCP(M, q): no quick route (the C extension is not built)")
+        return
+    try:
+        for n in sizes:
+            rng = np.random.default_rng(n)
+            A = rng.standard_normal((n, n))
+            M, q = A @ A.T + 0.1 * np.eye(n), rng.standard_normal(n)
+            best = {"general": np.inf, "quick": np.inf}
+            for _ in range(3):
+                for name, check in (("general", None), ("quick", quick)):
+                    module._check_finite = check
+                    t = min(timeit.repeat(lambda: lcp.LCP(M, q), number=20000, repeat=5))  # noqa: B023
+                    best[name] = min(best[name], t / 20000)
+            print(f"lcp.LCP(M, q) at n = {n}: general validation {1e6 * best['general']:.2f} us, "
+                  f"quick route {1e6 * best['quick']:.2f} us")
+    finally:
+        module._check_finite = quick
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sizes", default="10,20,30,50,100")
@@ -182,6 +211,7 @@ def main(argv: list[str] | None = None) -> int:
             rows.append(measure(n, args.count, args.repeats, inner, args.seed, sic, qe, tmp,
                                 min if args.stat == "min" else np.median))
     report(rows)
+    lcp_construction(sizes)
     print(f"load average at end {os.getloadavg()[0]:.2f}; the machine was shared with other jobs")
     if sic.available:
         sic.close()

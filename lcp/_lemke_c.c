@@ -526,15 +526,17 @@ static PyObject *py_check(PyObject *self, PyObject *args)
         return NULL;
     }
     const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
-    double acc = 0.0, qmin = q[0];
-    for (idx k = 0; k < n * n; k++) acc += M[k] - M[k]; /* NaN iff some entry is not finite */
+    double qmin = q[0];
+    int finite = 1; /* branch-free and independent per entry (vectorized): |x| <= DBL_MAX is
+                     * false for inf and NaN (a sum of x - x was one serial chain of adds) */
+    for (idx k = 0; k < n * n; k++) finite &= fabs(M[k]) <= DBL_MAX;
     for (idx i = 0; i < n; i++) {
-        acc += q[i] - q[i];
-        if (q[i] < qmin) qmin = q[i];
+        finite &= fabs(q[i]) <= DBL_MAX;
+        qmin = q[i] < qmin ? q[i] : qmin;
     }
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vq);
-    return Py_BuildValue("Od", acc == 0.0 ? Py_True : Py_False, qmin);
+    return Py_BuildValue("Od", finite ? Py_True : Py_False, qmin);
 }
 
 /* ------------------------------------------------------------------ one whole problem */
