@@ -160,3 +160,40 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
         if code == kernel.SOLVED:
             assert same(z, eq.z_back(ref.z))
             assert same(basis[:m].astype(np.intp), np.sort(np.asarray(ref.basis, dtype=np.intp)))
+
+
+@compiled
+@pytest.mark.parametrize("n", (*range(1, 14), 17, 30, 61))
+def test_c_assess_agrees_with_the_numpy_assess(n):
+    """lcp/_accuracy_c.c (rows in blocks of 4, column-wise U^T solve) against lcp.accuracy's
+    numpy `assess` (LAPACK's inverse, scipy's estimator: another implementation of the same
+    definitions) on Lemke's answers, perturbed answers and permuted bases: the same verdict,
+    the same polished point to rounding, backward errors equal to rounding, and the C forward
+    bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
+    from rigidlcp.lcp import accuracy
+    from rigidlcp.lcp.lemke import DEFAULT_TOL
+
+    if accuracy._accuracy_c is None:
+        pytest.skip("the accuracy extension is not built")
+    rng = np.random.default_rng(n)
+    for kind in ("psd", "scaled", "ties"):
+        M, q = _problem(n, kind, 0)
+        z, basis = np.empty(n), np.empty(n, dtype=np.intp)
+        eq = __import__("rigidlcp.lcp.scaling", fromlist=["ruiz"]).ruiz(M, q)
+        code, _, m, _ = kernel.solve_eq(M, q, eq.r, eq.c, DEFAULT_TOL, 1000 + 100 * n, z, basis)
+        assert code == kernel.SOLVED
+        for zz, a in ((z, basis[:m]), (z * (1 + 1e-9 * rng.standard_normal(n)),
+                                        rng.permutation(basis[:m]))):
+            out = np.empty(n)
+            got = accuracy._accuracy_c.assess(M, q, zz, np.ascontiguousarray(a, np.int64), out)
+            if got[0] != 0:
+                continue  # declined: the numpy code runs in that case anyway
+            ref = accuracy.assess(M, q, zz, 0, a)
+            c_berr, c_ferr, c_refined = got[1], got[2], bool(got[3])
+            assert c_refined == ref.refined
+            assert (c_berr <= accuracy.TOL) == (ref.berr <= accuracy.TOL)
+            assert abs(c_berr - ref.berr) <= 1e-13
+            scale = max(float(np.abs(ref.v).max()), 1e-300)
+            assert np.abs(out - ref.v).max() <= 1e-12 * scale
+            assert c_ferr <= ref.ferr * (1 + 1e-6) + 1e-15
+            assert (c_ferr <= accuracy.FERR_TOL) == (ref.ferr <= accuracy.FERR_TOL)
