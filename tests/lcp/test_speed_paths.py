@@ -172,6 +172,7 @@ def test_c_assess_agrees_with_the_numpy_assess(n):
     bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
     from rigidlcp.lcp import accuracy
     from rigidlcp.lcp.lemke import DEFAULT_TOL
+    from rigidlcp.lcp.scaling import ruiz
 
     if accuracy._accuracy_c is None:
         pytest.skip("the accuracy extension is not built")
@@ -179,7 +180,7 @@ def test_c_assess_agrees_with_the_numpy_assess(n):
     for kind in ("psd", "scaled", "ties"):
         M, q = _problem(n, kind, 0)
         z, basis = np.empty(n), np.empty(n, dtype=np.intp)
-        eq = __import__("rigidlcp.lcp.scaling", fromlist=["ruiz"]).ruiz(M, q)
+        eq = ruiz(M, q)
         code, _, m, _ = kernel.solve_eq(M, q, eq.r, eq.c, DEFAULT_TOL, 1000 + 100 * n, z, basis)
         assert code == kernel.SOLVED
         for zz, a in ((z, basis[:m]), (z * (1 + 1e-9 * rng.standard_normal(n)),
