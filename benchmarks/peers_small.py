@@ -9,7 +9,8 @@ so that all see the same machine load:
 
   natural       lcp.solve(lcp.LCP(M, q))            (the problem built and validated each call)
   prebuilt      lcp.solve(P)                        (P built once)
-  solve_many    lcp.solve_many(problems) / count    (the whole set in one call)
+  solve_many    lcp.solve_many(problems) / count    (the set, each problem --inner times in a
+                                                     row as for the others, in one call)
   QuantEcon     quantecon.optimize.lcp_lemke(M, q)  (numba, warm: compiled before timing)
   Sic. natural  Siconos: options, sn.LCP(M, q), linearComplementarity_driver (all timed)
   Sic. driver   Siconos: linearComplementarity_driver on a prebuilt problem and options
@@ -91,14 +92,14 @@ def measure(n: int, count: int, repeats: int, inner: int, seed: int, sic: Sicono
     lcp.solve(problems[0])
     if qe is not None:
         qe(*pairs[0], max_iter=max_iter)  # numba compiles here (not timed)
+    repeated = [p for p in problems for _ in range(inner)]
     times: dict[str, list[float]] = {w: [] for w in WAYS}
     answers: dict[str, list] = {}
     for _ in range(repeats):
         times["natural"].append(_per_call(lambda M, q: lcp.solve(lcp.LCP(M, q)), pairs, inner))
         times["prebuilt"].append(_per_call(lcp.solve, [(p,) for p in problems], inner))
-        t0 = time.perf_counter()
-        for _ in range(inner):
-            many = lcp.solve_many(problems)
+        t0 = time.perf_counter()  # the same sequence as the others: each problem inner times
+        many = lcp.solve_many(repeated)
         times["solve_many"].append((time.perf_counter() - t0) / (inner * count))
         if qe is not None:
             times["QuantEcon"].append(_per_call(lambda M, q: qe(M, q, max_iter=max_iter),
@@ -113,6 +114,7 @@ def measure(n: int, count: int, repeats: int, inner: int, seed: int, sic: Sicono
                 out = json.loads(sic.proc.stdout.readline())
                 times[way].append(out["per_call"])
                 answers[way] = out["zs"]
+    many = many[::inner]
     answers["natural"] = [s.z for s in many]
     if qe is not None:
         answers["QuantEcon"] = [qe(M, q, max_iter=max_iter).z for M, q in pairs]
