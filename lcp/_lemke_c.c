@@ -739,7 +739,7 @@ typedef struct {
     void *heap;
 } Work;
 
-#define STACK_WORDS 2048 /* 16 kB: enough for n <= 24 */
+#define STACK_WORDS 2048 /* 16 kB: enough for n <= 28 */
 #define ALIGN_WORDS 8    /* 64 bytes */
 
 static void work_free(Work *w) { free(w->heap); }
