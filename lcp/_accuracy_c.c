@@ -82,6 +82,37 @@ static double backward_error(idx n, const double *M, const double *q, const doub
     return out;
 }
 
+/* a_i -= l a_k over len entries: every entry rounded twice (product, difference; no fused
+ * multiply-add: -ffp-contract=off), so the AVX2 clone gives the same numbers as the plain
+ * loop, four at a time. */
+static void row_update_plain(double *ai, const double *ak, double l, idx len)
+{
+    for (idx j = 0; j < len; j++) ai[j] -= l * ak[j];
+}
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+__attribute__((target("avx2"))) static void row_update_avx2(double *ai, const double *ak,
+                                                           double l, idx len)
+{
+    for (idx j = 0; j < len; j++) ai[j] -= l * ak[j];
+}
+
+static void row_update(double *ai, const double *ak, double l, idx len)
+{
+    static int avx2 = -1;
+    if (avx2 < 0) {
+        __builtin_cpu_init();
+        avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    if (avx2)
+        row_update_avx2(ai, ak, l, len);
+    else
+        row_update_plain(ai, ak, l, len);
+}
+#else
+#define row_update row_update_plain
+#endif
+
 /* LU with partial pivoting of A (m x m, row-major, in place: L below the diagonal, U on and
  * above; perm[k] the row swapped with k at step k). -1 if U is singular to working precision:
  * a pivot below m eps times the largest (the numpy code then decides, by its SVD path). */
@@ -104,7 +135,10 @@ static int lu(idx m, double *A, idx *perm)
         for (idx i = k + 1; i < m; i++) {
             double l = A[i * m + k] / piv;
             A[i * m + k] = l;
-            if (l != 0.0)
+            if (l == 0.0) continue;
+            if (m - k - 1 >= 16)  /* long rows: the AVX2 clone where the CPU has it */
+                row_update(A + i * m + k + 1, A + k * m + k + 1, l, m - k - 1);
+            else
                 for (idx j = k + 1; j < m; j++) A[i * m + j] -= l * A[k * m + j];
         }
         umax = dmax(umax, fabs(piv));
