@@ -2,10 +2,10 @@
 
 * The C kernel's work array of `solve_eq` / `solve_batch` (lcp/_lemke_c.c: T's columns padded
   to a multiple of 4 doubles from n = 16, the block 64-byte aligned, on the stack up to n = 28
-  and malloc'd above) gives the z, pivots, basis and status of the general path, whose dictionary comes from
-  Python with no padding (`_lemke_kernel.run`), bit for bit: on sizes that are and are not
-  multiples of 4, on both sides of the stack/heap boundary, on random, degenerate (ties,
-  duplicated rows and columns, zeros in q) and badly scaled problems.
+  and malloc'd above) gives the z, pivots, basis and status of the general path, whose
+  dictionary comes from Python with no padding (`_lemke_kernel.run`), bit for bit: on sizes
+  that are and are not multiples of 4, on both sides of the stack/heap boundary, on random,
+  degenerate (ties, duplicated rows and columns, zeros in q) and badly scaled problems.
 * `lcp.LCP(M, q)`'s quick route for plain finite float64 data gives the arrays the general
   validation gives (values, dtype, layout, own copies), and every other input -- NaN, Inf,
   wrong shapes, Fortran order, views, integers, lists, complex -- is validated or refused
