@@ -36,6 +36,9 @@ def main() -> int:
         if "Ms" in req:
             print(json.dumps(_batch(np, sn, req)), flush=True)
             continue
+        if "set_Ms" in req:
+            print(json.dumps(_timed_set(np, sn, req)), flush=True)
+            continue
         M = np.ascontiguousarray(np.load(req["M"]), dtype=float)
         q = np.ascontiguousarray(np.load(req["q"]), dtype=float)
         n = q.size
@@ -86,6 +89,48 @@ def _batch(np, sn, req: dict) -> dict:
     res = max(float(np.max(np.abs(np.minimum(Z[i], Ms[i] @ Z[i] + qs[i])))) for i in range(k))
     return {"loop": loop, "calls": calls, "pivots": pivots,
             "failures": sum(1 for x in infos if x), "residual": res, "zs": Z.tolist()}
+
+
+def _timed_set(np, sn, req: dict) -> dict:
+    """benchmarks/peers_small.py: the mean seconds per call over stacked problems {"set_Ms":
+    path (k, n, n), "set_qs": path}, each called "inner" times in a row, "how" = "natural"
+    (solver options, problem object, linearComplementarity_driver: all timed), "driver"
+    (linearComplementarity_driver on a prebuilt problem and options) or "bare"
+    (lcp_lexicolemke on a prebuilt problem and options: the solver alone); "zs": the
+    answers of the last call, to be judged by the caller."""
+    Ms, qs = np.load(req["set_Ms"]), np.load(req["set_qs"])
+    k, n = qs.shape
+    Ms = [np.ascontiguousarray(Ms[i]) for i in range(k)]
+    qs = [np.ascontiguousarray(qs[i]) for i in range(k)]
+    inner, max_iter = int(req.get("inner", 1)), int(req.get("max_iter", 10000))
+    Z, W = np.zeros((k, n)), np.zeros((k, n))
+    total = 0.0
+    for i in range(k):
+        M, q, z, w = Ms[i], qs[i], Z[i], W[i]
+        if req["how"] == "natural":
+            t0 = time.perf_counter()
+            for _ in range(inner):
+                options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+                options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+                sn.linearComplementarity_driver(sn.LCP(M, q), z, w, options)
+            total += time.perf_counter() - t0
+            continue
+        problem = sn.LCP(M, q)
+        options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+        options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+        if req["how"] == "driver":
+            t0 = time.perf_counter()
+            for _ in range(inner):
+                sn.linearComplementarity_driver(problem, z, w, options)
+            total += time.perf_counter() - t0
+        else:
+            options = sn.SolverOptions(sn.SICONOS_LCP_LEMKE)
+            options.iparam[sn.SICONOS_IPARAM_MAX_ITER] = max_iter
+            t0 = time.perf_counter()
+            for _ in range(inner):
+                sn.lcp_lexicolemke(problem, z, w, options)
+            total += time.perf_counter() - t0
+    return {"per_call": total / (k * inner), "zs": Z.tolist()}
 
 
 if __name__ == "__main__":

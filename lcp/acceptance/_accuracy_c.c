@@ -39,12 +39,39 @@ static double backward_error(idx n, const double *M, const double *q, const doub
     double vs = dmax(xmax, mmax > 0 ? qmax / mmax : 0.0);
     if (!(vs > 0)) vs = 1.0;
     double out = 0.0;
+    double rb[4], sb[4];
     for (idx i = 0; i < n; i++) {
         const double *row = M + i * n;
-        double res = q[i], s = fabs(q[i]);
-        for (idx j = 0; j < n; j++) {
-            res += row[j] * x[j];
-            s += fabs(row[j]) * fabs(x[j]);
+        double res, s;
+        if (i % 4 == 0 && i + 4 <= n) {  /* four rows at once: independent sums, each in
+                                          * its own order (the same numbers, sooner) */
+            const double *r1 = row + n, *r2 = r1 + n, *r3 = r2 + n;
+            double a0 = q[i], a1 = q[i + 1], a2 = q[i + 2], a3 = q[i + 3];
+            double b0 = fabs(q[i]), b1 = fabs(q[i + 1]), b2 = fabs(q[i + 2]), b3 = fabs(q[i + 3]);
+            for (idx j = 0; j < n; j++) {
+                double xj = x[j], axj = fabs(xj);
+                a0 += row[j] * xj;
+                b0 += fabs(row[j]) * axj;
+                a1 += r1[j] * xj;
+                b1 += fabs(r1[j]) * axj;
+                a2 += r2[j] * xj;
+                b2 += fabs(r2[j]) * axj;
+                a3 += r3[j] * xj;
+                b3 += fabs(r3[j]) * axj;
+            }
+            rb[0] = a0, rb[1] = a1, rb[2] = a2, rb[3] = a3;
+            sb[0] = b0, sb[1] = b1, sb[2] = b2, sb[3] = b3;
+        }
+        if (i - i % 4 + 4 <= n) {
+            res = rb[i % 4];
+            s = sb[i % 4];
+        } else {
+            res = q[i];
+            s = fabs(q[i]);
+            for (idx j = 0; j < n; j++) {
+                res += row[j] * x[j];
+                s += fabs(row[j]) * fabs(x[j]);
+            }
         }
         s = dmax(s, floor);
         double wr = s > 0 ? res / s : (res == 0 ? 0.0 : copysign(INFINITY, res));
@@ -54,6 +81,37 @@ static double backward_error(idx n, const double *M, const double *q, const doub
     }
     return out;
 }
+
+/* a_i -= l a_k over len entries: every entry rounded twice (product, difference; no fused
+ * multiply-add: -ffp-contract=off), so the AVX2 clone gives the same numbers as the plain
+ * loop, four at a time. */
+static void row_update_plain(double *ai, const double *ak, double l, idx len)
+{
+    for (idx j = 0; j < len; j++) ai[j] -= l * ak[j];
+}
+
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+__attribute__((target("avx2"))) static void row_update_avx2(double *ai, const double *ak,
+                                                           double l, idx len)
+{
+    for (idx j = 0; j < len; j++) ai[j] -= l * ak[j];
+}
+
+static void row_update(double *ai, const double *ak, double l, idx len)
+{
+    static int avx2 = -1;
+    if (avx2 < 0) {
+        __builtin_cpu_init();
+        avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    if (avx2)
+        row_update_avx2(ai, ak, l, len);
+    else
+        row_update_plain(ai, ak, l, len);
+}
+#else
+#define row_update row_update_plain
+#endif
 
 /* LU with partial pivoting of A (m x m, row-major, in place: L below the diagonal, U on and
  * above; perm[k] the row swapped with k at step k). -1 if U is singular to working precision:
@@ -77,7 +135,10 @@ static int lu(idx m, double *A, idx *perm)
         for (idx i = k + 1; i < m; i++) {
             double l = A[i * m + k] / piv;
             A[i * m + k] = l;
-            if (l != 0.0)
+            if (l == 0.0) continue;
+            if (m - k - 1 >= 16)  /* long rows: the AVX2 clone where the CPU has it */
+                row_update(A + i * m + k + 1, A + k * m + k + 1, l, m - k - 1);
+            else
                 for (idx j = k + 1; j < m; j++) A[i * m + j] -= l * A[k * m + j];
         }
         umax = dmax(umax, fabs(piv));
@@ -96,16 +157,41 @@ static void lu_solve(idx m, const double *A, const idx *perm, double *x, int tra
                 x[k] = x[perm[k]];
                 x[perm[k]] = t;
             }
-        for (idx i = 0; i < m; i++)
+        /* L (unit): x[i] -= A[i, j] x[j] for j = 0, 1, ..., i - 1 in this order; four rows
+         * at once, each row's subtractions in that same order (the same numbers, sooner) */
+        idx i = 0;
+        for (; i + 4 <= m; i += 4) {
+            const double *A0 = A + i * m, *A1 = A0 + m, *A2 = A1 + m, *A3 = A2 + m;
+            double x0 = x[i], x1 = x[i + 1], x2 = x[i + 2], x3 = x[i + 3];
+            for (idx j = 0; j < i; j++) {
+                double xj = x[j];
+                x0 -= A0[j] * xj;
+                x1 -= A1[j] * xj;
+                x2 -= A2[j] * xj;
+                x3 -= A3[j] * xj;
+            }
+            x1 -= A1[i] * x0;
+            x2 -= A2[i] * x0;
+            x3 -= A3[i] * x0;
+            x2 -= A2[i + 1] * x1;
+            x3 -= A3[i + 1] * x1;
+            x3 -= A3[i + 2] * x2;
+            x[i] = x0, x[i + 1] = x1, x[i + 2] = x2, x[i + 3] = x3;
+        }
+        for (; i < m; i++)
             for (idx j = 0; j < i; j++) x[i] -= A[i * m + j] * x[j];
         for (idx i = m - 1; i >= 0; i--) {
             for (idx j = i + 1; j < m; j++) x[i] -= A[i * m + j] * x[j];
             x[i] /= A[i * m + i];
         }
     } else {  /* K = P^T L U: K^T x = b  <=>  U^T L^T (P x) = b */
-        for (idx i = 0; i < m; i++) {
-            for (idx j = 0; j < i; j++) x[i] -= A[j * m + i] * x[j];
-            x[i] /= A[i * m + i];
+        /* U^T: x[i] -= A[j, i] x[j] for j = 0, ..., i - 1 in this order, then x[i] /= A[i, i];
+         * done column by column (row j of A, contiguous): each x[i] gets the same
+         * subtractions in the same order */
+        for (idx j = 0; j < m; j++) {
+            x[j] /= A[j * m + j];
+            const double xj = x[j], *Aj = A + j * m;
+            for (idx i = j + 1; i < m; i++) x[i] -= Aj[i] * xj;
         }
         for (idx i = m - 1; i >= 0; i--)
             for (idx j = i + 1; j < m; j++) x[i] -= A[j * m + i] * x[j];
@@ -164,7 +250,22 @@ static double abs_inv_norm(idx m, const double *A, const idx *perm, const double
 /* r = K y + k, accumulated in long double, rounded to double. */
 static void residual_ld(idx m, const double *K, const double *k, const double *y, double *r)
 {
-    for (idx i = 0; i < m; i++) {
+    idx i0 = 0;
+    for (; i0 + 4 <= m; i0 += 4) {  /* four rows at once, each summed in its own order */
+        const double *K0 = K + i0 * m, *K1 = K0 + m, *K2 = K1 + m, *K3 = K2 + m;
+        long double s0 = (long double)k[i0], s1 = (long double)k[i0 + 1],
+                    s2 = (long double)k[i0 + 2], s3 = (long double)k[i0 + 3];
+        for (idx j = 0; j < m; j++) {
+            long double yj = (long double)y[j];
+            s0 += (long double)K0[j] * yj;
+            s1 += (long double)K1[j] * yj;
+            s2 += (long double)K2[j] * yj;
+            s3 += (long double)K3[j] * yj;
+        }
+        r[i0] = (double)s0, r[i0 + 1] = (double)s1, r[i0 + 2] = (double)s2,
+        r[i0 + 3] = (double)s3;
+    }
+    for (idx i = i0; i < m; i++) {
         long double s = (long double)k[i];
         for (idx j = 0; j < m; j++) s += (long double)K[i * m + j] * (long double)y[j];
         r[i] = (double)s;

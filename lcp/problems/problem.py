@@ -15,8 +15,13 @@ from typing import Any
 
 import numpy as np
 
+import rigidlcp.lcp._lemke_kernel as _kernel
+
 from ..errors import InvalidProblem, NotApplicable
 from ..io.files import atomic_write
+
+_F64 = np.dtype(np.float64)
+_check_finite = _kernel._lemke_c.check if _kernel.COMPILED else None
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
@@ -78,10 +83,21 @@ class LCP:
     meta: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        M = as_matrix("M", self.M, (None, None))
+        M, q = self.M, self.q
+        if (_check_finite is not None and type(M) is np.ndarray and type(q) is np.ndarray
+                and M.dtype is _F64 and q.dtype is _F64 and q.ndim == 1 and q.size
+                and M.shape == (q.size, q.size) and M.flags.c_contiguous
+                and q.flags.c_contiguous and _check_finite(M, q)[0]):
+            # plain finite float64 data (the common call): the copies `as_matrix` and
+            # `as_vector` would make, with one finiteness test in C for both (anything else,
+            # including a NaN, takes the general route below and its error message)
+            object.__setattr__(self, "M", M.copy())
+            object.__setattr__(self, "q", q.copy())
+            return
+        M = as_matrix("M", M, (None, None))
         if M.shape[0] != M.shape[1]:
             raise InvalidProblem(f"M must be square, got shape {M.shape}")
-        q = as_vector("q", self.q, M.shape[0])
+        q = as_vector("q", q, M.shape[0])
         object.__setattr__(self, "M", M)
         object.__setattr__(self, "q", q)
 

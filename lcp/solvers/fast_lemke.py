@@ -27,7 +27,7 @@ import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
-from .. import registry as api  # the table of methods (lcp.registry), not the facade
+from .. import registry
 from ..acceptance.accuracy import judge_lcp
 from ..acceptance.scaling import ruiz
 from ..problems.solution import Solution, solved_lcp
@@ -42,12 +42,13 @@ _SAFE = 1e300
 
 def applies() -> bool:
     """Is "lemke" the built-in method, equilibrated by default, with the compiled kernel on?"""
-    info = api._REGISTRY.get("lemke")
+    info = registry._REGISTRY.get("lemke")
     return (info is not None and info.func is _lemke and info.equilibrate
             and _kernel.enabled())
 
 
 _F64 = np.dtype(np.float64)
+_solve_eq = _kernel._lemke_c.solve_eq if _kernel.COMPILED else None
 
 
 def solve_lemke(problem) -> Solution | None:
@@ -63,8 +64,9 @@ def solve_lemke(problem) -> Solution | None:
     basis = np.empty(n, dtype=np.intp)
     max_iter = 1000 + 100 * n  # lemke()'s default
     try:  # C-contiguous finite float64 data only (else ValueError or BufferError)
-        code, pivots, m, bounds = _kernel.solve_eq(M, q, None, None, DEFAULT_TOL, max_iter,
-                                                   z, basis)
+        # _kernel.solve_eq's C function itself (its arguments are already of the right types)
+        code, pivots, m, bounds = _solve_eq(M, q, None, None, None, DEFAULT_TOL, max_iter, z,
+                                            basis)
         if code == _kernel.NEEDS_RUIZ:
             eq = ruiz(M, q)
             code, pivots, m, bounds = _kernel.solve_eq(M, q, eq.r, eq.c, DEFAULT_TOL,
