@@ -26,8 +26,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rigidlcp.lcp import _accuracy_c, _lemke_c
-from rigidlcp.lcp.scaling import ruiz
+from rigidlcp.lcp import _lemke_c
+from rigidlcp.lcp.acceptance import _accuracy_c
+from rigidlcp.lcp.acceptance.scaling import ruiz
 
 
 def load(directory: Path, name: str):

@@ -162,7 +162,7 @@ def lcp_construction(sizes: list[int]) -> None:
     interleaved."""
     import timeit
 
-    from rigidlcp.lcp import problem as module
+    from rigidlcp.lcp.problems import problem as module
 
     quick = module._check_finite
     if quick is None:

@@ -266,7 +266,8 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
 def assess_lcp(M: np.ndarray, q: np.ndarray, z: np.ndarray, basis=None,
                polish: bool | None = None) -> Accuracy:
     """`assess` for an LCP (no u). With a basis, in C when the extension is built and the
-    kernels are on (lcp/acceptance/_accuracy_c.c: the same steps; RIGIDLCP_NO_KERNEL=1 runs numpy)."""
+    kernels are on (lcp/acceptance/_accuracy_c.c: the same steps; RIGIDLCP_NO_KERNEL=1 runs
+    numpy)."""
     if basis is not None and polish is not False and _accuracy_c is not None and _kernel.enabled():
         a = basis if (type(basis) is np.ndarray and basis.dtype == _I64
                       and basis.flags.c_contiguous) else np.ascontiguousarray(

@@ -21,8 +21,8 @@ from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
-from rigidlcp.lcp import problem as problem_module
 from rigidlcp.lcp.errors import InvalidProblem
+from rigidlcp.lcp.problems import problem as problem_module
 
 from .test_fast_lemke import assert_same_answer, same
 
@@ -143,8 +143,8 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
     """Every outcome (solved, ray, pivot limit, cycling), not only the accepted ones: the code
     and pivot count of `solve_eq` (padded work array) against lemke() on the same equilibrated
     data (its dictionary from Python, unpadded), and z in the user's units when solved."""
-    from rigidlcp.lcp.lemke import DEFAULT_TOL, lemke
-    from rigidlcp.lcp.scaling import ruiz
+    from rigidlcp.lcp.acceptance.scaling import ruiz
+    from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL, lemke
 
     status = {kernel.SOLVED: ("solved",), kernel.RAY: ("ray", "infeasible"),
               kernel.MAX_ITER: ("max_iter",)}
@@ -166,14 +166,14 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
 @compiled
 @pytest.mark.parametrize("n", (*range(1, 14), 17, 30, 61))
 def test_c_assess_agrees_with_the_numpy_assess(n):
-    """lcp/_accuracy_c.c (rows in blocks of 4, column-wise U^T solve) against lcp.accuracy's
+    """lcp/acceptance/_accuracy_c.c (rows in blocks of 4, column-wise U^T solve) against lcp.accuracy's
     numpy `assess` (LAPACK's inverse, scipy's estimator: another implementation of the same
     definitions) on Lemke's answers, perturbed answers and permuted bases: the same verdict,
     the same polished point to rounding, backward errors equal to rounding, and the C forward
     bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
-    from rigidlcp.lcp import accuracy
-    from rigidlcp.lcp.lemke import DEFAULT_TOL
-    from rigidlcp.lcp.scaling import ruiz
+    from rigidlcp.lcp.acceptance import accuracy
+    from rigidlcp.lcp.acceptance.scaling import ruiz
+    from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL
 
     if accuracy._accuracy_c is None:
         pytest.skip("the accuracy extension is not built")
