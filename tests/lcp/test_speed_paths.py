@@ -167,8 +167,8 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
 @pytest.mark.parametrize("n", (*range(1, 14), 17, 30, 61))
 def test_c_assess_agrees_with_the_numpy_assess(n):
     """lcp/acceptance/_accuracy_c.c (rows in blocks of 4, column-wise U^T solve) against
-    lcp.accuracy's numpy `assess` (LAPACK's inverse, scipy's estimator: another implementation of the same
-    definitions) on Lemke's answers, perturbed answers and permuted bases: the same verdict,
+    lcp.accuracy's numpy `assess` (LAPACK's inverse, scipy's estimator: another implementation
+    of the same definitions) on Lemke's answers, perturbed answers and permuted bases: the same verdict,
     the same polished point to rounding, backward errors equal to rounding, and the C forward
     bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
     from rigidlcp.lcp.acceptance import accuracy
