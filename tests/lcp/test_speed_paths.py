@@ -168,9 +168,9 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
 def test_c_assess_agrees_with_the_numpy_assess(n):
     """lcp/acceptance/_accuracy_c.c (rows in blocks of 4, column-wise U^T solve) against
     lcp.accuracy's numpy `assess` (LAPACK's inverse, scipy's estimator: another implementation
-    of the same definitions) on Lemke's answers, perturbed answers and permuted bases: the same verdict,
-    the same polished point to rounding, backward errors equal to rounding, and the C forward
-    bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
+    of the same definitions) on Lemke's answers, perturbed answers and permuted bases: the same
+    verdict, the same polished point to rounding, backward errors equal to rounding, and the C
+    forward bound (Hager's estimate of || |K^-1| g ||, a lower bound) at most the exact one."""
     from rigidlcp.lcp.acceptance import accuracy
     from rigidlcp.lcp.acceptance.scaling import ruiz
     from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL
