@@ -27,21 +27,17 @@ Big-M constants, each a consequence of a bound that is proved or reported as not
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import Bounds, LinearConstraint, linprog, milp
+from scipy.optimize import linprog
 
 from rigidlcp.lcp.errors import RigidLCPError
 from rigidlcp.models.dynamics import Dynamics
-from rigidlcp.models.lattice import PLANE
 from rigidlcp.models.system import System
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .result import OPTIMAL
-
 
 #: Default force box (per contact) when no bound is proved, in units of m_g max(g, |gamma|).
 BOX_FACTOR = 10.0
@@ -78,8 +74,6 @@ def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
     Ht = dyn.H[c:].toarray()
     T_u = Ht[:, 2 * p:] / r
     T_V = dyn.u_obs(1.0)[c:]
-    if np.any(np.abs(Ht[:, :2 * p]) > 0):
-        pass  # translation columns: irrelevant, disks do not translate in this regime
     T = np.column_stack([T_u, T_V])
     nz = np.abs(T) > 1e-12
     if np.any(nz.sum(axis=1) > 2) or np.any(np.abs(np.abs(T[nz]) - 1.0) > 1e-12):
@@ -90,8 +84,8 @@ def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
 
 @dataclass
 class Formulation:
-    """The MILP's constraint matrix and bounds; columns x = [R, S] (2c) | u (p) | V | y+ (F) |
-    y- (F), F = the frictional contacts."""
+    """The MILP's constraint matrix and bounds; columns x = [R, S] (2c) | ra = r alpha (p) |
+    u = r omega (p) | V | y+ (F) | y- (F), F = the frictional contacts."""
 
     system: System
     dyn: Dynamics
@@ -110,7 +104,23 @@ class Formulation:
 
     @property
     def n_cont(self) -> int:
-        return 2 * self.system.c + self.system.p + 1
+        return 2 * self.system.c + 2 * self.system.p + 1
+
+    def start(self, R: np.ndarray, S: np.ndarray, omega: np.ndarray, V: float,
+              s: np.ndarray) -> np.ndarray:
+        """A full column vector for a known state (a MIP start), velocities scaled into the
+        normalization (min sliding |v_t| = 1)."""
+        sys_, c, p = self.system, self.system.c, self.system.p
+        r = sys_.lattice.radius
+        x = np.concatenate([R, S])
+        ra = r * self.dyn.accelerations(x)[2 * p:]
+        vt = self.dyn.velocities(omega, V)[c:]
+        sl = s[self.fric] != 0
+        k = 1.0 / max(float(np.min(np.abs(vt[self.fric][sl]), initial=np.inf)), 1e-300)
+        k = 1.0 if not np.isfinite(k) else k
+        yp = (s[self.fric] > 0).astype(float)
+        ym = (s[self.fric] < 0).astype(float)
+        return np.concatenate([x, ra, k * r * omega, [k * V], yp, ym])
 
 
 def _equalities(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray]:
@@ -144,70 +154,73 @@ def force_bound(system: System, dyn: Dynamics, box: float | None = None) -> tupl
 
 def formulate(system: System, box: float | None = None, V_mode: str | None = None
               ) -> Formulation:
-    """The MILP of the module docstring (no objective)."""
+    """The MILP of the module docstring (no objective), in sparse form: the translational
+    force balance per disk (no translation; with it a_n = 0 on every contact, checked below),
+    the torque balance I alpha = -r sum S written for ra = r alpha, and a_t = T_u ra + T_V gamma
+    (the same two-variable form as v_t)."""
     dyn = Dynamics(system)
     c, p, mu = system.c, system.p, system.mu
+    r = system.lattice.radius
     fric = np.flatnonzero(mu > 0)
     F = fric.size
     T_u, T_V, OMEGA = velocity_box(dyn)
+    Hn_rot = dyn.H[:c].toarray()[:, 2 * p:]
+    if np.any(Hn_rot != 0) or np.any(dyn.u_obs_dot[:c] != 0):
+        raise NoVelocityBound("a_n depends on rotations or on the plane's motion: not the "
+                              "paper's regime")
     U, proved = force_bound(system, dyn, box)
     if V_mode is None:
         V_mode = ("free" if system.gamma != 0 else "zero" if system.V0 == 0
                   else "positive" if system.V0 > 0 else "negative")
-    n = 2 * c + p + 1 + 2 * F
-    iR, iS, iu, iV = 0, c, 2 * c, 2 * c + p
-    yp, ym = 2 * c + p + 1, 2 * c + p + 1 + F
+    n = 2 * c + 2 * p + 1 + 2 * F
+    iR, iS, ia, iu, iV = 0, c, 2 * c, 2 * c + p, 2 * c + 2 * p
+    yp, ym = iV + 1, iV + 1 + F
     rows, lo, hi = [], [], []
+    fidx = np.arange(F)
 
-    def add(block: np.ndarray, lower, upper) -> None:
-        rows.append(sp.csr_matrix(block))
+    def add(block, lower, upper) -> None:
+        block = sp.csr_matrix(block)
+        rows.append(block)
         lo.append(np.broadcast_to(np.asarray(lower, float), block.shape[0]).copy())
         hi.append(np.broadcast_to(np.asarray(upper, float), block.shape[0]).copy())
 
-    E, e = _equalities(dyn)
-    blk = np.zeros((E.shape[0], n))
-    blk[:, :2 * c] = E
-    add(blk, e, e)
-    # Coulomb's cone |S| <= mu R on frictional contacts (S = 0 elsewhere: bounds).
-    for sgn in (1.0, -1.0):
-        blk = np.zeros((F, n))
-        blk[np.arange(F), iS + fric] = sgn
-        blk[np.arange(F), iR + fric] = -mu[fric]
-        add(blk, -np.inf, 0.0)
-    # y+ => S + mu R <= 0;  y- => mu R - S <= 0  (both in [0, 2 mu U]).
+    def cols(blocks: dict[int, sp.spmatrix], m: int) -> sp.csr_matrix:
+        out = sp.lil_matrix((m, n))
+        for start, B in blocks.items():
+            B = sp.csr_matrix(B)
+            out[:, start:start + B.shape[1]] = B
+        return out.tocsr()
+
+    HT = sp.csr_matrix(dyn.H.T)
+    add(cols({0: HT[:2 * p]}, 2 * p), -dyn.f[:2 * p], -dyn.f[:2 * p])  # no translation
+    torque = sp.diags(r * dyn.Minv[2 * p:]) @ HT[2 * p:]  # ra = r M^-1 (H^T x)_rot
+    add(cols({0: -torque, ia: sp.eye(p)}, p), 0.0, 0.0)
+    Ef = sp.csr_matrix((np.ones(F), (fidx, fric)), shape=(F, c))
+    Mu = sp.diags(mu[fric]) @ Ef
+    for sgn in (1.0, -1.0):  # |S| <= mu R
+        add(cols({iR: -Mu, iS: sgn * Ef}, F), -np.inf, 0.0)
     big = 2.0 * mu[fric] * U
-    for sgn, ycol in ((1.0, yp), (-1.0, ym)):
-        blk = np.zeros((F, n))
-        blk[np.arange(F), iS + fric] = sgn
-        blk[np.arange(F), iR + fric] = mu[fric]
-        blk[np.arange(F), ycol + np.arange(F)] = big
-        add(blk, -np.inf, big)
-    # a_t in [-A y-, A y+]: y0 => a_t = 0, y+ => a_t >= 0, y- => a_t <= 0.
-    Wt = dyn.W[c + fric]
-    Rmax = np.full(c, U)
-    A_t = np.abs(dyn.q[c + fric]) + np.abs(Wt[:, :c]) @ Rmax + np.abs(Wt[:, c:]) @ (mu * Rmax)
-    for sgn, ycol in ((1.0, ym), (-1.0, yp)):  # a_t + A y- >= 0;  -a_t + A y+ >= 0
-        blk = np.zeros((F, n))
-        blk[:, :2 * c] = sgn * Wt
-        blk[np.arange(F), ycol + np.arange(F)] = A_t
-        add(blk, -sgn * dyn.q[c + fric], np.inf)
-    # v_t in [y+ - B y-, B y+ - y-] (B = 2 OMEGA bounds |v_t| over the box).
+    for sgn, ycol in ((1.0, yp), (-1.0, ym)):  # y+ => S + mu R <= 0; y- => mu R - S <= 0
+        add(cols({iR: Mu, iS: sgn * Ef, ycol: sp.diags(big)}, F), -np.inf, big)
+    # |ra_i| <= r^2 / I sum_{contacts of i} mu U: bounds |a_t| <= A over the force box.
+    touch = np.abs(HT[2 * p:].toarray())[:, c:] > 0
+    ra_max = r * dyn.Minv[2 * p:] * r * (touch @ (mu * U))
+    gam = T_V[fric] * system.gamma
+    A_t = np.abs(gam) + np.abs(T_u[fric]) @ ra_max
+    Tf = sp.csr_matrix(T_u[fric])
+    # a_t = T_u ra + gam in [-A y-, A y+]
+    add(cols({ia: Tf, ym: sp.diags(A_t)}, F), -gam, np.inf)
+    add(cols({ia: -Tf, yp: sp.diags(A_t)}, F), gam, np.inf)
+    # v_t = T_u u + T_V V in [y+ - B y-, B y+ - y-]  (B = 2 OMEGA bounds |v_t| in the box)
     B = 2.0 * OMEGA
-    for sgn, (cp, cm) in ((1.0, (-1.0, B)), (-1.0, (B, -1.0))):
-        blk = np.zeros((F, n))
-        blk[:, iu:iu + p] = sgn * T_u[fric]
-        blk[:, iV] = sgn * T_V[fric]
-        blk[np.arange(F), yp + np.arange(F)] = cp
-        blk[np.arange(F), ym + np.arange(F)] = cm
-        add(blk, 0.0, np.inf)
-    blk = np.zeros((F, n))  # y+ + y- <= 1
-    blk[np.arange(F), yp + np.arange(F)] = 1.0
-    blk[np.arange(F), ym + np.arange(F)] = 1.0
-    add(blk, -np.inf, 1.0)
-    lb = np.r_[np.zeros(c), np.where(mu > 0, -np.inf, 0.0), np.full(p, -OMEGA), -OMEGA,
-               np.zeros(2 * F)]
-    ub = np.r_[np.full(c, U), np.where(mu > 0, np.inf, 0.0), np.full(p, OMEGA), OMEGA,
-               np.ones(2 * F)]
+    TV = sp.csr_matrix(T_V[fric][:, None])
+    add(cols({iu: Tf, iV: TV, yp: -sp.eye(F), ym: B * sp.eye(F)}, F), 0.0, np.inf)
+    add(cols({iu: -Tf, iV: -TV, yp: B * sp.eye(F), ym: -sp.eye(F)}, F), 0.0, np.inf)
+    add(cols({yp: sp.eye(F), ym: sp.eye(F)}, F), -np.inf, 1.0)  # y+ + y- <= 1
+    lb = np.r_[np.zeros(c), np.where(mu > 0, -np.inf, 0.0), -ra_max, np.full(p, -OMEGA),
+               -OMEGA, np.zeros(2 * F)]
+    ub = np.r_[np.full(c, U), np.where(mu > 0, np.inf, 0.0), ra_max, np.full(p, OMEGA),
+               OMEGA, np.ones(2 * F)]
     if V_mode == "zero":
         lb[iV] = ub[iV] = 0.0
     elif V_mode == "positive":
@@ -216,7 +229,7 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
         ub[iV] = -1.0
     elif V_mode != "free":
         raise ValueError(f"V_mode must be free, zero, positive or negative, got {V_mode!r}")
-    integrality = np.r_[np.zeros(2 * c + p + 1), np.ones(2 * F)]
+    integrality = np.r_[np.zeros(2 * c + 2 * p + 1), np.ones(2 * F)]
     A = sp.vstack(rows).tocsr()
     return Formulation(system, dyn, A, np.concatenate(lo), np.concatenate(hi), lb, ub,
                        integrality, fric, U, proved, OMEGA, V_mode)
@@ -226,7 +239,7 @@ def states_of(form: Formulation, y: np.ndarray) -> np.ndarray:
     """Tangential states (+1, -1, 0 non-sliding; 0 also for frictionless) from the binaries."""
     c, p, F = form.system.c, form.system.p, form.fric.size
     s = np.zeros(c, dtype=int)
-    base = 2 * c + p + 1
+    base = 2 * c + 2 * p + 1
     s[form.fric] = np.where(y[base:base + F] > 0.5, 1, np.where(y[base + F:] > 0.5, -1, 0))
     return s
 
@@ -296,7 +309,7 @@ def state_velocities(form: Formulation, s: np.ndarray) -> tuple[np.ndarray, floa
     non-sliding; V as form.V_mode), or None when the kinematics admit no such velocities.
     With gamma = 0 and V0 != 0 the cone point is scaled to V = V0."""
     system, dyn = form.system, form.dyn
-    c, p, r = system.c, system.p, system.lattice.radius
+    p, r = system.p, system.lattice.radius
     T_u, T_V, OMEGA = velocity_box(dyn)
     T = np.column_stack([T_u, T_V])
     fr = form.fric

@@ -13,15 +13,14 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import Bounds, LinearConstraint, milp
+import scipy.sparse as sp
 
 from rigidlcp.models.system import System
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .observables import check_observable, steady_observables
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
-from .steady import _MILP, Formulation, NotSteady, formulate, state_extreme, state_velocities, \
-    states_of
+from .steady import Formulation, NotSteady, formulate, state_extreme, state_velocities, states_of
 from .witness import make_witness, steady_check
 
 #: A witness is accepted when its independent residual is at most this.
@@ -32,7 +31,9 @@ WITNESS_TOL = 1e-8
 class SteadyRanges:
     """Ranges over the valid steady states of `system`. box_proved: every valid steady state
     has R <= U (else the ranges are over those with R <= U); V_mode: how V was treated
-    (docs/mechanics.md); selected: the run's own values, when a run was given."""
+    (docs/mechanics.md). When a run was given: run_values, its own values, and own, the
+    ranges over the valid steady states with the run's own contact states (linear programs,
+    no force box: unbounded ends are reported so)."""
 
     system: System
     ranges: dict[str, Range]
@@ -41,6 +42,7 @@ class SteadyRanges:
     V_mode: str
     seconds: float
     run_values: dict[str, float] = field(default_factory=dict)
+    own: dict[str, Range] = field(default_factory=dict)
 
     @property
     def mu_g(self) -> Range:
@@ -62,6 +64,10 @@ class SteadyRanges:
                "V": self.V_mode, "seconds": round(self.seconds, 3)}
         if "mu_g" in self.run_values:
             out["run"] = {"mu_g": self.run_values["mu_g"]}
+        if "mu_g" in self.own:
+            o = self.own["mu_g"]
+            out["own_states"] = {"mu_g": [num(o.lo), num(o.hi)],
+                                 "status": [o.lo.status, o.hi.status]}
         groups: dict[str, list] = {}
         for name, r in self.ranges.items():
             if name == "mu_g":
@@ -85,6 +91,14 @@ class SteadyRanges:
             run = self.run_values.get(name)
             lines.append(f"{name:<12} {cell(r.lo):>16} {cell(r.hi):>16} {r.width:>11.4g} "
                          f"{'' if run is None else f'{run:.8g}':>13}")
+            if name in self.own:
+                o = self.own[name]
+                lines.append(f"{'  own states':<12} {cell(o.lo):>16} {cell(o.hi):>16} "
+                             f"{o.width:>11.4g}")
+        for name, r in self.ranges.items():
+            for e in (r.lo, r.hi):
+                if e.note:
+                    lines.append(f"note ({name}): {e.note}")
         return "\n".join(lines)
 
     def __repr__(self) -> str:
@@ -114,48 +128,127 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     exists or the run is not steady."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
+    start = None
+    if last is not None:
+        fin = target.final
+        res, s_run = steady_check(system, fin.omega, fin.V, last["R"], last["S"])
+        if res <= WITNESS_TOL:
+            start = (last["R"], last["S"], fin.omega, fin.V, s_run)
     form = formulate(system, box, V_mode)
     obs = steady_observables(system, which, form.dyn)
     for name, L in (observables or {}).items():
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
     scope = "all valid steady states" + ("" if form.box_proved else
                                          f" with every R <= {form.U:.4g} (no bound proved)")
-    ranges, run_values = {}, {}
+    ranges, run_values, own = {}, {}, {}
+    model = _Model(form)
+    if start is not None:
+        model.starts.append(form.start(*start))
     for name, L in obs.items():
-        lo = _end(form, L, +1, time_limit)
-        hi = _end(form, L, -1, time_limit)
+        lo = _end(form, model, L, +1, time_limit)
+        hi = _end(form, model, L, -1, time_limit)
         ranges[name] = Range(name, lo, hi, scope)
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
             ranges[name].selected = run_values[name]
+            if start is not None:
+                own[name] = Range(name, _own_end(form, start, L, +1),
+                                  _own_end(form, start, L, -1), "the run's own contact states",
+                                  run_values[name])
     return SteadyRanges(system, ranges, form.U, form.box_proved, form.V_mode,
-                        time.perf_counter() - t0, run_values)
+                        time.perf_counter() - t0, run_values, own)
 
 
-def _end(form: Formulation, L: np.ndarray, sense: int, time_limit: float) -> End:
+def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
+    """An end over the valid steady states with the run's contact states (its velocities)."""
+    R, S, omega, V, s = start
+    status, x, ray = state_extreme(form, s, L, sense)
+    if x is None:
+        return End("failed", note="the run's contact states admit no force (rounding)")
+    wit = make_witness(form.system, omega, V, x[:form.system.c], x[form.system.c:], form.dyn)
+    end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual)
+    if wit.residual > WITNESS_TOL:
+        end.status, end.value = "failed", None
+        end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
+    elif status == UNBOUNDED:
+        end = _check_ray(form, end, wit, ray, L, sense)
+    return end
+
+
+class _Model:
+    """The MILP of a Formulation in one HiGHS instance, re-solved with new costs."""
+
+    def __init__(self, form: Formulation):
+        import highspy
+
+        A = sp.csc_matrix(form.A)
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
+        lp.col_cost_ = np.zeros(A.shape[1])
+        lp.col_lower_, lp.col_upper_ = form.lb, form.ub
+        lp.row_lower_, lp.row_upper_ = form.lo, form.hi
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+            A.indptr, A.indices, A.data)
+        lp.integrality_ = [highspy.HighsVarType.kInteger if v else
+                           highspy.HighsVarType.kContinuous for v in form.integrality]
+        with quiet_highs():
+            h = highspy.Highs()
+        for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
+                           ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
+                           ("primal_feasibility_tolerance", 1e-9)):
+            h.setOptionValue(key, value)
+        h.passModel(lp)
+        self.h, self.hs, self.n = h, highspy, A.shape[1]
+        self.starts: list[np.ndarray] = []
+
+    def solve(self, cost: np.ndarray, time_limit: float) -> tuple[str, np.ndarray | None]:
+        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None)."""
+        h, hs = self.h, self.hs
+        h.clearSolver()
+        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        h.setOptionValue("time_limit", float(time_limit))
+        for x in self.starts:  # known valid states as MIP starts (HiGHS keeps the best)
+            sol = hs.HighsSolution()
+            sol.col_value = list(x)
+            sol.value_valid = True
+            h.setSolution(sol)
+        with quiet_highs():
+            h.run()
+        st = h.getModelStatus()
+        has_x = h.getInfo().primal_solution_status == 2
+        x = np.asarray(h.getSolution().col_value) if has_x else None
+        if st == hs.HighsModelStatus.kOptimal:
+            return OPTIMAL, x
+        if st == hs.HighsModelStatus.kInfeasible:
+            return INFEASIBLE, None
+        if st == hs.HighsModelStatus.kTimeLimit:
+            return TIME_LIMIT, x
+        return "failed", x
+
+
+def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit: float
+         ) -> End:
     """min (sense +1) or max (sense -1) of L . x over the valid steady states."""
     t0 = time.perf_counter()
     c, p = form.system.c, form.system.p
-    cost = np.zeros(form.A.shape[1])
+    cost = np.zeros(model.n)
     cost[:2 * c] = sense * L
-    with quiet_highs():
-        out = milp(cost, integrality=form.integrality,
-                   constraints=LinearConstraint(form.A, form.lo, form.hi),
-                   bounds=Bounds(form.lb, form.ub),
-                   options={"time_limit": float(time_limit), **_MILP})
-    if out.status == 2:
+    mstat, xm = model.solve(cost, time_limit)
+    if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
-    if out.x is None:
-        return End(TIME_LIMIT if out.status == 1 else "failed",
-                   seconds=time.perf_counter() - t0, note=str(out.message))
-    s = states_of(form, out.x)
+    if xm is None:
+        return End(TIME_LIMIT if mstat == TIME_LIMIT else "failed",
+                   seconds=time.perf_counter() - t0, note=f"HiGHS: {mstat}, no point")
+    s = states_of(form, xm)
     status, x, ray = state_extreme(form, s, L, sense)
     vel = state_velocities(form, s)
     if vel is None:  # the LP disagrees with the MILP's kinematics: keep the MILP's velocities
-        vel = (out.x[2 * c:2 * c + p] / form.system.lattice.radius, float(out.x[2 * c + p]))
+        r = form.system.lattice.radius
+        vel = (xm[2 * c + p:2 * c + 2 * p] / r, float(xm[2 * c + 2 * p]))
     if x is None:
-        x = out.x[:2 * c]
+        x = xm[:2 * c]
     wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
               seconds=time.perf_counter() - t0)
@@ -163,7 +256,7 @@ def _end(form: Formulation, L: np.ndarray, sense: int, time_limit: float) -> End
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
         return end
-    if out.status == 1:  # time limit with an incumbent: a value met, not a bound
+    if mstat != OPTIMAL:  # time limit with an incumbent: a value met, not a bound
         end.status, end.best, end.value = TIME_LIMIT, float(L @ x), None
         return end
     if status == UNBOUNDED:
@@ -171,8 +264,10 @@ def _end(form: Formulation, L: np.ndarray, sense: int, time_limit: float) -> End
     elif status == INFEASIBLE:
         end.status, end.value = "failed", None
         end.note = "the contact states of the MILP's point admit no force (rounding)"
-    elif sense * (end.value - sense * out.fun * sense) < -1e-9 * max(1.0, abs(end.value)):
+    elif sense * (end.value - float(L @ xm[:2 * c])) < -1e-9 * max(1.0, abs(end.value)):
         end.note = "the extreme of these contact states lies beyond the force box"
+    if end.status == OPTIMAL:
+        model.starts.append(form.start(wit.R, wit.S, wit.omega, wit.V, wit.s))
     return end
 
 
