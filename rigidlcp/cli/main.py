@@ -25,6 +25,7 @@ COMMAND_MODULES = (
     "rigidlcp.cli.nullspace",  # nullspace, verify-formulas
     "rigidlcp.cli.forces",  # forces
     "rigidlcp.cli.certify_run",  # certify-run
+    "rigidlcp.cli.ranges",  # ranges
     "rigidlcp.cli.bench",  # bench
     "rigidlcp.cli.fuzz",  # fuzz
     "rigidlcp.cli.reproduce",  # reproduce

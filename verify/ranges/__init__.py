@@ -8,6 +8,8 @@ Each end of a range carries a witness checked independently, a ray when unbounde
 status "time limit" (never a bound).
 """
 
+from .event import EventRanges as EventRanges
+from .event import event_ranges as event_ranges
 from .result import End as End
 from .result import Range as Range
 from .steady_ranges import SteadyRanges as SteadyRanges
