@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
@@ -105,6 +106,11 @@ class SteadyRanges:
         return self.table()
 
 
+def _alpha(system: System, R: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """Angular accelerations of the forces (R, S): the rotational part of nu'."""
+    return Dynamics(system).accelerations(np.concatenate([R, S]))[2 * system.p:]
+
+
 def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
     if isinstance(target, System):
         return target, None
@@ -130,10 +136,14 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     system, last = _run_system(target)
     start = None
     if last is not None:
+        # The run's state one time unit after its last event (a steady state stays one; a
+        # contact that starts to slide there has v_t = 0 at the event itself).
         fin = target.final
-        res, s_run = steady_check(system, fin.omega, fin.V, last["R"], last["S"])
+        alpha = _alpha(system, last["R"], last["S"])
+        omega, V = fin.omega + alpha, fin.V + system.gamma
+        res, s_run = steady_check(system, omega, V, last["R"], last["S"])
         if res <= WITNESS_TOL:
-            start = (last["R"], last["S"], fin.omega, fin.V, s_run)
+            start = (last["R"], last["S"], omega, V, s_run)
     form = formulate(system, box, V_mode)
     obs = steady_observables(system, which, form.dyn)
     for name, L in (observables or {}).items():
