@@ -12,5 +12,5 @@ from .event import EventRanges as EventRanges
 from .event import event_ranges as event_ranges
 from .result import End as End
 from .result import Range as Range
-from .steady_ranges import SteadyRanges as SteadyRanges
-from .steady_ranges import steady_ranges as steady_ranges
+from .valid_steady import SteadyRanges as SteadyRanges
+from .valid_steady import steady_ranges as steady_ranges
