@@ -114,3 +114,20 @@ def test_frictionless_row_between_frictionless_walls():
         want = 0.05 if name == "mu_g" else -0.1
         assert r.lo.value == pytest.approx(want, abs=1e-9)
         assert r.hi.value == pytest.approx(want, abs=1e-9)
+
+
+@pytest.mark.parametrize("V0", [1.0, -0.5, 0.0])
+def test_constant_velocity_V_is_the_runs(V0):
+    """gamma = 0: V = V0 is fixed (docs/mechanics.md). One disk, smooth walls: rolling needs
+    omega = -V0 and alpha = 0, so S_P = 0; sliding with v_t < 0 needs S_P = mu_P, alpha = -0.4
+    and a_t = +0.4 <= 0, with v_t > 0 alpha = +0.4 and a_t = -0.4 >= 0: both impossible.
+    mu_g = 0 and alpha = 0, and the witness has V = V0, omega = -V0."""
+    s = models.System(models.rectangular(1, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.0, V0=V0)
+    res = steady_ranges(s, which="alpha", time_limit=20)
+    assert res.V_mode == {1.0: "positive", -0.5: "negative", 0.0: "zero"}[V0]
+    for r in res.ranges.values():
+        assert r.lo.value == pytest.approx(0.0, abs=1e-12)
+        assert r.hi.value == pytest.approx(0.0, abs=1e-12)
+    w = res.mu_g.lo.witness
+    assert w.V == V0 and w.omega[0] == pytest.approx(-V0, abs=1e-12)
