@@ -141,7 +141,8 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         fin = target.final
         alpha = _alpha(system, last["R"], last["S"])
         omega, V = fin.omega + alpha, fin.V + system.gamma
-        res, s_run = steady_check(system, omega, V, last["R"], last["S"])
+        v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
+        res, s_run = steady_check(system, omega, V, last["R"], last["S"], v_scale=v_scale)
         if res <= WITNESS_TOL:
             start = (last["R"], last["S"], omega, V, s_run)
     form = formulate(system, box, V_mode)
@@ -175,13 +176,15 @@ def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     status, x, ray = state_extreme(form, s, L, sense)
     if x is None:
         return End("failed", note="the run's contact states admit no force (rounding)")
-    wit = make_witness(form.system, omega, V, x[:form.system.c], x[form.system.c:], form.dyn)
+    system = form.system
+    v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
+    wit = make_witness(system, omega, V, x[:system.c], x[system.c:], form.dyn, v_scale)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual)
     if wit.residual > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
     elif status == UNBOUNDED:
-        end = _check_ray(form, end, wit, ray, L, sense)
+        end = _check_ray(form, end, wit, ray, L, sense, v_scale)
     return end
 
 
@@ -281,7 +284,8 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
     return end
 
 
-def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int) -> End:
+def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
+               v_scale: float = 0.0) -> End:
     """End "unbounded" if x + t d stays a valid steady state for a large t and L d has the
     right sign; otherwise "failed" with the reason."""
     c = form.system.c
@@ -292,7 +296,7 @@ def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int)
     x = np.concatenate([wit.R, wit.S])
     t = 1e3 * max(1.0, float(np.max(np.abs(x))))
     y = x + t * ray
-    res, _ = steady_check(form.system, wit.omega, wit.V, y[:c], y[c:], form.dyn)
+    res, _ = steady_check(form.system, wit.omega, wit.V, y[:c], y[c:], form.dyn, v_scale)
     if res > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"the ray did not pass the check (residual {res:.1e} at t = {t:.3g})"

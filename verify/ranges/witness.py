@@ -53,11 +53,12 @@ class SteadyWitness:
                 f"max R={np.max(self.R, initial=0):.3g}, residual {self.residual:.1e}>")
 
 
-def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = None
-                 ) -> tuple[float, np.ndarray]:
+def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,
+                 v_scale: float = 0.0) -> tuple[float, np.ndarray]:
     """(residual, s): the largest relative violation of the steady-state laws (module
     docstring) by (omega, V, R, S), and the states read off sgn(v_t) (0 where |v_t| <= 1e-9
-    max|v_t|)."""
+    max(max|v_t|, v_scale); v_scale: the velocity scale of a run, whose rounding noise
+    (1e-16) is not a velocity)."""
     dyn = dyn or Dynamics(system)
     c, p, mu = system.c, system.p, system.mu
     omega = np.asarray(omega, dtype=float)
@@ -70,7 +71,7 @@ def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = N
     a = dyn.H @ nu_dot + dyn.u_obs_dot
     v = dyn.velocities(omega, V)
     vt = v[c:]
-    vscale = max(float(np.max(np.abs(vt), initial=0.0)), 1e-300)
+    vscale = max(float(np.max(np.abs(vt), initial=0.0)), v_scale, 1e-300)
     s = np.where(np.abs(vt) <= 1e-9 * vscale, 0, np.sign(vt)).astype(int)
     s[mu == 0] = 0
     at = a[c:]
@@ -83,13 +84,13 @@ def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = N
     return float(max(np.max(x, initial=0.0) for x in viol)), s
 
 
-def make_witness(system: System, omega, V: float, R, S, dyn: Dynamics | None = None
-                 ) -> SteadyWitness:
+def make_witness(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,
+                 v_scale: float = 0.0) -> SteadyWitness:
     """A SteadyWitness with its alpha, mu_g and independent residual computed here."""
     dyn = dyn or Dynamics(system)
     lam = np.concatenate([R, S])
     alpha = dyn.accelerations(lam)[2 * system.p:]
-    res, s = steady_check(system, omega, V, R, S, dyn)
+    res, s = steady_check(system, omega, V, R, S, dyn, v_scale)
     lat = system.lattice
     return SteadyWitness(np.asarray(omega, float), float(V), alpha, np.asarray(R, float),
                          np.asarray(S, float), np.column_stack([lat.i, lat.j]), s,
