@@ -37,6 +37,7 @@ from rigidlcp.lcp.errors import RigidLCPError
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 
+from .bounds import proved_bounds
 from .result import OPTIMAL
 
 #: Default force box (per contact) when no bound is proved, in units of m_g max(g, |gamma|).
@@ -101,6 +102,16 @@ class Formulation:
     omega_box: float
     V_mode: str  # "free" | "zero" | "positive" | "negative"
     notes: list[str] = field(default_factory=list)
+    R_hi: np.ndarray | None = None  # per-contact force bounds (verify.ranges.bounds)
+    free_R: np.ndarray | None = None  # contacts whose R bound holds for S-observables only
+
+    def proved_for(self, L: np.ndarray) -> bool:
+        """Whether the force bounds are proved for the observable L (verify.ranges.bounds:
+        not for an observable that weighs the R of a self-stress group)."""
+        if not self.box_proved:
+            return False
+        c = self.system.c
+        return self.free_R is None or not np.any(np.asarray(L)[:c][self.free_R] != 0)
 
     @property
     def n_cont(self) -> int:
@@ -168,7 +179,14 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
     if np.any(Hn_rot != 0) or np.any(dyn.u_obs_dot[:c] != 0):
         raise NoVelocityBound("a_n depends on rotations or on the plane's motion: not the "
                               "paper's regime")
-    U, proved = force_bound(system, dyn, box)
+    E, e = _equalities(dyn)
+    fb = proved_bounds(system, dyn, E, e)
+    if fb is not None:
+        R_hi, S_abs, proved = fb.R_hi, fb.S_abs, True
+        U = float(np.max(R_hi, initial=0.0))
+    else:
+        U, proved = force_bound(system, dyn, box)
+        R_hi, S_abs = np.full(c, U), mu * U
     if V_mode is None:
         V_mode = ("free" if system.gamma != 0 else "zero" if system.V0 == 0
                   else "positive" if system.V0 > 0 else "negative")
@@ -199,28 +217,34 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
     Mu = sp.diags(mu[fric]) @ Ef
     for sgn in (1.0, -1.0):  # |S| <= mu R
         add(cols({iR: -Mu, iS: sgn * Ef}, F), -np.inf, 0.0)
-    big = 2.0 * mu[fric] * U
+    big = S_abs[fric] + mu[fric] * R_hi[fric]  # >= S + mu R and mu R - S
     for sgn, ycol in ((1.0, yp), (-1.0, ym)):  # y+ => S + mu R <= 0; y- => mu R - S <= 0
         add(cols({iR: Mu, iS: sgn * Ef, ycol: sp.diags(big)}, F), -np.inf, big)
-    # |ra_i| <= r^2 / I sum_{contacts of i} mu U: bounds |a_t| <= A over the force box.
-    touch = np.abs(HT[2 * p:].toarray())[:, c:] > 0
-    ra_max = r * dyn.Minv[2 * p:] * r * (touch @ (mu * U))
+    if fb is not None:
+        ra_lo, ra_hi = fb.ra_lo, fb.ra_hi
+    else:  # |ra_i| <= r^2 / I sum_{contacts of i} mu U over the force box
+        touch = np.abs(HT[2 * p:].toarray())[:, c:] > 0
+        ra_hi = r * dyn.Minv[2 * p:] * r * (touch @ (mu * U))
+        ra_lo = -ra_hi
     gam = T_V[fric] * system.gamma
-    A_t = np.abs(gam) + np.abs(T_u[fric]) @ ra_max
+    Tp, Tm = np.maximum(T_u[fric], 0), np.minimum(T_u[fric], 0)
+    A_hi = np.maximum(gam + Tp @ ra_hi + Tm @ ra_lo, 0.0)  # a_t in [A_lo, A_hi] (intervals)
+    A_lo = np.minimum(gam + Tp @ ra_lo + Tm @ ra_hi, 0.0)
+    if fb is not None:  # the LP bounds of a_t itself
+        A_hi = np.maximum(np.minimum(A_hi, fb.at_hi[fric]), 0.0)
+        A_lo = np.minimum(np.maximum(A_lo, fb.at_lo[fric]), 0.0)
     Tf = sp.csr_matrix(T_u[fric])
-    # a_t = T_u ra + gam in [-A y-, A y+]
-    add(cols({ia: Tf, ym: sp.diags(A_t)}, F), -gam, np.inf)
-    add(cols({ia: -Tf, yp: sp.diags(A_t)}, F), gam, np.inf)
+    # a_t = T_u ra + gam in [A_lo y-, A_hi y+]
+    add(cols({ia: Tf, ym: sp.diags(-A_lo)}, F), -gam, np.inf)
+    add(cols({ia: -Tf, yp: sp.diags(A_hi)}, F), gam, np.inf)
     # v_t = T_u u + T_V V in [y+ - B y-, B y+ - y-]  (B = 2 OMEGA bounds |v_t| in the box)
     B = 2.0 * OMEGA
     TV = sp.csr_matrix(T_V[fric][:, None])
     add(cols({iu: Tf, iV: TV, yp: -sp.eye(F), ym: B * sp.eye(F)}, F), 0.0, np.inf)
     add(cols({iu: -Tf, iV: -TV, yp: B * sp.eye(F), ym: -sp.eye(F)}, F), 0.0, np.inf)
     add(cols({yp: sp.eye(F), ym: sp.eye(F)}, F), -np.inf, 1.0)  # y+ + y- <= 1
-    lb = np.r_[np.zeros(c), np.where(mu > 0, -np.inf, 0.0), -ra_max, np.full(p, -OMEGA),
-               -OMEGA, np.zeros(2 * F)]
-    ub = np.r_[np.full(c, U), np.where(mu > 0, np.inf, 0.0), ra_max, np.full(p, OMEGA),
-               OMEGA, np.ones(2 * F)]
+    lb = np.r_[np.zeros(c), -S_abs, ra_lo, np.full(p, -OMEGA), -OMEGA, np.zeros(2 * F)]
+    ub = np.r_[R_hi, S_abs, ra_hi, np.full(p, OMEGA), OMEGA, np.ones(2 * F)]
     if V_mode == "zero":
         lb[iV] = ub[iV] = 0.0
     elif V_mode == "positive":
@@ -232,7 +256,8 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
     integrality = np.r_[np.zeros(2 * c + 2 * p + 1), np.ones(2 * F)]
     A = sp.vstack(rows).tocsr()
     return Formulation(system, dyn, A, np.concatenate(lo), np.concatenate(hi), lb, ub,
-                       integrality, fric, U, proved, OMEGA, V_mode)
+                       integrality, fric, U, proved, OMEGA, V_mode, [], R_hi,
+                       None if fb is None else fb.free_R)
 
 
 def states_of(form: Formulation, y: np.ndarray) -> np.ndarray:

@@ -149,8 +149,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     obs = steady_observables(system, which, form.dyn)
     for name, L in (observables or {}).items():
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
-    scope = "all valid steady states" + ("" if form.box_proved else
-                                         f" with every R <= {form.U:.4g} (no bound proved)")
+    unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
     model = _Model(form)
     if start is not None:
@@ -158,6 +157,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     for name, L in obs.items():
         lo = _end(form, model, L, +1, time_limit)
         hi = _end(form, model, L, -1, time_limit)
+        scope = "all valid steady states" if form.proved_for(L) else unproved
         ranges[name] = Range(name, lo, hi, scope)
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
