@@ -26,6 +26,8 @@ from .witness import make_witness, steady_check
 
 #: A witness is accepted when its independent residual is at most this.
 WITNESS_TOL = 1e-8
+#: Contact-state sets kept as seeds (verify.ranges.valid_steady._Model.add_seed).
+MAX_SEEDS = 6
 
 
 @dataclass
@@ -154,6 +156,9 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     model = _Model(form)
     if start is not None:
         model.starts.append(form.start(*start))
+        model.add_seed(start[4])
+    for s_seed in seed_states(form):
+        model.add_seed(s_seed)
     for name, L in obs.items():
         lo = _end(form, model, L, +1, time_limit)
         hi = _end(form, model, L, -1, time_limit)
@@ -214,14 +219,23 @@ class _Model:
         h.passModel(lp)
         self.h, self.hs, self.n = h, highspy, A.shape[1]
         self.starts: list[np.ndarray] = []
+        self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
 
-    def solve(self, cost: np.ndarray, time_limit: float) -> tuple[str, np.ndarray | None]:
-        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None)."""
+    def add_seed(self, s: np.ndarray) -> None:
+        """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
+        s = np.asarray(s, dtype=int)
+        self.seeds = [t for t in self.seeds if not np.array_equal(t, s)] + [s]
+        del self.seeds[:-MAX_SEEDS]
+
+    def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
+              ) -> tuple[str, np.ndarray | None]:
+        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
+        extra: MIP starts for this objective only."""
         h, hs = self.h, self.hs
         h.clearSolver()
         h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
         h.setOptionValue("time_limit", float(time_limit))
-        for x in self.starts:  # known valid states as MIP starts (HiGHS keeps the best)
+        for x in [*self.starts, *extra]:  # valid states as MIP starts (HiGHS keeps the best)
             sol = hs.HighsSolution()
             sol.col_value = list(x)
             sol.value_valid = True
@@ -247,7 +261,7 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
     c, p = form.system.c, form.system.p
     cost = np.zeros(model.n)
     cost[:2 * c] = sense * L
-    mstat, xm = model.solve(cost, time_limit)
+    mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
     if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
@@ -281,7 +295,42 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
         end.note = "the extreme of these contact states lies beyond the force box"
     if end.status == OPTIMAL:
         model.starts.append(form.start(wit.R, wit.S, wit.omega, wit.V, wit.s))
+    if end.status in (OPTIMAL, TIME_LIMIT):
+        model.add_seed(wit.s)
     return end
+
+
+def seed_states(form: Formulation) -> list[np.ndarray]:
+    """Contact-state sets of simple velocities, tried at every end: no rotation (omega = 0)
+    with V = +1 and -1 (V free) or V of the run's sign: every disk-disk contact non-sliding,
+    every frictional contact with the plane sliding the same way (the locked array)."""
+    system, dyn = form.system, form.dyn
+    Vs = {"free": (1.0, -1.0), "zero": (0.0,), "positive": (1.0,),
+          "negative": (-1.0,)}[form.V_mode]
+    out = []
+    for V in Vs:
+        vt = dyn.velocities(np.zeros(system.p), V)[system.c:]
+        s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
+        if state_velocities(form, s) is not None:
+            out.append(s)
+    return out
+
+
+def _seed_starts(form: Formulation, model: _Model, L: np.ndarray, sense: int
+                 ) -> list[np.ndarray]:
+    """MIP starts for one end: the extreme of L over each seed state set (a linear program),
+    where it is finite and its witness passes steady_check."""
+    c, out = form.system.c, []
+    for s in model.seeds:
+        status, x, _ = state_extreme(form, s, L, sense)
+        vel = state_velocities(form, s)
+        if status != OPTIMAL or vel is None:
+            continue
+        R, S = x[:c], x[c:]
+        if (np.all(R <= form.R_hi) if form.R_hi is not None else True) and \
+                steady_check(form.system, vel[0], vel[1], R, S, form.dyn)[0] <= WITNESS_TOL:
+            out.append(form.start(R, S, vel[0], vel[1], s))
+    return out
 
 
 def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
