@@ -18,11 +18,13 @@ the sign of V0 when gamma = 0: the module `kinematics` below says why and proves
 Big-M constants, each a consequence of a bound that is proved or reported as not proved:
 * velocities: |u_i|, |V| <= OMEGA = 2 (p + 1) (`velocity_box`: a system of two-variable unit
   inequalities, solved by shortest paths, has a solution within that box whenever it has one);
-* forces: R_alpha <= U. U is proved when the linear relaxation (no binaries) bounds sum R;
-  otherwise U is a box (default `BOX_FACTOR` m_g max(g, |gamma|)) and every range is "within
-  the box" (`SteadyRanges.box_proved` False), each end's contact states then checked for a ray
-  (an end that grows without bound on its own contact states is reported "unbounded");
-* a_t: |a_t| <= |q_t| + sum_b |W_tR_b| U + mu_b |W_tS_b| U, from the force box.
+* forces: per contact |S| <= S_abs, R <= R_hi, proved by verify.ranges.bounds (LPs over the
+  relaxation, the rows' self-stress reduced) for every observable of S and of the bounded R
+  (`Formulation.proved_for`); where that proof fails, R <= U, proved when the linear
+  relaxation bounds sum R, otherwise a box (default `BOX_FACTOR` m_g max(g, |gamma|)) and the
+  range is "within the box", each end's contact states then checked for a ray (an end that
+  grows without bound on its own contact states is reported "unbounded");
+* a_t: the LP bounds of a_t (verify.ranges.bounds), else intervals from the r alpha bounds.
 """
 
 from __future__ import annotations
