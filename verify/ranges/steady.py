@@ -331,6 +331,18 @@ def state_extreme(form: Formulation, s: np.ndarray, L: np.ndarray, sense: int):
 
 
 
+def least_R(form: Formulation, s: np.ndarray, S: np.ndarray) -> np.ndarray | None:
+    """The R of least sum with the given S on the states s (the self-stress reduction of
+    verify.ranges.bounds: same S, same states), or None if the LP fails."""
+    A_ub, b_ub, A_eq, b_eq, bounds = _state_lp(form, s)
+    c = form.system.c
+    bounds = bounds[:c] + [(v, v) for v in S]
+    res = linprog(np.r_[np.ones(c), np.zeros(c)], A_ub=A_ub if A_ub.size else None,
+                  b_ub=b_ub if A_ub.size else None, A_eq=A_eq, b_eq=b_eq, bounds=bounds,
+                  method="highs", options=_LP)
+    return res.x[:c] if res.status == 0 else None
+
+
 def state_velocities(form: Formulation, s: np.ndarray) -> tuple[np.ndarray, float] | None:
     """(omega, V) whose tangential velocities have the signs s (s v_t >= 1 sliding, v_t = 0
     non-sliding; V as form.V_mode), or None when the kinematics admit no such velocities.

@@ -21,7 +21,15 @@ from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .observables import check_observable, steady_observables
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
-from .steady import Formulation, NotSteady, formulate, state_extreme, state_velocities, states_of
+from .steady import (
+    Formulation,
+    NotSteady,
+    formulate,
+    least_R,
+    state_extreme,
+    state_velocities,
+    states_of,
+)
 from .witness import make_witness, steady_check
 
 #: A witness is accepted when its independent residual is at most this.
@@ -235,7 +243,9 @@ class _Model:
         h.clearSolver()
         h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
         h.setOptionValue("time_limit", float(time_limit))
-        for x in [*self.starts, *extra]:  # valid states as MIP starts (HiGHS keeps the best)
+        starts = [*self.starts, *extra]
+        # the best valid state as the MIP start (a later setSolution replaces an earlier one)
+        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
             sol = hs.HighsSolution()
             sol.col_value = list(x)
             sol.value_valid = True
@@ -327,8 +337,11 @@ def _seed_starts(form: Formulation, model: _Model, L: np.ndarray, sense: int
         if status != OPTIMAL or vel is None:
             continue
         R, S = x[:c], x[c:]
-        if (np.all(R <= form.R_hi) if form.R_hi is not None else True) and \
-                steady_check(form.system, vel[0], vel[1], R, S, form.dyn)[0] <= WITNESS_TOL:
+        if form.R_hi is not None and np.any(R > form.R_hi):
+            R = least_R(form, s, S)  # same S and states, R within the proved bounds
+            if R is None or np.any(R > form.R_hi):
+                continue
+        if steady_check(form.system, vel[0], vel[1], R, S, form.dyn)[0] <= WITNESS_TOL:
             out.append(form.start(R, S, vel[0], vel[1], s))
     return out
 
