@@ -40,8 +40,10 @@ MAX_SEEDS = 6
 
 @dataclass
 class SteadyRanges:
-    """Ranges over the valid steady states of `system`. box_proved: every valid steady state
-    has R <= U (else the ranges are over those with R <= U); V_mode: how V was treated
+    """Ranges over the valid steady states of `system`. box_proved: the force bounds (R <= U,
+    per contact in verify.ranges.bounds) are proved, for every observable of S and of the
+    bounded R (each Range's scope says whether it is covered; else the range is over the
+    states with R <= U); V_mode: how V was treated
     (docs/mechanics.md). When a run was given: run_values, its own values, and own, the
     ranges over the valid steady states with the run's own contact states (linear programs,
     no force box: unbounded ends are reported so)."""
