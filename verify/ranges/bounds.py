@@ -178,6 +178,15 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
         if ext is None or not np.all(np.isfinite(ext)):
             return None
         ra_lo[i], ra_hi[i] = -_pad(-ext[0]), _pad(ext[1])
+    # Power: nu'^T M nu' = nu'^T (H^T lambda + f) with no translation gives
+    # sum_i I_i alpha_i^2 = S . a_t - u_obs'^T lambda, and S . a_t <= 0 on every valid steady
+    # state (sliding: S = -s mu R, s a_t >= 0; non-sliding: a_t = 0; frictionless: S = 0), so
+    # I_i alpha_i^2 <= max over P of (-u_obs'^T lambda) =: Pmax (= gamma F_g at most).
+    ext = P.extreme(-np.asarray(dyn.u_obs_dot, float))
+    if ext is not None and np.isfinite(ext[1]):
+        I_rot = 1.0 / dyn.Minv[2 * p:]
+        cap = r * np.sqrt(_pad(max(ext[1], 0.0)) / I_rot)
+        ra_lo, ra_hi = np.maximum(ra_lo, -_pad(cap)), np.minimum(ra_hi, _pad(cap))
     # a_t of each frictional contact: T_u r alpha + T_V gamma (verify.ranges.steady), one
     # LP pair each (tighter than the sum of the r alpha intervals)
     Tu = dyn.H[c:].toarray()[:, 2 * p:] / r
@@ -187,7 +196,9 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
         ext = P.extreme(Tu[a] @ Lra)
         if ext is None or not np.all(np.isfinite(ext)):
             return None
-        at_lo[a], at_hi[a] = gam[a] - _pad(-ext[0]), gam[a] + _pad(ext[1])
+        Tp, Tm = np.maximum(Tu[a], 0.0), np.minimum(Tu[a], 0.0)  # or from the r alpha box
+        at_lo[a] = gam[a] + max(-_pad(-ext[0]), Tp @ ra_lo + Tm @ ra_hi)
+        at_hi[a] = gam[a] + min(_pad(ext[1]), Tp @ ra_hi + Tm @ ra_lo)
     free = np.flatnonzero(~np.isfinite(R_hi))
     groups = []
     if free.size:

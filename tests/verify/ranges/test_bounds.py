@@ -1,8 +1,9 @@
 """The proved force bounds of verify.ranges.bounds hold on valid steady states found without
 them: random velocities (integers, so ties give non-sliding contacts) fix the contact states;
 a linear program written here (not the code under test) finds forces of those states for a
-random objective, with no force box; each such valid steady state must satisfy |S| <= S_abs,
-the r alpha and a_t bounds, and, for its S, admit forces with R <= R_hi (the self-stress
+random objective, with no force box; each such valid steady state must satisfy the power
+identity I |alpha|^2 = S . a_t - u_obs' . lambda with S . a_t <= 0, |S| <= S_abs, the r alpha
+and a_t bounds, and, for its S, admit forces with R <= R_hi (the self-stress
 reduction), checked by a second LP written here. And the 10x1 rows' ranges, now proved."""
 
 from __future__ import annotations
@@ -90,6 +91,11 @@ def test_random_valid_steady_states_satisfy_the_bounds(lx, ly, mu_pp, mu_plane, 
         tol = 1e-7 * max(1.0, float(np.abs(x).max()))
         assert np.all(np.abs(S) <= fb.S_abs + tol)
         ra = r * dyn.accelerations(x)[2 * p:]
+        # the power identity behind the r alpha cap (verify.ranges.bounds), from Newton-Euler
+        at = (dyn.H @ dyn.accelerations(x) + dyn.u_obs_dot)[c:]
+        power = float(np.sum(ra ** 2 / r ** 2 / dyn.Minv[2 * p:]))
+        assert power == pytest.approx(S @ at - dyn.u_obs_dot @ x, abs=tol)
+        assert S @ at <= tol
         assert np.all(ra >= fb.ra_lo - tol) and np.all(ra <= fb.ra_hi + tol)
         at = (dyn.H @ dyn.accelerations(x) + dyn.u_obs_dot)[c:]
         fr = system.mu > 0
