@@ -101,6 +101,11 @@ class _P:
         with quiet_highs():
             h.run()
         st = h.getModelStatus()
+        if st == hs.HighsModelStatus.kUnknown:  # warm start in trouble: once more from scratch
+            h.clearSolver()
+            with quiet_highs():
+                h.run()
+            st = h.getModelStatus()
         if st == hs.HighsModelStatus.kOptimal:
             return float(h.getInfo().objective_function_value)
         if st in (hs.HighsModelStatus.kUnbounded, hs.HighsModelStatus.kUnboundedOrInfeasible):
