@@ -16,7 +16,12 @@ from .nullspace.formulas import paper_singularities as paper_singularities
 
 def __getattr__(name: str):
     """Public subpackages and modules are attributes, imported on first use
-    (verify.strategies, verify.nullspace, ...)."""
+    (verify.strategies, verify.nullspace, ...); verify.steady_ranges and verify.event_ranges
+    are the functions of verify.ranges (issue 21)."""
+    if name in ("steady_ranges", "event_ranges"):
+        import importlib
+
+        return getattr(importlib.import_module(f"{__name__}.ranges"), name)
     if not name.startswith("_"):
         import importlib
         import importlib.util

@@ -28,6 +28,7 @@ COMMAND_MODULES = (
     "rigidlcp.cli.pack",  # pack (deposition)
     "rigidlcp.cli.forceset",  # forceset (statics of a packing)
     "rigidlcp.cli.certify_run",  # certify-run
+    "rigidlcp.cli.ranges",  # ranges
     "rigidlcp.cli.bench",  # bench
     "rigidlcp.cli.fuzz",  # fuzz
     "rigidlcp.cli.reproduce",  # reproduce

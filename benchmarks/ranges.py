@@ -1,0 +1,79 @@
+"""Ranges over all valid steady states (verify.ranges.steady_ranges, issue 21): a script, not
+a test.
+
+    python benchmarks/ranges.py [--time-limit SECONDS] [--skip-alpha]
+
+1. The four rows of issue 21's table (rect 10x1 at 0.05/0.1/0, gamma 0.01 and 0.02; rect 10x1
+   at 0.1/0.2/0, gamma 0.02; Fig. 9: rect 10x4 at 0.1/0.2/0, gamma 0.16), each from the run of
+   seed 1: the run's mu_g, the range over the valid steady states with the run's own contact
+   states (linear programs), and over every contact-state set (the MILP; "time limit" ends
+   show the best value met, which is *not* a bound).
+2. Fig. 9's system: mu_g and every angular acceleration, with the time of each end.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from rigidlcp import models
+from rigidlcp.verify.ranges import steady_ranges
+from rigidlcp.verify.ranges.result import OPTIMAL
+
+CASES = [("rect 10x1 0.05/0.1/0 gamma 0.01", 10, 1, 0.05, 0.1, 0.01),
+         ("rect 10x1 0.05/0.1/0 gamma 0.02", 10, 1, 0.05, 0.1, 0.02),
+         ("rect 10x1 0.1/0.2/0 gamma 0.02", 10, 1, 0.1, 0.2, 0.02),
+         ("Fig. 9 rect 10x4 0.1/0.2/0 gamma 0.16", 10, 4, 0.1, 0.2, 0.16)]
+
+
+def cell(e) -> str:
+    if e.status == OPTIMAL:
+        return f"{e.value:.7f}"
+    if e.best is not None:
+        return f"TL (met {e.best:.7f})"
+    return e.status
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--time-limit", type=float, default=5.0, help="seconds per MILP end")
+    ap.add_argument("--skip-alpha", action="store_true")
+    args = ap.parse_args()
+    print(f"time limit {args.time_limit:g} s per end\n")
+    print("| case | run mu_g | own states | all valid steady states | seconds |")
+    print("|---|---|---|---|---|")
+    fig9_run = None
+    for name, lx, ly, mpp, mpl, gamma in CASES:
+        s = models.System(models.rectangular(lx, ly), mu_pp=mpp, mu_plane=mpl, mu_wall=0.0,
+                          gamma=gamma)
+        run = models.simulate(s, seed=1)
+        if ly == 4:
+            fig9_run = run
+        t0 = time.perf_counter()
+        r = steady_ranges(run, which="mu_g", time_limit=args.time_limit)
+        secs = time.perf_counter() - t0
+        own, every = r.own["mu_g"], r.mu_g
+        print(f"| {name} | {run.records[-1].mu_g:.7f} | [{cell(own.lo)}, {cell(own.hi)}] | "
+              f"[{cell(every.lo)}, {cell(every.hi)}] | {secs:.1f} |")
+    if args.skip_alpha:
+        return 0
+    print("\nFig. 9 (rect 10x4, seed 1): mu_g and every angular acceleration over all valid "
+          "steady states")
+    t0 = time.perf_counter()
+    r = steady_ranges(fig9_run, which="alpha", time_limit=args.time_limit)
+    total = time.perf_counter() - t0
+    print("| observable | min | max | run | s (min) | s (max) |")
+    print("|---|---|---|---|---|---|")
+    decided = 0
+    for name, rg in r.ranges.items():
+        decided += rg.lo.status == OPTIMAL
+        decided += rg.hi.status == OPTIMAL
+        print(f"| {name} | {cell(rg.lo)} | {cell(rg.hi)} | {r.run_values[name]:.7f} | "
+              f"{rg.lo.seconds:.2f} | {rg.hi.seconds:.2f} |")
+    print(f"\n{decided} of {2 * len(r.ranges)} ends decided; total {total:.1f} s "
+          f"(force box R <= {r.U:g}, {'proved' if r.box_proved else 'not proved'})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,49 @@
+"""`rigidlcp ranges RUN.npz [--json]`: the range of mu_g (and of every angular acceleration, R,
+S) over every valid steady state of a steady run's system (rigidlcp.verify.ranges), with a
+witness state at each end, beside the run's own value and the range over its own contact
+states."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "ranges", help="ranges of mu_g and other observables over all valid steady states",
+        description="For a run saved by `rigidlcp simulate --out` that ended steady: the range "
+        "of mu_g (and of each angular acceleration; with --observables all, of each R and S) "
+        "over every valid steady state of its system (docs/mechanics.md, 'Valid steady "
+        "states'), over every contact-state set the kinematics admit, each end with a "
+        "witness state checked against the laws; beside it, the range over the run's own "
+        "contact states. An end stopped by --time-limit is reported as 'time limit', never as "
+        "a bound.")
+    p.add_argument("run", help="a run file (RUN.npz, with its RUN.json)")
+    p.add_argument("--observables", choices=("mu_g", "alpha", "all"), default="alpha",
+                   help="mu_g only; mu_g and every angular acceleration (default); also "
+                   "every R and S")
+    p.add_argument("--time-limit", type=float, default=10.0,
+                   help="seconds of MILP per end (default 10)")
+    p.add_argument("--box", type=float, default=None,
+                   help="force box R <= BOX when no bound is proved (default 10 m_g g)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.set_defaults(func=cmd_ranges)
+
+
+def cmd_ranges(args: argparse.Namespace) -> int:
+    from rigidlcp.models.runio import load_run
+    from rigidlcp.verify.ranges import steady_ranges
+
+    if not args.time_limit > 0:
+        raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
+    if args.box is not None and not args.box > 0:
+        raise ValueError(f"--box must be > 0, got {args.box}")
+    run = load_run(args.run)
+    result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
+                           box=args.box)
+    if args.json:
+        print(json.dumps(result.to_dict()))
+    else:
+        print(result.table())
+    return 0

@@ -1,0 +1,65 @@
+"""`rigidlcp ranges RUN.npz [--json]` (issue 21): the JSON layout, the table, bad input."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from rigidlcp import models
+from rigidlcp.cli import main
+from rigidlcp.models.runio import save_run
+from rigidlcp.verify.ranges.witness import steady_check
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("runs")
+    system = models.System(models.rectangular(3, 1), mu_pp=0.05, mu_plane=0.1, mu_wall=0.0,
+                           gamma=0.01)
+    steady = models.simulate(system, seed=1)
+    assert steady.status == "steady"
+    short = models.simulate(system, seed=1, t_max=1e-3)
+    assert short.status != "steady"
+    return system, steady, save_run(steady, d / "steady"), save_run(short, d / "short")
+
+
+def test_json_is_the_issues_layout(runs, capsys):
+    system, run, path, _ = runs
+    assert main(["ranges", str(path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert list(out) == ["steady"]
+    st = out["steady"]
+    lo, hi = st["mu_g"]
+    assert lo <= run.records[-1].mu_g <= hi
+    assert len(st["alpha"]) == system.p
+    for key, W in st["witnesses"].items():
+        assert set(W) >= {"mu_g", "omega", "V", "alpha", "R", "S", "pairs"}
+        assert len(W["omega"]) == len(W["alpha"]) == system.p
+        assert len(W["R"]) == len(W["S"]) == len(W["pairs"]) == system.c
+        assert W["mu_g"] == pytest.approx(lo if key == "min" else hi, abs=1e-12)
+        pairs = np.array(W["pairs"])
+        assert set(pairs[:, 1][pairs[:, 1] < 0]) == {-1, -2, -3}
+        res, _ = steady_check(system, W["omega"], W["V"], np.array(W["R"]), np.array(W["S"]))
+        assert res <= 1e-8
+
+
+def test_table(runs, capsys):
+    assert main(["ranges", str(runs[2]), "--observables", "mu_g"]) == 0
+    out = capsys.readouterr().out
+    assert "mu_g" in out and "own states" in out
+
+
+@pytest.mark.parametrize("case", ["missing", "not_steady", "other_kind", "bad_limit"])
+def test_bad_input_one_line_exit_2(runs, case, tmp_path, capsys):
+    _, _, path, short = runs
+    other = tmp_path / "x.npz"
+    np.savez(other, M=np.eye(2))
+    argv = {"missing": ["ranges", str(tmp_path / "none.npz")],
+            "not_steady": ["ranges", str(short)],
+            "other_kind": ["ranges", str(other)],
+            "bad_limit": ["ranges", str(path), "--time-limit", "0"]}[case]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rigidlcp ranges: error:") and "\n" not in err

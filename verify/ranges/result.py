@@ -1,0 +1,85 @@
+"""Results of range computations: one End per side (min / max), a Range per observable.
+
+An End's status is "optimal" (the value is the exact extreme over the set searched, attained by
+its witness), "unbounded" (a ray along which the observable grows without end, checked),
+"time limit" (HiGHS stopped before proving optimality: the value, if any, is only the best
+point met, *not* a bound) or "infeasible" (the set is empty). `scope` says over what the
+extreme was taken ("all valid steady states", "the face of the given solution", "every
+solution of the event", "... with R <= U" when a force bound is not proved).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+OPTIMAL, UNBOUNDED, TIME_LIMIT, INFEASIBLE = "optimal", "unbounded", "time limit", "infeasible"
+
+
+@dataclass
+class End:
+    """One end of a range. value: the extreme (None unless status is "optimal"; +-inf when
+    "unbounded"); witness: what attains it (a SteadyWitness, or an event's z); ray: the
+    direction of unboundedness (checked); best: the best value met when the time limit
+    stopped the search (not a bound); residual: the witness's independent residual."""
+
+    status: str
+    value: float | None = None
+    witness: object | None = None
+    ray: np.ndarray | None = None
+    residual: float = float("nan")
+    best: float | None = None
+    seconds: float = 0.0
+    note: str = ""
+
+    def __repr__(self) -> str:
+        if self.status == OPTIMAL:
+            return f"{self.value:.10g} (residual {self.residual:.1e})"
+        if self.status == UNBOUNDED:
+            return f"{self.value} (ray checked)"
+        if self.status == TIME_LIMIT:
+            best = "" if self.best is None else f", best met {self.best:.10g} (not a bound)"
+            return f"time limit{best}"
+        return self.status
+
+
+@dataclass
+class Range:
+    """[lo, hi] of one observable; `selected`: the value of a given solution (a run's state,
+    the engine's event solution), which must lie in the range; `scope`: see the module
+    docstring."""
+
+    name: str
+    lo: End
+    hi: End
+    scope: str = ""
+    selected: float | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def interval(self) -> tuple[float | None, float | None]:
+        return self.lo.value, self.hi.value
+
+    @property
+    def decided(self) -> bool:
+        return self.lo.status in (OPTIMAL, UNBOUNDED) and self.hi.status in (OPTIMAL, UNBOUNDED)
+
+    @property
+    def width(self) -> float:
+        if not self.decided:
+            return float("nan")
+        return float(self.hi.value) - float(self.lo.value)
+
+    def contains(self, value: float, tol: float = 1e-9) -> bool:
+        """value in [lo, hi] (to tol relative to the range's magnitude); False when undecided."""
+        if not self.decided:
+            return False
+        lo, hi = float(self.lo.value), float(self.hi.value)
+        slack = tol * max(1.0, abs(lo) if np.isfinite(lo) else 1.0,
+                          abs(hi) if np.isfinite(hi) else 1.0)
+        return lo - slack <= value <= hi + slack
+
+    def __repr__(self) -> str:
+        sel = "" if self.selected is None else f", selected {self.selected:.10g}"
+        return f"{self.name}: [{self.lo!r}, {self.hi!r}]{sel}"

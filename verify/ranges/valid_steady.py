@@ -1,0 +1,370 @@
+"""`steady_ranges`: the range of mu_g (and of each angular acceleration, R, S, or a user's
+observable) over every valid steady state of a system (verify.ranges.steady), each end with a
+witness state checked against the laws by verify.ranges.witness.steady_check.
+
+An end is found by the MILP of verify.ranges.steady; its contact states are then fixed and the
+extreme recomputed by a linear program over the forces of those states, without the force box
+(the witness), and the velocities by a second one. The MILP's own point is never the witness.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.system import System
+from rigidlcp.verify.certificates.uniqueness import quiet_highs
+
+from .observables import check_observable, steady_observables
+from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
+from .steady import (
+    Formulation,
+    NotSteady,
+    formulate,
+    least_R,
+    state_extreme,
+    state_velocities,
+    states_of,
+)
+from .witness import make_witness, steady_check
+
+#: A witness is accepted when its independent residual is at most this.
+WITNESS_TOL = 1e-8
+#: Contact-state sets kept as seeds (verify.ranges.valid_steady._Model.add_seed).
+MAX_SEEDS = 6
+
+
+@dataclass
+class SteadyRanges:
+    """Ranges over the valid steady states of `system`. box_proved: the force bounds (R <= U,
+    per contact in verify.ranges.bounds) are proved, for every observable of S and of the
+    bounded R (each Range's scope says whether it is covered; else the range is over the
+    states with R <= U); V_mode: how V was treated
+    (docs/mechanics.md). When a run was given: run_values, its own values, and own, the
+    ranges over the valid steady states with the run's own contact states (linear programs,
+    no force box: unbounded ends are reported so)."""
+
+    system: System
+    ranges: dict[str, Range]
+    U: float
+    box_proved: bool
+    V_mode: str
+    seconds: float
+    run_values: dict[str, float] = field(default_factory=dict)
+    own: dict[str, Range] = field(default_factory=dict)
+
+    @property
+    def mu_g(self) -> Range:
+        return self.ranges["mu_g"]
+
+    def to_dict(self) -> dict:
+        """The JSON of `rigidlcp ranges` (issue 21): {"steady": {"mu_g": [lo, hi],
+        "witnesses": {"min": W, "max": W}, ...}}; an end that is not a number (unbounded, time
+        limit) is null, its status says which."""
+        def num(e: End):
+            return float(e.value) if e.status == OPTIMAL else None
+
+        mg = self.mu_g
+        out = {"mu_g": [num(mg.lo), num(mg.hi)],
+               "witnesses": {k: (e.witness.to_dict() if e.witness is not None else None)
+                             for k, e in (("min", mg.lo), ("max", mg.hi))},
+               "status": {"mu_g": [mg.lo.status, mg.hi.status]},
+               "scope": mg.scope, "force_bound": {"U": self.U, "proved": self.box_proved},
+               "V": self.V_mode, "seconds": round(self.seconds, 3)}
+        if "mu_g" in self.run_values:
+            out["run"] = {"mu_g": self.run_values["mu_g"]}
+        if "mu_g" in self.own:
+            o = self.own["mu_g"]
+            out["own_states"] = {"mu_g": [num(o.lo), num(o.hi)],
+                                 "status": [o.lo.status, o.hi.status]}
+        groups: dict[str, list] = {}
+        for name, r in self.ranges.items():
+            if name == "mu_g":
+                continue
+            base = name.split("[")[0]
+            groups.setdefault(base, []).append([num(r.lo), num(r.hi)])
+            out["status"].setdefault(base, []).append([r.lo.status, r.hi.status])
+        out.update(groups)
+        return {"steady": out}
+
+    def table(self) -> str:
+        lines = [f"valid steady states of {self.system.lattice!r} (gamma {self.system.gamma:g}, "
+                 f"mu {self.system.mu_pp:g}/{self.system.mu_plane:g}/{self.system.mu_wall:g}); "
+                 f"V {self.V_mode}; force bound R <= {self.U:.4g} "
+                 f"{'(proved)' if self.box_proved else '(a box: not proved)'}; "
+                 f"{self.seconds:.2f} s",
+                 f"{'observable':<12} {'min':>16} {'max':>16} {'width':>11} {'run':>13}"]
+        for name, r in self.ranges.items():
+            def cell(e: End) -> str:
+                return f"{e.value:.10g}" if e.status == OPTIMAL else e.status
+            run = self.run_values.get(name)
+            lines.append(f"{name:<12} {cell(r.lo):>16} {cell(r.hi):>16} {r.width:>11.4g} "
+                         f"{'' if run is None else f'{run:.8g}':>13}")
+            if name in self.own:
+                o = self.own[name]
+                lines.append(f"{'  own states':<12} {cell(o.lo):>16} {cell(o.hi):>16} "
+                             f"{o.width:>11.4g}")
+        for name, r in self.ranges.items():
+            for e in (r.lo, r.hi):
+                if e.note:
+                    lines.append(f"note ({name}): {e.note}")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return self.table()
+
+
+def _alpha(system: System, R: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """Angular accelerations of the forces (R, S): the rotational part of nu'."""
+    return Dynamics(system).accelerations(np.concatenate([R, S]))[2 * system.p:]
+
+
+def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
+    if isinstance(target, System):
+        return target, None
+    if hasattr(target, "records") and hasattr(target, "system"):
+        if target.status != "steady":
+            raise NotSteady(f"the run ended {target.status!r}, not in a steady state: steady "
+                            "ranges need a run that reached one (or pass its system)")
+        last = target.records[-1]
+        return target.system, {"R": np.asarray(last.R, float), "S": np.asarray(last.S, float)}
+    raise TypeError(f"expected a models.System or a steady Run, got {type(target).__name__}")
+
+
+def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
+                  time_limit: float = 60.0, box: float | None = None,
+                  V_mode: str | None = None) -> SteadyRanges:
+    """Range of each observable over all valid steady states of `target` (a System, or a Run
+    that ended steady: its last state's values are reported beside the ranges and must lie
+    in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
+    also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
+    box: the force box when no bound is proved. Raises NotSteady when no valid steady state
+    exists or the run is not steady."""
+    t0 = time.perf_counter()
+    system, last = _run_system(target)
+    start = None
+    if last is not None:
+        # The run's state one time unit after its last event (a steady state stays one; a
+        # contact that starts to slide there has v_t = 0 at the event itself).
+        fin = target.final
+        alpha = _alpha(system, last["R"], last["S"])
+        omega, V = fin.omega + alpha, fin.V + system.gamma
+        v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
+        res, s_run = steady_check(system, omega, V, last["R"], last["S"], v_scale=v_scale)
+        if res <= WITNESS_TOL:
+            start = (last["R"], last["S"], omega, V, s_run)
+    form = formulate(system, box, V_mode)
+    obs = steady_observables(system, which, form.dyn)
+    for name, L in (observables or {}).items():
+        obs[str(name)] = check_observable(str(name), L, 2 * system.c)
+    unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
+    ranges, run_values, own = {}, {}, {}
+    model = _Model(form)
+    if start is not None:
+        model.starts.append(form.start(*start))
+        model.add_seed(start[4])
+    for s_seed in seed_states(form):
+        model.add_seed(s_seed)
+    for name, L in obs.items():
+        lo = _end(form, model, L, +1, time_limit)
+        hi = _end(form, model, L, -1, time_limit)
+        scope = "all valid steady states" if form.proved_for(L) else unproved
+        ranges[name] = Range(name, lo, hi, scope)
+        if last is not None:
+            run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
+            ranges[name].selected = run_values[name]
+            if start is not None:
+                own[name] = Range(name, _own_end(form, start, L, +1),
+                                  _own_end(form, start, L, -1), "the run's own contact states",
+                                  run_values[name])
+    return SteadyRanges(system, ranges, form.U, form.box_proved, form.V_mode,
+                        time.perf_counter() - t0, run_values, own)
+
+
+def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
+    """An end over the valid steady states with the run's contact states (its velocities)."""
+    R, S, omega, V, s = start
+    status, x, ray = state_extreme(form, s, L, sense)
+    if x is None:
+        return End("failed", note="the run's contact states admit no force (rounding)")
+    system = form.system
+    v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
+    wit = make_witness(system, omega, V, x[:system.c], x[system.c:], form.dyn, v_scale)
+    end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual)
+    if wit.residual > WITNESS_TOL:
+        end.status, end.value = "failed", None
+        end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
+    elif status == UNBOUNDED:
+        end = _check_ray(form, end, wit, ray, L, sense, v_scale)
+    return end
+
+
+class _Model:
+    """The MILP of a Formulation in one HiGHS instance, re-solved with new costs."""
+
+    def __init__(self, form: Formulation):
+        import highspy
+
+        A = sp.csc_matrix(form.A)
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
+        lp.col_cost_ = np.zeros(A.shape[1])
+        lp.col_lower_, lp.col_upper_ = form.lb, form.ub
+        lp.row_lower_, lp.row_upper_ = form.lo, form.hi
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+            A.indptr, A.indices, A.data)
+        lp.integrality_ = [highspy.HighsVarType.kInteger if v else
+                           highspy.HighsVarType.kContinuous for v in form.integrality]
+        with quiet_highs():
+            h = highspy.Highs()
+        for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
+                           ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
+                           ("primal_feasibility_tolerance", 1e-9)):
+            h.setOptionValue(key, value)
+        h.passModel(lp)
+        self.h, self.hs, self.n = h, highspy, A.shape[1]
+        self.starts: list[np.ndarray] = []
+        self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
+
+    def add_seed(self, s: np.ndarray) -> None:
+        """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
+        s = np.asarray(s, dtype=int)
+        self.seeds = [t for t in self.seeds if not np.array_equal(t, s)] + [s]
+        del self.seeds[:-MAX_SEEDS]
+
+    def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
+              ) -> tuple[str, np.ndarray | None]:
+        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
+        extra: MIP starts for this objective only."""
+        h, hs = self.h, self.hs
+        h.clearSolver()
+        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        h.setOptionValue("time_limit", float(time_limit))
+        starts = [*self.starts, *extra]
+        # the best valid state as the MIP start (a later setSolution replaces an earlier one)
+        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
+            sol = hs.HighsSolution()
+            sol.col_value = list(x)
+            sol.value_valid = True
+            h.setSolution(sol)
+        with quiet_highs():
+            h.run()
+        st = h.getModelStatus()
+        has_x = h.getInfo().primal_solution_status == 2
+        x = np.asarray(h.getSolution().col_value) if has_x else None
+        if st == hs.HighsModelStatus.kOptimal:
+            return OPTIMAL, x
+        if st == hs.HighsModelStatus.kInfeasible:
+            return INFEASIBLE, None
+        if st == hs.HighsModelStatus.kTimeLimit:
+            return TIME_LIMIT, x
+        return "failed", x
+
+
+def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit: float
+         ) -> End:
+    """min (sense +1) or max (sense -1) of L . x over the valid steady states."""
+    t0 = time.perf_counter()
+    c, p = form.system.c, form.system.p
+    cost = np.zeros(model.n)
+    cost[:2 * c] = sense * L
+    mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
+    if mstat == INFEASIBLE:
+        raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
+                        "violates a law (MILP infeasible)")
+    if xm is None:
+        return End(TIME_LIMIT if mstat == TIME_LIMIT else "failed",
+                   seconds=time.perf_counter() - t0, note=f"HiGHS: {mstat}, no point")
+    s = states_of(form, xm)
+    status, x, ray = state_extreme(form, s, L, sense)
+    vel = state_velocities(form, s)
+    if vel is None:  # the LP disagrees with the MILP's kinematics: keep the MILP's velocities
+        r = form.system.lattice.radius
+        vel = (xm[2 * c + p:2 * c + 2 * p] / r, float(xm[2 * c + 2 * p]))
+    if x is None:
+        x = xm[:2 * c]
+    wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
+    end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
+              seconds=time.perf_counter() - t0)
+    if wit.residual > WITNESS_TOL:
+        end.status, end.value = "failed", None
+        end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
+        return end
+    if mstat != OPTIMAL:  # time limit with an incumbent: a value met, not a bound
+        end.status, end.best, end.value = TIME_LIMIT, float(L @ x), None
+        return end
+    if status == UNBOUNDED:
+        end = _check_ray(form, end, wit, ray, L, sense)
+    elif status == INFEASIBLE:
+        end.status, end.value = "failed", None
+        end.note = "the contact states of the MILP's point admit no force (rounding)"
+    elif sense * (end.value - float(L @ xm[:2 * c])) < -1e-9 * max(1.0, abs(end.value)):
+        end.note = "the extreme of these contact states lies beyond the force box"
+    if end.status == OPTIMAL:
+        model.starts.append(form.start(wit.R, wit.S, wit.omega, wit.V, wit.s))
+    if end.status in (OPTIMAL, TIME_LIMIT):
+        model.add_seed(wit.s)
+    return end
+
+
+def seed_states(form: Formulation) -> list[np.ndarray]:
+    """Contact-state sets of simple velocities, tried at every end: no rotation (omega = 0)
+    with V = +1 and -1 (V free) or V of the run's sign: every disk-disk contact non-sliding,
+    every frictional contact with the plane sliding the same way (the locked array)."""
+    system, dyn = form.system, form.dyn
+    Vs = {"free": (1.0, -1.0), "zero": (0.0,), "positive": (1.0,),
+          "negative": (-1.0,)}[form.V_mode]
+    out = []
+    for V in Vs:
+        vt = dyn.velocities(np.zeros(system.p), V)[system.c:]
+        s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
+        if state_velocities(form, s) is not None:
+            out.append(s)
+    return out
+
+
+def _seed_starts(form: Formulation, model: _Model, L: np.ndarray, sense: int
+                 ) -> list[np.ndarray]:
+    """MIP starts for one end: the extreme of L over each seed state set (a linear program),
+    where it is finite and its witness passes steady_check."""
+    c, out = form.system.c, []
+    for s in model.seeds:
+        status, x, _ = state_extreme(form, s, L, sense)
+        vel = state_velocities(form, s)
+        if status != OPTIMAL or vel is None:
+            continue
+        R, S = x[:c], x[c:]
+        if form.R_hi is not None and np.any(R > form.R_hi):
+            R = least_R(form, s, S)  # same S and states, R within the proved bounds
+            if R is None or np.any(R > form.R_hi):
+                continue
+        if steady_check(form.system, vel[0], vel[1], R, S, form.dyn)[0] <= WITNESS_TOL:
+            out.append(form.start(R, S, vel[0], vel[1], s))
+    return out
+
+
+def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
+               v_scale: float = 0.0) -> End:
+    """End "unbounded" if x + t d stays a valid steady state for a large t and L d has the
+    right sign; otherwise "failed" with the reason."""
+    c = form.system.c
+    if ray is None or not sense * float(L @ ray) < 0:
+        end.status, end.value = "failed", None
+        end.note = "the LP was unbounded but no improving ray was found"
+        return end
+    x = np.concatenate([wit.R, wit.S])
+    t = 1e3 * max(1.0, float(np.max(np.abs(x))))
+    y = x + t * ray
+    res, _ = steady_check(form.system, wit.omega, wit.V, y[:c], y[c:], form.dyn, v_scale)
+    if res > WITNESS_TOL:
+        end.status, end.value = "failed", None
+        end.note = f"the ray did not pass the check (residual {res:.1e} at t = {t:.3g})"
+        return end
+    end.status, end.value, end.ray = UNBOUNDED, -sense * np.inf, ray
+    end.note = f"ray checked: x + {t:.3g} d is a valid steady state"
+    return end

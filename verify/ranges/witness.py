@@ -1,0 +1,97 @@
+"""Independent checks of range witnesses: a steady state against the laws, contact by contact.
+
+`steady_check` does not use the MILP or its W: it recomputes the accelerations from Newton-Euler
+(nu' = M^-1 (H^T lambda + f), a = H nu' + u_obs', models.dynamics) and the tangential velocities
+from (omega, V), reads each contact's state off the sign of its v_t, and measures how far the
+state is from the definition of a valid steady state (docs/mechanics.md):
+
+    a_n = 0 and no translation; R >= 0; |S| <= mu R; S = 0 where mu = 0;
+    v_t > 0: S = -mu R and a_t >= 0;  v_t < 0: S = +mu R and a_t <= 0;  v_t = 0: a_t = 0.
+
+Residuals are relative: forces to the force scale (max |lambda|, m g), accelerations to
+max(g, |gamma|) times (1 + |lambda| / (m g)), velocities to max |v_t| (the cone's scale).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigidlcp.models.dynamics import Dynamics
+from rigidlcp.models.observables import global_friction_coefficient
+from rigidlcp.models.system import System
+
+
+@dataclass
+class SteadyWitness:
+    """A steady state: velocities omega (per disk) and V, angular accelerations alpha, forces
+    R and S (per contact), contact pairs [i, j] (obstacles -1 left wall, -2 right wall, -3
+    plane), the tangential states s (+1/-1 sliding, 0 non-sliding or frictionless), mu_g, and
+    the independent residual of `steady_check`."""
+
+    omega: np.ndarray
+    V: float
+    alpha: np.ndarray
+    R: np.ndarray
+    S: np.ndarray
+    pairs: np.ndarray
+    s: np.ndarray
+    mu_g: float
+    residual: float
+
+    def to_dict(self) -> dict:
+        return {"mu_g": float(self.mu_g), "omega": self.omega.tolist(), "V": float(self.V),
+                "alpha": self.alpha.tolist(), "R": self.R.tolist(), "S": self.S.tolist(),
+                "pairs": self.pairs.tolist(), "s": self.s.tolist(),
+                "residual": float(self.residual)}
+
+    def __repr__(self) -> str:
+        n_sl = int(np.sum(self.s != 0))
+        return (f"<SteadyWitness mu_g={self.mu_g:.7g}, V={self.V:.4g}, {n_sl} sliding, "
+                f"max|alpha|={np.max(np.abs(self.alpha), initial=0):.3g}, "
+                f"max R={np.max(self.R, initial=0):.3g}, residual {self.residual:.1e}>")
+
+
+def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,
+                 v_scale: float = 0.0) -> tuple[float, np.ndarray]:
+    """(residual, s): the largest relative violation of the steady-state laws (module
+    docstring) by (omega, V, R, S), and the states read off sgn(v_t) (0 where |v_t| <= 1e-9
+    max(max|v_t|, v_scale); v_scale: the velocity scale of a run, whose rounding noise
+    (1e-16) is not a velocity)."""
+    dyn = dyn or Dynamics(system)
+    c, p, mu = system.c, system.p, system.mu
+    omega = np.asarray(omega, dtype=float)
+    R, S = np.asarray(R, dtype=float), np.asarray(S, dtype=float)
+    lam = np.concatenate([R, S])
+    fs = system.mass * max(system.g, abs(system.gamma), 1e-12)
+    fscale = max(float(np.max(np.abs(lam), initial=0.0)), fs)
+    ascale = max(system.g, abs(system.gamma), 1e-12) * fscale / fs
+    nu_dot = dyn.accelerations(lam)
+    a = dyn.H @ nu_dot + dyn.u_obs_dot
+    v = dyn.velocities(omega, V)
+    vt = v[c:]
+    vscale = max(float(np.max(np.abs(vt), initial=0.0)), v_scale, 1e-300)
+    s = np.where(np.abs(vt) <= 1e-9 * vscale, 0, np.sign(vt)).astype(int)
+    s[mu == 0] = 0
+    at = a[c:]
+    viol = [np.abs(a[:c]) / ascale, np.abs(nu_dot[:2 * p]) / ascale,
+            np.maximum(-R, 0) / fscale, np.maximum(np.abs(S) - mu * R, 0) / fscale,
+            np.where(mu == 0, np.abs(S), 0) / fscale,
+            np.where(s != 0, np.abs(S + s * mu * R), 0) / fscale,
+            np.where(s != 0, np.maximum(-s * at, 0), 0) / ascale,
+            np.where((s == 0) & (mu > 0), np.abs(at), 0) / ascale]
+    return float(max(np.max(x, initial=0.0) for x in viol)), s
+
+
+def make_witness(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,
+                 v_scale: float = 0.0) -> SteadyWitness:
+    """A SteadyWitness with its alpha, mu_g and independent residual computed here."""
+    dyn = dyn or Dynamics(system)
+    lam = np.concatenate([R, S])
+    alpha = dyn.accelerations(lam)[2 * system.p:]
+    res, s = steady_check(system, omega, V, R, S, dyn, v_scale)
+    lat = system.lattice
+    return SteadyWitness(np.asarray(omega, float), float(V), alpha, np.asarray(R, float),
+                         np.asarray(S, float), np.column_stack([lat.i, lat.j]), s,
+                         global_friction_coefficient(system, np.asarray(S, float)), res)
