@@ -43,7 +43,7 @@ def over_all(res: Results, c: Claim) -> str:
         if cid.startswith("fig12"):
             return _fig12(res, cid)
         if cid.startswith("ivb"):
-            return _ivb(res, cid)
+            return _ivb(res, c)
         if cid.startswith(("fig8", "fig9", "fig6", "fig13")):
             return _state_claim(res, c)
     except Exception as exc:  # a broken judgement is reported, never dropped
@@ -164,13 +164,16 @@ def _fig12(res: Results, cid: str) -> str:
         parts.append(f"{key} end curve m_e({e.gamma[0]:g}) = {e.m_e[0]:.4g}")
         if e.m_e[0] >= 2 * m_g:
             ok.append(f"the {key} end curve")
+    if sel.m_e[0] >= 2 * m_g:  # the selection's curve is one of valid steady states too
+        ok.insert(0, "this toolkit's selection")
     head = ("holds for some (" + ", ".join(ok) + ")" if ok else
-            "unknown: neither end curve has m_e(0) >= 2 m_g")
+            "unknown: neither the selection nor an end curve has m_e(0) >= 2 m_g")
     return (f"{head}; m_e is a slope along a curve of valid steady states, and the band "
             f"admits many: {'; '.join(parts)}; band at {_band_text(pts, 0)}")
 
 
-def _ivb(res: Results, cid: str) -> str:
+def _ivb(res: Results, c: Claim) -> str:
+    cid = c.id
     other = "ivb_plane" if cid.startswith("ivb-plane") else "ivb_pp"
     base, fam = _effective_of(res, "fig11"), _effective_of(res, other)
     if base is None or fam is None:
@@ -192,6 +195,8 @@ def _ivb(res: Results, cid: str) -> str:
             np.all(d <= tol) and np.any(d < -tol))
         (held if good else failed).append(f"{key} end curves ({q}(0) {getattr(x, q)[0]:.4g} "
                                           f"vs {getattr(y, q)[0]:.4g})")
+    if c.passed:  # the selections' curves are curves of valid steady states too
+        held.insert(0, "this toolkit's selections (the claim's row)")
     if held:
         return ("holds for some: " + "; ".join(held) + (f"; not for: {'; '.join(failed)}"
                                                         if failed else "")

@@ -156,9 +156,9 @@ def band_figures(res: Results, name: str, out: Path, cite: bool) -> tuple[Path, 
     mu_png = _save(fig, out / "mu_g.png")
     fig, axes = plt.subplots(1, 2, figsize=(12.0, 4.0), gridspec_kw={"wspace": 0.3})
     for ax, q, ylab, title in (
-            (axes[0], "m_e", r"$m_e = m_g + \partial F_g/\partial\gamma$", "(a) effective inertia"),
-            (axes[1], "mu_e", r"$\mu_e = (F_g - \gamma\,\partial F_g/\partial\gamma) / (m_g g)$",
-             "(b) effective friction coefficient")):
+            (axes[0], "m_e", r"$m_e = m_g + \partial F_g/\partial\gamma$",
+             "(a) effective inertia"),
+            (axes[1], "mu_e", r"$\mu_e$", "(b) effective friction coefficient")):
         curves = [getattr(e, q) for e in fam.values() if e is not None
                   and np.array_equal(e.gamma, eff.gamma)]
         if curves:

@@ -90,3 +90,10 @@ def test_missing_inputs_are_unknown_not_a_verdict():
     for cid in ("fig7-steady", "fig11-linear", "fig12-inertia", "ivb-pp-m_e"):
         text = over_all(res, Claim(cid, "", "", "", "", True))
         assert text.startswith("unknown"), (cid, text)
+
+
+def test_fig12_inertia_names_the_curves_where_it_holds(fig11_small):
+    """m_e(0) >= 2 m_g on the selection's curve (24.5 = 2.45 m_g): "holds for some", naming it;
+    m_e is a slope along a curve, so "for all" is never claimed."""
+    text = over_all(fig11_small, Claim("fig12-inertia", "", "", "", "", True))
+    assert text.startswith("holds for some (this toolkit's selection"), text
