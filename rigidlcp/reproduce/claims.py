@@ -27,6 +27,7 @@ from .experiments import (
     ranges,
     seed_claim,
 )
+from .overall import over_all
 
 
 def evaluate(res: Results) -> list[Claim]:
@@ -41,6 +42,7 @@ def evaluate(res: Results) -> list[Claim]:
             c.id, c.where = c.id or cid, c.where or where
             c.claim = c.claim or claim
             cross_check(res, c)
+            c.overall = over_all(res, c)
             out.append(c)
     return out
 

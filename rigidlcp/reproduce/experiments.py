@@ -104,6 +104,8 @@ def jobs_of(p: dict) -> list[tuple]:
                                      "seed")}
         for point in Sweep({"gamma": parse_grid("gamma", cfg["gamma"])}, fixed).points():
             jobs.append(("point", name, point))
+        # the band: mu_g over every valid steady state at each gamma (valid_steady.py)
+        jobs += [("band", name, float(g)) for g in parse_grid("gamma", cfg["gamma"])]
     return jobs
 
 
@@ -128,6 +130,15 @@ class Job:
             row = run_point(job[2])
             row.pop("wall_time_s", None)
             return row
+        if kind == "band":
+            from .valid_steady import BAND_TIME_LIMIT, mu_g_band
+
+            cfg = self.p[job[1]]
+            return mu_g_band(cfg, [job[2]], seed=cfg["seed"], time_limit=BAND_TIME_LIMIT)[0]
+        if kind == "steady-set":
+            from .valid_steady import SET_TIME_LIMIT, steady_set
+
+            return steady_set(job[2], SET_TIME_LIMIT[self.p != plan(quick=False)])
         if kind == "formulas":
             from rigidlcp.verify.nullspace.formulas import formula_table
 
@@ -151,6 +162,7 @@ class Claim:
     error: str = ""
     ts_confirmed: bool | None = None  # None: not a steady-state claim (crosscheck.py)
     ts: str = ""  # "kept by the toolkit's time-stepper": the verdict and the drifts
+    overall: str = ""  # "over all valid steady states": holds for all / some / none (overall.py)
     determinacy: str = ""  # certified uniqueness at the steady state(s) (crosscheck.py)
 
     @property
@@ -172,6 +184,10 @@ class Results:
     #: "NAME gamma=G" for sweep points
     ts_checks: dict = field(default_factory=dict)
     certificates: dict = field(default_factory=dict)
+    #: per sweep, the mu_g band over every valid steady state at each gamma (valid_steady.py)
+    bands: dict[str, list] = field(default_factory=dict)
+    #: per STEADY experiment, verify.ranges.SteadyRanges of its first seed's run (or why not)
+    steady_sets: dict = field(default_factory=dict)
 
     def seeds(self, name: str) -> list[models.Run]:
         cfg = self.plan[name]
@@ -204,6 +220,8 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
                 res.runs.setdefault(job[1], {})[job[2:]] = out
             elif job[0] == "point":
                 res.sweeps.setdefault(job[1], []).append(out)
+            elif job[0] == "band":
+                res.bands.setdefault(job[1], []).append(out)
             else:
                 res.formulas += out
             if bar is not None:
@@ -213,13 +231,16 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
             bar.close()
     for rows in res.sweeps.values():
         rows.sort(key=lambda r: r["gamma"])
+    for pts in res.bands.values():
+        pts.sort(key=lambda pt: pt.gamma)
     checks = check_jobs(p, res)
     if bar is not None:
         bar = new_bar(total=len(checks), unit="job", desc="cross-checks")
     try:
         for k, out in iter_map(Job(p), checks, jobs=jobs, dask=dask):
             kind, label = checks[k][:2]
-            (res.certificates if kind == "cert" else res.ts_checks)[label] = out
+            {"cert": res.certificates, "steady-set": res.steady_sets}.get(
+                kind, res.ts_checks)[label] = out
             if bar is not None:
                 bar.update(1)
     finally:
@@ -244,13 +265,14 @@ def sweep_gammas(cfg: dict) -> list[float]:
 
 def check_jobs(p: dict, res: Results) -> list[tuple]:
     """The cross-check jobs (crosscheck.py) of the runs in `res`: time-stepping and certificate
-    of each STEADY experiment's first seed, time-stepping at sweep_gammas of each sweep."""
+    of each STEADY experiment's first seed, and its range of mu_g over every valid steady state
+    (valid_steady.steady_set); time-stepping at sweep_gammas of each sweep."""
     out: list[tuple] = []
     for name in STEADY:
         cfg = p[name]
         run = res.runs.get(name, {}).get((cfg["seeds"][0], cfg["gamma"], SELECT))
         if run is not None:
-            out += [("ts", name, run), ("cert", name, run)]
+            out += [("steady-set", name, run), ("ts", name, run), ("cert", name, run)]
     for name in SWEEPS:
         cfg = p[name]
         for g in sweep_gammas(cfg):

@@ -88,6 +88,8 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     base = res.effective("fig11")
     mu_g_png, eff_png = plot_effective([("10x1, mu 0.05 / 0.1 / 0", base)], d,
                                        cite="fig11" not in smaller)
+    if res.bands.get("fig11"):  # the same figures with the bands over all valid steady states
+        mu_g_png, eff_png = band_figures(res, "fig11", d, cite="fig11" not in smaller)
     files["fig11"], files["fig12"] = mu_g_png, eff_png
     d = out / "ivb"
     d.mkdir(exist_ok=True)
@@ -124,6 +126,56 @@ def figures(res: Results, out: Path) -> dict[str, Path]:
     axes[1].set_title("steady state; stars: Fig. 5(e) loop contacts")
     files["fig6"] = _save(fig, out / "fig6_omega.png")
     return files
+
+
+def band_figures(res: Results, name: str, out: Path, cite: bool) -> tuple[Path, Path]:
+    """Figs. 11-12 as bands: mu_g over every valid steady state at each gamma (the band), and
+    m_e, mu_e of the band's two end curves (each a curve of valid steady states), with the
+    selection's curve inside; gammas whose band has an undecided end are marked."""
+    from .valid_steady import end_families
+
+    plt = _plt()
+    pts, eff = res.bands[name], res.effective(name)
+    fam = end_families(pts, eff.m_g, eff.g)
+    ok = [pt for pt in pts if pt.every.decided]
+    bad = [pt.gamma for pt in pts if not pt.every.decided]
+    sel = f"this toolkit's selection ({SELECT})"
+    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    g = np.array([pt.gamma for pt in ok])
+    ax.fill_between(g, [pt.every.lo.value for pt in ok], [pt.every.hi.value for pt in ok],
+                    color="C0", alpha=0.25, lw=0, label="all valid steady states (band)")
+    ax.plot(eff.gamma, eff.mu_g, "o-", ms=3, color="C1", label=sel)
+    for x in bad:
+        ax.axvline(x, color="red", lw=0.6, ls=":")
+    if bad:
+        ax.plot([], [], color="red", lw=0.6, ls=":", label="band end not decided (time limit)")
+    ax.set_xlabel(r"$\gamma$ / g")
+    ax.set_ylabel(r"$\mu_g$")
+    ax.set_title("global friction coefficient" + (" (Fig. 11)" if cite else ""))
+    ax.legend(fontsize="small")
+    mu_png = _save(fig, out / "mu_g.png")
+    fig, axes = plt.subplots(1, 2, figsize=(12.0, 4.0), gridspec_kw={"wspace": 0.3})
+    for ax, q, ylab, title in (
+            (axes[0], "m_e", r"$m_e = m_g + \partial F_g/\partial\gamma$",
+             "(a) effective inertia"),
+            (axes[1], "mu_e", r"$\mu_e$", "(b) effective friction coefficient")):
+        curves = [getattr(e, q) for e in fam.values() if e is not None
+                  and np.array_equal(e.gamma, eff.gamma)]
+        if curves:
+            stack = np.vstack(curves + [getattr(eff, q)])
+            ax.fill_between(eff.gamma, stack.min(axis=0), stack.max(axis=0), color="C0",
+                            alpha=0.2, lw=0, label="between the band's end curves")
+        for (key, e), style in zip(fam.items(), ("--", ":")):
+            if e is not None:
+                ax.plot(e.gamma, getattr(e, q), style, color="C0", lw=1.2,
+                        label=f"{key} end of the band")
+        ax.plot(eff.gamma, getattr(eff, q), "o-", ms=3, color="C1", label=sel)
+        ax.set_xlabel(r"$\gamma$ / g")
+        ax.set_ylabel(ylab)
+        ax.set_title(title + (" (Fig. 12)" if cite else ""))
+    axes[0].axhline(eff.m_g, color="grey", lw=0.8, ls="--", label=r"$m_g$")
+    axes[0].legend(fontsize="small")
+    return mu_png, _save(fig, out / "effective.png")
 
 
 def fig8_steady_state(run, path: Path) -> Path:
@@ -193,12 +245,22 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
         "([face (a)]: another solution with the same contact states, found by LPs on the face "
         "of the recorded solution); witnesses' sizes in the sections below.",
         "",
+        "**Over all valid steady states** (rigidlcp/reproduce/overall.py, issue 21): the "
+        "steady states of the rigid model are not unique (docs/mechanics.md, \"Valid steady "
+        "states and their ranges\"), so each steady-state claim is also judged over every "
+        "valid steady state of its system: holds for all, for some (which), for none, or "
+        "unknown (why), with the range of mu_g (verify.ranges.steady_ranges; each end a "
+        "checked witness, an end not decided in its time limit is \"unknown (time limit)\" "
+        "with the best value met, never a bound). The column \"this toolkit's selection "
+        f"(face-min-norm)\" is the verdict on the one state the select='{SELECT}' rule "
+        "reaches.",
+        "",
         "## Claims",
         "",
-        "| id | where | claim | measured | criterion | result | kept by the toolkit's "
-        "time-stepper "
+        "| id | where | claim | measured | criterion | this toolkit's selection "
+        f"({SELECT}) | over all valid steady states | kept by the toolkit's time-stepper "
         "| determinacy (certified) |",
-        "|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
     smaller = size_differences(res.plan)
     if smaller:
@@ -211,7 +273,8 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
     for c in claims:
         size = " (quick run, see below)" if claim_sizes(c.id, smaller) else ""
         lines.append(f"| {c.id} | {c.where} | {_cell(c.claim)} | {_cell(c.measured)} | "
-                     f"{_cell(c.criterion)} | **{c.verdict}**{size} | {_cell(c.ts)} | "
+                     f"{_cell(c.criterion)} | **{c.verdict}**{size} | "
+                     f"{_cell(c.overall or 'n/a')}{size and ' (quick run)'} | {_cell(c.ts)} | "
                      f"{_cell(c.determinacy)} |")
     lines += ["", "## Sizes and parameters", "",
               "| experiment | lattice | size | gamma (g) | V0 | mu_pp / mu_plane / mu_wall | "
@@ -243,7 +306,10 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
                 lines += [f"![{name}]({rel.as_posix()})", ""]
         for p in prefixes:
             for c in [c for k, v in by_prefix.items() if k.startswith(p) for c in v]:
-                lines.append(f"* **{c.id}: {c.verdict}.** {c.measured}")
+                lines.append(f"* **{c.id}: {c.verdict}** (this toolkit's selection). "
+                             f"{c.measured}")
+                if c.overall and not c.overall.startswith("n/a"):
+                    lines.append(f"  Over all valid steady states: {c.overall}.")
                 if c.note and (not c.passed or c.id.startswith(("fig12", "fig13-min", "fig9"))):
                     lines.append(f"  {c.note}")
                 if c.error:

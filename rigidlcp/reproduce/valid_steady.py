@@ -12,7 +12,10 @@ state), or "unknown" (an end not decided, or a line might pass through values
 inside the ranges: the values of a union of contact-state sets need not fill the interval,
 so the ends alone cannot prove it).
 
-Not yet wired into the report (report.py): see issue 21, point 3.
+`steady_set` gives the range of mu_g over the valid steady states of an experiment's run (the
+report's column "over all valid steady states", overall.py), `end_families` the effective
+curves (Eqs. 4.1-4.2) of the band's lower and upper ends: each end is a checked valid steady
+state per gamma, so each is one curve of valid steady states beside the selected one.
 """
 
 from __future__ import annotations
@@ -22,8 +25,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigidlcp import models
-from rigidlcp.verify.ranges import Range, steady_ranges
-from rigidlcp.verify.ranges.result import OPTIMAL
+from rigidlcp.models.effective import Effective, legendre
+from rigidlcp.verify.ranges import Range, SteadyRanges, steady_ranges
+from rigidlcp.verify.ranges.result import OPTIMAL, TIME_LIMIT
+
+#: Seconds per end of a band point (Fig. 11's 10x1: ~0.4 s per point) and of an experiment's
+#: steady set (the 10x4 arrays do not decide their ends in reasonable time: "time limit").
+BAND_TIME_LIMIT = 20.0
+SET_TIME_LIMIT = {False: 30.0, True: 2.0}
 
 
 @dataclass
@@ -97,3 +106,55 @@ def linear_through_zero(points: list[BandPoint], rel: float = 1e-9,
                                       "every range")
     return "unknown", (f"slopes {k_lo:.6g}..{k_hi:.6g} fit every range, but neither end "
                        "lies on one line (intermediate values not checked)")
+
+
+def steady_set(run: models.Run, time_limit: float) -> SteadyRanges | str:
+    """The range of mu_g over every valid steady state of a run's system, with the run's own
+    contact states; a string (the reason) when there is none to compute."""
+    try:
+        return steady_ranges(run, time_limit=time_limit)
+    except Exception as exc:  # NotSteady, a solver failure: the column says why
+        return f"{type(exc).__name__}: {exc}"
+
+
+def end_families(points: list[BandPoint], m_g: float, g: float = 1.0
+                 ) -> dict[str, Effective | None]:
+    """{"lower": Effective, "upper": Effective} of the band's end curves F_g = m_g g mu_g over
+    the gammas where that end is decided (None with fewer than 3 such gammas)."""
+    out: dict[str, Effective | None] = {}
+    for key in ("lower", "upper"):
+        ends = [(pt.gamma, (pt.every.lo if key == "lower" else pt.every.hi)) for pt in points]
+        ok = [(gam, e.value) for gam, e in ends if e.status == OPTIMAL]
+        if len(ok) < 3:
+            out[key] = None
+            continue
+        gam, mu = np.array(ok).T
+        out[key] = legendre(gam, m_g * g * mu, m_g, g)
+    return out
+
+
+def fmt_range(r: Range | None) -> str:
+    """"[lo, hi]" with an undecided end as "time limit (best met x, not a bound)"."""
+    if r is None:
+        return "not computed"
+
+    def end(e) -> str:
+        if e.status == OPTIMAL:
+            return f"{e.value:.7g}"
+        if e.status == TIME_LIMIT and e.best is not None:
+            return f"unknown (time limit; best met {e.best:.7g}, not a bound)"
+        if e.status == TIME_LIMIT:
+            return "unknown (time limit; no value met)"
+        return e.status
+    return f"[{end(r.lo)}, {end(r.hi)}]"
+
+
+def values_met(r: Range) -> list[float]:
+    """The values of r's checked witnesses (decided ends and best values met at a time limit)."""
+    out = []
+    for e in (r.lo, r.hi):
+        if e.status == OPTIMAL:
+            out.append(float(e.value))
+        elif e.status == TIME_LIMIT and e.best is not None:
+            out.append(float(e.best))
+    return out
