@@ -20,7 +20,8 @@
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
   every optimum checked to lie in P.
-* sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (an LP with
+* sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (a checked
+  optimum of a range LP at the bound is a witness; else an LP with
   that cone row made an equality), and their count against McNamara & Herrmann's 2M - 3N
   (M contacts, N disks): a packing with s contacts simultaneously at the Coulomb bound has
   dim P >= 0 only if s <= 2M - 3N generically.
@@ -296,6 +297,7 @@ def _full_row_rank(B: sp.csr_matrix) -> float | None:
 def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:
     c, n, mu = prob.c, prob.n, prob.mu
     lo, hi = np.zeros(n), np.zeros(n)
+    seen = np.zeros(c, dtype=bool)  # contacts found at |S| = mu R, R > 0 at some optimum
     todo = [a for a in range(c) if fs.implicit[a] != "R=0"]
     total = len(todo) * 2 + sum(1 for a in todo if mu[a] > 0 and not fs.implicit[a]) * 2
     done = 0
@@ -312,8 +314,11 @@ def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:
             if status == "unbounded":
                 out.append(-sgn * np.inf)
             elif status == "optimal":
-                fs.unchecked += not prob.admissible(lam)
+                ok = prob.admissible(lam)
+                fs.unchecked += not ok
                 out.append(float(lam[k]))
+                if ok:
+                    seen[:] |= _at_bound(prob, lam)
             else:
                 raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
         if progress:
@@ -331,16 +336,27 @@ def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:
         else:
             lo[c + a], hi[c + a] = extent(c + a)
     fs.lo, fs.hi = lo, hi
-    fs.sliding = _sliding(prob, lp, fs)
+    fs.sliding = _sliding(prob, lp, fs, seen)
 
 
-def _sliding(prob: StaticProblem, lp: ForceLP, fs: ForceSet) -> np.ndarray:
-    """Whether S = +-mu R with R > 0 is attainable at each contact (module docstring)."""
+def _at_bound(prob: StaticProblem, lam: np.ndarray) -> np.ndarray:
+    """Contacts at the Coulomb bound with R > 0 at a checked point of P (|S| >= mu R up to
+    1e-9 of the force scale, R > ZERO x scale): witnesses that they can slide."""
+    c, mu = prob.c, prob.mu
+    R, S = lam[:c], lam[c:]
+    tol = 1e-9 * max(prob.scale, float(np.max(np.abs(lam), initial=0.0)))
+    return (mu > 0) & (R > ZERO * prob.scale) & (np.abs(S) >= mu * R - tol)
+
+
+def _sliding(prob: StaticProblem, lp: ForceLP, fs: ForceSet,
+             seen: np.ndarray | None = None) -> np.ndarray:
+    """Whether S = +-mu R with R > 0 is attainable at each contact (module docstring);
+    seen: contacts already found at the bound at a checked optimum (no LP needed)."""
     c, k = prob.c, prob.fric.size
-    out = np.zeros(c, dtype=bool)
+    out = np.zeros(c, dtype=bool) if seen is None else seen.copy()
     for n, a in enumerate(prob.fric):
         kind = fs.implicit[a]
-        if kind == "R=0":
+        if kind == "R=0" or out[a]:
             continue
         if kind:
             out[a] = fs.hi[a] > ZERO * prob.scale
