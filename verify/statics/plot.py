@@ -54,3 +54,38 @@ def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path
     atomic_write(out, write)
     plt.close(fig)
     return out
+
+
+def plot_pf(f: np.ndarray | dict, out: str | Path, bins: int = 40) -> Path:
+    """PNG of the force distribution P(f), f = R / <R> (verify.statics.ensemble): a histogram
+    density on linear and logarithmic axes. f: one array, or {label: array} for several."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from rigidlcp.lcp.io.files import atomic_write
+
+    series = f if isinstance(f, dict) else {"": f}
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), layout="constrained")
+    top = max(float(np.max(v, initial=0.0)) for v in series.values()) or 1.0
+    edges = np.linspace(0.0, top, bins + 1)
+    for label, v in series.items():
+        dens, _ = np.histogram(v, bins=edges, density=True)
+        mid = 0.5 * (edges[1:] + edges[:-1])
+        for ax in axes:
+            ax.plot(mid, dens, drawstyle="steps-mid", label=label or None)
+    axes[1].set_yscale("log")
+    for ax in axes:
+        ax.set_xlabel("f = R / <R>")
+        ax.set_ylabel("P(f)")
+    if len(series) > 1:
+        axes[0].legend(fontsize="small")
+    out = Path(out)
+
+    def write(tmp: str) -> None:
+        fig.savefig(tmp, format="png", dpi=110)
+
+    atomic_write(out, write)
+    plt.close(fig)
+    return out

@@ -35,6 +35,7 @@ import json
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
@@ -173,3 +174,47 @@ def test_properties_on_deposited_packings(n, seed, mu, spread):
         assert (kind == "R=0") == (fs.hi[a] <= 1e-9 * prob.scale), a
     rng = np.random.default_rng(seed)
     assert _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng) == fs.dimension
+
+
+@pytest.mark.parametrize("seed, mu", [(1, 0.3), (3, 0.5), (5, 1.0), (2, 0.05)])
+def test_ranges_and_sliding_against_linprog_on_the_rows_form(seed, mu):
+    """ForceLP solves P in cone coordinates (u = mu R - S, v = mu R + S as bounded columns)
+    and the sliding contacts are partly settled by range optima already at the bound: an
+    independent method, scipy's linprog on P written with its cone rows, must give the same
+    range ends (to 1e-7 of the forces) and the same sliding contacts."""
+    lat = deposit(6, seed=seed, radii=(0.8, 1.2), width=5.0)
+    system = models.System(lat, mu_pp=mu, mu_plane=mu, mu_wall=mu)
+    fs = analyse(system)
+    if not fs.exists:
+        pytest.skip("no equilibrium on this pile")
+    prob = StaticProblem(system)
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+
+    def opt(cost, A_eq=prob.A, b_eq=prob.b):
+        return linprog(cost, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=A_eq,
+                       b_eq=b_eq, bounds=bounds, method="highs")
+
+    scale = max(1.0, float(np.max(np.abs(fs.hi[np.isfinite(fs.hi)]))))
+    for k in range(prob.n):
+        for sgn, end in ((1.0, fs.lo[k]), (-1.0, fs.hi[k])):
+            e = np.zeros(prob.n)
+            e[k] = sgn
+            res = opt(e)
+            if res.status == 3:
+                assert not np.isfinite(end), k
+            else:
+                assert res.status == 0 and abs(res.x[k] - end) <= 1e-7 * scale, k
+    c, fric = prob.c, list(prob.fric)
+    for a in range(c):  # can slide: max R with S = mu R or S = -mu R is positive
+        can = False
+        if a in fric:
+            for s in (1.0, -1.0):
+                row = np.zeros(prob.n)
+                row[a], row[c + a] = -s * system.mu[a], 1.0
+                A_eq = sp.vstack([prob.A, sp.csr_matrix(row)])
+                e = np.zeros(prob.n)
+                e[a] = -1.0
+                res = opt(e, A_eq, np.r_[prob.b, 0.0])
+                can |= res.status == 3 or (res.status == 0 and res.x[a] > 1e-9 * prob.scale)
+        assert bool(fs.sliding[a]) == can, a
