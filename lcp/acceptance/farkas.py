@@ -91,6 +91,12 @@ def check_certificate(eq: Equilibration, y_tilde: np.ndarray) -> Farkas | None:
     return Farkas(y=y * eq.r / float(np.sum(y * eq.r)), gap=gap, radius=float(radius))
 
 
+def _float(x) -> float:
+    """The double nearest a python-flint rational (numerator over denominator: Python's int
+    division rounds correctly; python-flint < 0.7's fmpq has no __float__)."""
+    return int(x.p) / int(x.q)
+
+
 def _q(x: float):
     from flint import fmpq  # a dependency (pyproject); imported on first use
 
@@ -129,8 +135,8 @@ def exact_certificate(eq: Equilibration, y: np.ndarray, active_tol: float = 1e-9
         if qty >= 0:
             continue
         total = sum(cand, fmpq(0))
-        yf = np.array([float(v / total) for v in cand])
-        gap = -float(qty / total)
+        yf = np.array([_float(v / total) for v in cand])
+        gap = -_float(qty / total)
         return Farkas(y=yf * eq.r / float(np.sum(yf * eq.r)), gap=gap, radius=np.inf,
                       exact=True)
     return None

@@ -106,10 +106,16 @@ def lemke_exact(M: np.ndarray, q: np.ndarray, d: np.ndarray, max_iter: int) -> S
         r = z0_rows[0] if z0_rows else min(tied, key=lambda i: key(i, col))
 
 
+def _float(x) -> float:
+    """The double nearest a python-flint rational (its numerator over its denominator: Python's
+    int division rounds correctly; python-flint < 0.7's fmpq has no __float__)."""
+    return int(x.p) / int(x.q)
+
+
 def _solution(basic: list, rhs: list, n: int, pivots: int, status: str) -> Solution:
     x = np.zeros(2 * n + 1)
     for i, var in enumerate(basic):
-        x[var] = float(rhs[i])
+        x[var] = _float(rhs[i])
     z = x[n:2 * n]
     basis = np.array(sorted(v - n for v in basic if n <= v < 2 * n), dtype=np.intp)
     return Solution(z=z.copy(), w=x[:n].copy(), status=status, method="lemke",
@@ -122,7 +128,7 @@ def _ray(basic: list, rhs: list, col: list, s: int, n: int, pivots: int) -> Solu
     sol = _solution(basic, rhs, n, pivots, "ray")
     dz = np.zeros(2 * n + 1)
     for i, var in enumerate(basic):
-        dz[var] = -float(col[i])
+        dz[var] = -_float(col[i])
     dz[s] = 1.0
     ray = np.append(dz[n:2 * n], dz[2 * n])
     ray /= max(float(np.abs(ray).max()), 1e-300)

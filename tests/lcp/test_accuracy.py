@@ -63,7 +63,7 @@ def exact_basis_solution(M: np.ndarray, q: np.ndarray, basis: np.ndarray) -> np.
     b = fmpq_mat(len(a), 1, [-fmpq(*float(q[i]).as_integer_ratio()) for i in a])
     x = A.solve(b)
     for k, i in enumerate(a):
-        z[i] = float(x[k, 0])
+        z[i] = int(x[k, 0].p) / int(x[k, 0].q)  # python-flint < 0.7: fmpq has no __float__
     return z
 
 
