@@ -145,7 +145,16 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
                 raise RuntimeError(f"equilibrium LP {status} and no Farkas certificate found "
                                    "(please report)")
             return ForceSet(system, False, certificate=y, radius=radius, lps=3)
-    fs = ForceSet(system, True, solution=lam, lps=1, residuals=prob.residuals(lam))
+    witness = lam
+    if interior and max(prob.residuals(lam)) > 1e-12 * prob.scale:
+        # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
+        # reported network is a simplex vertex when that is closer (checked the same way)
+        lp = ForceLP(prob)
+        status, vertex = lp.solve(np.zeros(prob.n))
+        if (status == "optimal" and prob.admissible(vertex)
+                and max(prob.residuals(vertex)) < max(prob.residuals(lam))):
+            witness = vertex
+    fs = ForceSet(system, True, solution=witness, lps=1, residuals=prob.residuals(witness))
     fs.implicit = implicit_equalities(prob, lam if interior else None)
     fs.dimension, fs.rank_gap = dimension(prob, fs.implicit)
     if ranges:
