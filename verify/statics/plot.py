@@ -20,7 +20,6 @@ def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path
     import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
 
-    from rigidlcp.lcp.io.files import atomic_write
     from rigidlcp.models.plot import contact_points, draw_lattice
 
     system, c = fs.system, fs.c
@@ -46,14 +45,7 @@ def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path
     cb.set_label("indeterminacy of R: max R - min R over the admissible set (m g)")
     ax.set_title(f"{lat.title()}: admissible forces, dimension {fs.dimension}; width ~ R of "
                  "one checked equilibrium", fontsize="small")
-    out = Path(out)
-
-    def write(tmp: str) -> None:
-        fig.savefig(tmp, format="png", dpi=110)
-
-    atomic_write(out, write)
-    plt.close(fig)
-    return out
+    return _save_png(fig, out)
 
 
 def plot_pf(f: np.ndarray | dict, out: str | Path, bins: int = 40) -> Path:
@@ -64,7 +56,6 @@ def plot_pf(f: np.ndarray | dict, out: str | Path, bins: int = 40) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from rigidlcp.lcp.io.files import atomic_write
 
     series = f if isinstance(f, dict) else {"": f}
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), layout="constrained")
@@ -81,6 +72,16 @@ def plot_pf(f: np.ndarray | dict, out: str | Path, bins: int = 40) -> Path:
         ax.set_ylabel("P(f)")
     if len(series) > 1:
         axes[0].legend(fontsize="small")
+    return _save_png(fig, out)
+
+
+def _save_png(fig, out: str | Path) -> Path:
+    """Write `fig` to `out` as a PNG, atomically (a failed write leaves no partial file), and
+    close it."""
+    import matplotlib.pyplot as plt
+
+    from rigidlcp.lcp.io.files import atomic_write
+
     out = Path(out)
 
     def write(tmp: str) -> None:
