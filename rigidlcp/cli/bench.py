@@ -66,7 +66,8 @@ def register(sub) -> None:
                    help="do not add the installed peers (quantecon-lemke, drake-moby, "
                    "drake-unrevised-lemke, lemkelcp) to the default methods")
     p.add_argument("--list", action="store_true", help="list the sets and methods and exit")
-    p.add_argument("--quiet", action="store_true", help="no progress lines")
+    p.add_argument("--quiet", "--no-progress", action="store_true",
+                   help="no progress lines (--no-progress, as in the other commands)")
     p.set_defaults(func=cmd_bench)
 
 

@@ -32,7 +32,7 @@ def register(sub) -> None:
                    help="also the range of every observable over the face (more LPs)")
     p.add_argument("--events", help="events to certify: K, K1,K2,... or START:STOP (default all)")
     p.add_argument("--json", action="store_true", help="print the totals as JSON")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_certify_run)
 
 

@@ -9,6 +9,8 @@ from __future__ import annotations
 import argparse
 import json
 
+import numpy as np
+
 
 def register(sub) -> None:
     from rigidlcp.models.system import DEFAULT_MU
@@ -41,7 +43,7 @@ def register(sub) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write forceset.json and forceset.png here")
     p.add_argument("--force", action="store_true", help="overwrite files in --out")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_forceset)
 
 
@@ -58,13 +60,19 @@ def cmd_forceset(args: argparse.Namespace) -> int:
     import sys
 
     from rigidlcp.lcp.io.files import atomic_write_text, output_dir
-    from rigidlcp.models.packing import GAP_TOL, report
-    from rigidlcp.models.packing_io import read_packing
+    from rigidlcp.models.packing import GAP_TOL, Overlap, report
+    from rigidlcp.models.packing_io import read_disks, read_packing
     from rigidlcp.models.system import System
     from rigidlcp.verify.statics.forceset import analyse
 
-    lat = read_packing(args.file, left=_wall(args.left), right=_wall(args.right),
-                       gap_tol=GAP_TOL if args.gap_tol is None else args.gap_tol)
+    gap_tol = GAP_TOL if args.gap_tol is None else args.gap_tol
+    left, right = _wall(args.left), _wall(args.right)
+    disks = read_disks(args.file)
+    try:
+        lat = read_packing(args.file, left=left, right=right, gap_tol=gap_tol)
+    except Overlap as exc:  # a hand-written file rounds its centres: say what accepts it
+        raise Overlap(f"{exc}; --gap-tol G accepts overlaps up to G x radius", exc.i, exc.j,
+                      exc.overlap) from None
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
@@ -111,6 +119,7 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         return 0
     print(f"{lat.title()}: {lat.c} contacts ({report(lat).text()}); mu_pp = {args.mu_pp:g}, "
           f"mu_plane = {args.mu_plane:g}, mu_wall = {args.mu_wall:g}", file=sys.stdout)
+    print(_box_line(lat, disks, left, right))
     if not fs.exists:
         print(f"no equilibrium: Farkas certificate checked (no admissible forces with "
               f"sum R < {fs.radius:.3g})")
@@ -120,14 +129,32 @@ def cmd_forceset(args: argparse.Namespace) -> int:
           + (" (unique forces)" if fs.dimension == 0 else ""))
     if not args.no_ranges:
         lo, hi = fs.diameter()
+        open_r = int(np.sum(~np.isfinite(fs.hi[:fs.c])))
+        size = (f"diameter in [{lo:.4g}, {hi:.4g}]" if open_r == 0 else
+                f"unbounded: {open_r} of {fs.c} R have no upper end (walls and plane can wedge "
+                "the pile with any force; null in the JSON)")
         print(f"{int(fs.sliding.sum())} contacts can slide (2M - 3N = {fs.sliding_bound}); "
-              f"diameter in [{lo:.4g}, {hi:.4g}]; {fs.lps} LPs")
+              f"{size}; {fs.lps} LPs")
     if "ensemble" in result:
         e = result["ensemble"]
         print(f"{e['samples']} uniform samples ({e['sampler']}), each checked: largest "
               f"residuals {e['residuals'][0]:.2e} (balance), {e['residuals'][1]:.2e} (laws); "
               f"force fluctuation {e['fluctuation']:.4g} <R>; samples.npz, pf.png")
     return 0
+
+
+def _box_line(lat, disks, left, right) -> str:
+    """Where the obstacles are and where each wall comes from (the option, the file's
+    '# box:' comment, or the tight box around the disks); the plane is y = 0."""
+    def side(name: str, at, given, stated) -> str:
+        if at is None:
+            return f"no {name} wall"
+        src = ("--" + name if given is not None else "the file's box" if stated is not None
+               else "tight box")
+        return f"{name} wall x = {at:g} ({src})"
+
+    return (f"box: {side('left', lat.left, left, disks.left)}, "
+            f"{side('right', lat.right, right, disks.right)}, plane y = 0")
 
 
 def _write_ensemble(ens, args: argparse.Namespace, out) -> dict:

@@ -105,7 +105,8 @@ def _one_line(exc: BaseException) -> str:
         text = f"{exc.strerror or type(exc).__name__}: {exc.filename}"
     else:
         text = str(exc) or type(exc).__name__
-    return " ".join(text.split())
+    # The toolkit's messages name both spellings, "--force (force=True)"; here only the flag.
+    return " ".join(text.replace("--force (force=True)", "--force").split())
 
 
 if __name__ == "__main__":

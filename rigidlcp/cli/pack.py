@@ -44,7 +44,7 @@ def register(sub) -> None:
     p.add_argument("--out", required=True, metavar="FILE", help="output .csv or .npz")
     p.add_argument("--force", action="store_true", help="overwrite FILE")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_pack)
 
 

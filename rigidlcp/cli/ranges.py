@@ -40,6 +40,7 @@ def cmd_ranges(args: argparse.Namespace) -> int:
     if args.box is not None and not args.box > 0:
         raise ValueError(f"--box must be > 0, got {args.box}")
     run = load_run(args.run)
+    _warn_long(run.system, args)
     result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
                            box=args.box)
     if args.json:
@@ -47,3 +48,25 @@ def cmd_ranges(args: argparse.Namespace) -> int:
     else:
         print(result.table())
     return 0
+
+
+#: A run whose MILPs may take longer than this (seconds, at their time limits) is announced.
+LONG_RUN_S = 60.0
+
+
+def _warn_long(system, args: argparse.Namespace) -> None:
+    """Say on stderr, before the work, how long the MILPs may take: one per end of every
+    observable, each up to --time-limit, with no progress bar (a 10 x 4 run: about 14 min)."""
+    import sys
+
+    n = 1 + (system.p if args.observables in ("alpha", "all") else 0) \
+        + (2 * system.c if args.observables == "all" else 0)
+    worst = 2 * n * args.time_limit
+    if worst < LONG_RUN_S:
+        return
+    what = "mu_g" + (f" and {system.p} angular accelerations" if n > 1 else "") \
+        + (f" and R, S of {system.c} contacts" if args.observables == "all" else "")
+    span = f"{worst:.0f} s" if worst < 300 else f"{worst / 60:.0f} min"
+    print(f"rigidlcp ranges: {2 * n} MILP ends ({what}), each up to {args.time_limit:g} s: "
+          f"up to about {span}; `--observables mu_g` for mu_g alone, --time-limit S to stop "
+          "each end sooner", file=sys.stderr, flush=True)

@@ -26,7 +26,7 @@ def register(sub) -> None:
                    help="run the jobs on a dask.distributed scheduler or a LocalCluster")
     p.add_argument("--force", action="store_true",
                    help="write into an --out directory that is not empty")
-    p.add_argument("--no-progress", action="store_true")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_reproduce)
 
 

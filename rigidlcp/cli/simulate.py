@@ -105,7 +105,7 @@ def register(sub) -> None:
     g.add_argument("--force", action="store_true",
                    help="overwrite an existing --out run / write into a non-empty DIR")
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
-    g.add_argument("--no-progress", action="store_true")
+    g.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_simulate)
 
     p = sub.add_parser("plot", help="figures of a saved run (Figs. 7-10, 13)")

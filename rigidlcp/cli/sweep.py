@@ -71,7 +71,7 @@ def add_sweep(sub) -> None:
     e.add_argument("--force", action="store_true",
                    help="write into an --out directory that is not empty and not a sweep's")
     e.add_argument("--json", action="store_true", help="print the rows as JSON lines")
-    e.add_argument("--no-progress", action="store_true")
+    e.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_sweep)
 
 

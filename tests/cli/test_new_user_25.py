@@ -1,0 +1,84 @@
+"""What a new user tripped on (session 25): `--force (force=True)` on the command line, bench
+without --no-progress, `ranges` silent for 14 minutes, a hand-written packing whose walls and
+unbounded forces were not explained, and an overlap from rounded centres with no way out named."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+import pytest
+
+from rigidlcp import models
+from rigidlcp.cli import main
+from rigidlcp.cli.main import build_parser
+from rigidlcp.cli.ranges import LONG_RUN_S, _warn_long
+from rigidlcp.models.runio import save_run
+
+# Three unit disks: two on the plane touching each other, one on top of them (centre height
+# 1 + sqrt(3), written to 16 digits); with the tight box, each bottom disk touches a wall.
+THREE = "x,y,r\n1,1,1\n3,1,1\n2,2.7320508075688772,1\n"
+
+
+def test_refusal_names_the_flag_not_the_python_keyword(tmp_path, capsys):
+    out = tmp_path / "p.csv"
+    assert main(["pack", "--n", "3", "--out", str(out), "--no-progress"]) == 0
+    capsys.readouterr()
+    assert main(["pack", "--n", "3", "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "pass --force to overwrite" in err and "force=True" not in err and "\n" not in err
+
+
+def test_bench_takes_no_progress_like_the_other_commands():
+    args = build_parser().parse_args(["bench", "--no-progress", "--list"])
+    assert args.quiet is True
+
+
+def test_ranges_announces_a_long_run_before_the_work(capsys):
+    fig9 = models.System(models.rectangular(10, 4))
+    _warn_long(fig9, argparse.Namespace(observables="alpha", time_limit=10.0))
+    err = capsys.readouterr().err
+    # 2 ends of mu_g and of each of the 40 angular accelerations, 10 s each: 820 s
+    assert "82 MILP ends" in err and "14 min" in err and "--observables mu_g" in err
+    _warn_long(fig9, argparse.Namespace(observables="mu_g", time_limit=10.0))  # 20 s: quiet
+    assert capsys.readouterr().err == ""
+    assert 2 * 10.0 < LONG_RUN_S
+
+
+def test_ranges_note_goes_to_stderr_and_json_stays_clean(tmp_path, capsys):
+    system = models.System(models.rectangular(1, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.1)
+    run = models.simulate(system, seed=1, progress=False)
+    assert run.status == "steady"
+    path = save_run(run, tmp_path / "one")
+    # mu_g and one alpha, 2 ends each, 30 s each at most: 120 s, announced
+    assert main(["ranges", str(path), "--json", "--time-limit", "30"]) == 0
+    cap = capsys.readouterr()
+    assert "4 MILP ends" in cap.err
+    lo, hi = json.loads(cap.out)["steady"]["mu_g"]
+    assert lo == pytest.approx(0.05) and hi == pytest.approx(0.05)  # gamma / 2, rolling
+
+
+def test_hand_written_packing_says_where_its_walls_are(tmp_path, capsys):
+    f = tmp_path / "three.csv"
+    f.write_text(THREE)
+    assert main(["forceset", str(f), "--mu-pp", "0.5", "--mu-plane", "0.5", "--mu-wall",
+                 "0.5", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "left wall x = 0 (tight box), right wall x = 4 (tight box), plane y = 0" in out
+    # each bottom disk is pinched between a wall and its neighbour: R has no upper end there
+    assert "unbounded: 3 of 7 R have no upper end" in out and "inf" not in out
+    assert main(["forceset", str(f), "--left", "none", "--right", "none", "--mu-pp", "0.5",
+                 "--mu-plane", "0.5", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "no left wall, no right wall" in out and "diameter in [" in out
+
+
+def test_rounded_centres_name_the_gap_tolerance(tmp_path, capsys):
+    f = tmp_path / "rounded.csv"
+    f.write_text(THREE.replace("2.7320508075688772", "2.732"))  # overlap 4.4e-5
+    assert main(["forceset", str(f), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("rigidlcp forceset: error: disks 0 and 2 overlap")
+    assert "--gap-tol" in err and "\n" not in err
+    assert main(["forceset", str(f), "--gap-tol", "1e-4", "--no-progress"]) == 0
