@@ -40,7 +40,8 @@ def cmd_ranges(args: argparse.Namespace) -> int:
     if args.box is not None and not args.box > 0:
         raise ValueError(f"--box must be > 0, got {args.box}")
     run = load_run(args.run)
-    _warn_long(run.system, args)
+    if run.status == "steady":  # else refused in one line by steady_ranges, without the note
+        _warn_long(run.system, args)
     result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
                            box=args.box)
     if args.json:
