@@ -157,9 +157,9 @@ def cmd_forces(args: argparse.Namespace) -> int:
 
 def _print(system, s: dict) -> None:
     lat = system.lattice
-    print(f"{lat.name} {lat.lx}x{lat.ly}: {lat.p} disks, {lat.c} contacts; mu_pp = "
-          f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, gamma = "
-          f"{system.gamma}; angular velocities from seed {s['seed']}")
+    print(f"{lat.title() if lat.regular else 'packing'}: {lat.p} disks, {lat.c} contacts; "
+          f"mu_pp = {system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
+          f"gamma = {system.gamma}; angular velocities from seed {s['seed']}")
     print(f"state: {s['sliding']} sliding contacts, {s['candidates']} non-sliding candidates; "
           f"normal states of the solver's solution: {s['T_states']} T, {s['NT_states']} NT")
     lo, hi = s["F_g_range"]
@@ -220,7 +220,7 @@ def _draw(system, networks: list[tuple[str, np.ndarray]], out: Path, args) -> li
         ax.axis("off")
     for ax, (name, x) in zip(axes.flat, networks):
         panel(ax, name, x)
-    fig.suptitle(f"{lat.name} {lat.lx}x{lat.ly}, seed {args.seed}: admissible normal forces "
+    fig.suptitle(f"{lat.title()}, seed {args.seed}: admissible normal forces "
                  "(width ~ R, common scale)", fontsize="small")
     from rigidlcp.models.plot import force_key
 

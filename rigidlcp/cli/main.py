@@ -72,7 +72,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # named by the sub-command, whose --help lists what it takes
+        parser.exit(2, f"rigidlcp {args.command}: error: unrecognized arguments: "
+                    f"{' '.join(extra)} (see `rigidlcp {args.command} --help`)\n")
     try:
         return int(args.func(args) or 0)
     except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more

@@ -121,8 +121,8 @@ def _print_null_space(ns, states: str, loops) -> None:
     lat = sysm.lattice
     n_t = int(ns.normal.sum())
     n_ns = int((ns.tangential == 0).sum())
-    print(f"{lat.name} {lat.lx}x{lat.ly}: {lat.p} disks, {lat.c} contacts; mu_pp = "
-          f"{sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
+    print(f"{lat.title() if lat.regular else 'packing'}: {lat.p} disks, {lat.c} contacts; "
+          f"mu_pp = {sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
     print(f"states: {states} ({n_t} T, {lat.c - n_t} NT; {n_ns} NS, {lat.c - n_ns} sliding or "
           "frictionless)")
     kept, dropped = ns.gap

@@ -187,8 +187,8 @@ def cmd_simulate(args) -> int:
         print(json.dumps(summary, indent=2, default=float))
     else:
         lat = system.lattice
-        print(f"{lat.name} {lat.lx}x{lat.ly}: {lat.p} disks, {lat.c} contacts; mu_pp = "
-              f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
+        print(f"{lat.title() if lat.regular else 'packing'}: {lat.p} disks, {lat.c} contacts; "
+              f"mu_pp = {system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
               f"gamma = {system.gamma} g, V0 = {system.V0}")
         rows = [("status", run.status), ("message", run.message), ("events", run.n_events),
                 ("wall time (s)", f"{run.wall_time:.3f}"), ("method", run.method)]

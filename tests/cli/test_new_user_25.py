@@ -82,3 +82,24 @@ def test_rounded_centres_name_the_gap_tolerance(tmp_path, capsys):
     assert err.startswith("rigidlcp forceset: error: disks 0 and 2 overlap")
     assert "--gap-tol" in err and "\n" not in err
     assert main(["forceset", str(f), "--gap-tol", "1e-4", "--no-progress"]) == 0
+
+
+def test_unknown_option_is_named_by_its_subcommand(capsys):
+    """`rigidlcp nullspace --packing F` said `rigidlcp: error: ...` and pointed at the top-level
+    --help, which does not list nullspace's options."""
+    with pytest.raises(SystemExit) as exc:
+        main(["nullspace", "--packing", "three.csv"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err == ("rigidlcp nullspace: error: unrecognized arguments: --packing three.csv "
+                   "(see `rigidlcp nullspace --help`)")
+
+
+def test_a_packing_run_is_not_titled_as_an_array(tmp_path, capsys):
+    """`simulate --packing` printed 'packing 2x4: 3 disks' (a lattice's lx x ly, meaningless)."""
+    f = tmp_path / "three.csv"
+    f.write_text(THREE)
+    assert main(["simulate", "--packing", str(f), "--out", str(tmp_path / "run.npz"),
+                 "--no-progress"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("packing: 3 disks, 7 contacts; mu_pp = 0.1")
