@@ -102,8 +102,16 @@ def _jsonable(x: Any) -> Any:
 
 def _load(path: str):
     """lcp.load: a missing, corrupt or foreign file raises FileNotFoundError / InvalidFile
-    naming it (one line on the command line)."""
-    return load(path)
+    naming it (one line on the command line); a file that reads but holds a bad problem (NaN,
+    mismatched sizes) raises InvalidProblem, here prefixed with the file's name."""
+    from rigidlcp.lcp.errors import InvalidFile, InvalidProblem
+
+    try:
+        return load(path)
+    except InvalidProblem as exc:
+        if isinstance(exc, InvalidFile) or str(path) in str(exc):
+            raise
+        raise InvalidProblem(f"{path}: {exc}") from None
 
 
 def cmd_certify(args: argparse.Namespace) -> int:

@@ -103,3 +103,15 @@ def test_a_packing_run_is_not_titled_as_an_array(tmp_path, capsys):
                  "--no-progress"]) == 0
     first = capsys.readouterr().out.splitlines()[0]
     assert first.startswith("packing: 3 disks, 7 contacts; mu_pp = 0.1")
+
+
+@pytest.mark.parametrize("command", ["solve", "certify"])
+def test_a_bad_problem_names_its_file(tmp_path, capsys, command):
+    """A .npz with NaN in M said 'M contains NaN or Inf' without the file's name."""
+    import numpy as np
+
+    f = tmp_path / "nan.npz"
+    np.savez(f, M=np.array([[1.0, np.nan], [0.0, 1.0]]), q=np.array([1.0, -1.0]))
+    assert main([command, str(f)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"rigidlcp {command}: error: {f}: M contains NaN") and "\n" not in err
