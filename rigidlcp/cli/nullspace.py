@@ -39,10 +39,13 @@ def add_nullspace(sub) -> None:
         "[\"NS\"|\"+\"|\"-\", ...]} (one entry per contact, in the lattice's order; also "
         "true/false and 0/+1/-1), or .npz with arrays 'normal' and 'tangential'. The --json "
         "output has this form. See docs/verification.md.")
-    p.add_argument("--lattice", choices=("rect", "tri"), default="rect")
+    p.add_argument("--lattice", choices=("rect", "tri"), default="rect",
+                   help="rectangular or triangular array (default rect)")
     p.add_argument("--lx", type=int, default=4, help="disks in the rows touching both walls")
     p.add_argument("--ly", type=int, default=3, help="number of rows")
-    p.add_argument("--states", default="tangential", metavar="normal|tangential|FILE")
+    p.add_argument("--states", default="tangential", metavar="normal|tangential|FILE",
+                   help="the paper's states of Eq. (3.3) or (3.4) (default tangential), or a "
+                   "JSON file of per-contact states (docs/verification.md)")
     for name, default in NULLSPACE_MU.items():
         p.add_argument("--" + name.replace("_", "-"), type=float, default=default,
                        help=f"friction coefficient (default {default}; 0 = frictionless)")
@@ -162,13 +165,16 @@ def add_verify_formulas(sub) -> None:
         "the contact matrix, and the corrected closed forms (docs/verification.md). A paper "
         "value that differs from the SVD count is starred. Exit status 1 if a corrected closed "
         "form disagrees with the SVD.")
-    p.add_argument("--lattice", choices=("rect", "tri", "both"), default="both")
-    p.add_argument("--lx", type=int, nargs=2, default=(2, 12), metavar=("MIN", "MAX"))
-    p.add_argument("--ly", type=int, nargs=2, default=(1, 8), metavar=("MIN", "MAX"))
+    p.add_argument("--lattice", choices=("rect", "tri", "both"), default="both",
+                   help="which arrays (default both)")
+    p.add_argument("--lx", type=int, nargs=2, default=(2, 12), metavar=("MIN", "MAX"),
+                   help="range of Lx (default 2 12)")
+    p.add_argument("--ly", type=int, nargs=2, default=(1, 8), metavar=("MIN", "MAX"),
+                   help="range of Ly (default 1 8)")
     p.add_argument("--walls", choices=("rough", "frictionless"), default="rough",
                    help="rough: wall contacts NS in the tangential state (Eq. 3.4's "
                    "convention); frictionless: S = 0 at the walls (the paper's simulations)")
-    p.add_argument("--json", action="store_true")
+    p.add_argument("--json", action="store_true", help="the table as JSON")
     p.add_argument("--markdown", action="store_true", help="the table in Markdown")
     p.add_argument("--grid", action="store_true",
                    help="Markdown grids (Lx down, Ly across): SVD count [paper's, if different]")

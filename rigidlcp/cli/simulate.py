@@ -18,7 +18,8 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
     from rigidlcp.models.system import DEFAULT_MU
 
     g = p.add_argument_group("system")
-    g.add_argument("--lattice", choices=("rect", "tri"), default="rect")
+    g.add_argument("--lattice", choices=("rect", "tri"), default="rect",
+                   help="rectangular or triangular array (default rect)")
     g.add_argument("--lx", type=int, default=10,
                    help="disks in the rows touching both walls (default 10)")
     g.add_argument("--ly", type=int, default=4, help="number of rows (default 4)")
@@ -98,7 +99,8 @@ def register(sub) -> None:
                    "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none "
                    "(docs/integrators.md)")
     g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
-    g.add_argument("--max-events", type=int, default=100_000)
+    g.add_argument("--max-events", type=int, default=100_000,
+                   help="stop after this many events (default 100000)")
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")
     g.add_argument("--dump-problems", default=None, metavar="DIR",
                    help="write every event's LCP to DIR/event_NNNNNN.npz (DIR new or empty)")

@@ -55,8 +55,9 @@ def add_sweep(sub) -> None:
                    default=RUN_OPTIONS["select"], metavar="RULE",
                    help="the point followed where an event's solution is not unique: "
                    "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none")
-    r.add_argument("--max-events", type=int, default=RUN_OPTIONS["max_events"])
-    r.add_argument("--t-max", type=float, default=None)
+    r.add_argument("--max-events", type=int, default=RUN_OPTIONS["max_events"],
+                   help=f"events per run at most (default {RUN_OPTIONS['max_events']})")
+    r.add_argument("--t-max", type=float, default=None, help="stop each run at this time")
     r.add_argument("--omega-scale", type=float, default=RUN_OPTIONS["omega_scale"],
                    help="initial angular velocities uniform in [-scale, scale]")
     e = p.add_argument_group("execution")

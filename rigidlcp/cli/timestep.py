@@ -28,8 +28,9 @@ def register(sub) -> None:
     g.add_argument("--selection", type=selection_rule, default="none", metavar="RULE",
                    help="the point followed where a step's solution is not unique: none "
                    "(default: the solver's), face-min-norm, max-sum-R[:CAP], random:SEED")
-    g.add_argument("--t-max", type=float, default=np.inf)
-    g.add_argument("--max-steps", type=int, default=2_000_000)
+    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
+    g.add_argument("--max-steps", type=int, default=2_000_000,
+                   help="stop after this many steps (default 2000000)")
     g.add_argument("--record-every", type=int, default=100,
                    help="also record every N steps (besides state changes; 0: only those)")
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json); an "

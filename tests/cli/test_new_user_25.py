@@ -115,3 +115,12 @@ def test_a_bad_problem_names_its_file(tmp_path, capsys, command):
     assert main([command, str(f)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"rigidlcp {command}: error: {f}: M contains NaN") and "\n" not in err
+
+
+def test_every_option_of_every_command_has_a_help_text():
+    """--help listed --lattice, --max-events, --t-max, --states, ... with no word about them."""
+    sub = next(a for a in build_parser()._actions
+               if a.__class__.__name__ == "_SubParsersAction")
+    bare = [f"{name} {a.option_strings[0]}" for name, p in sub.choices.items()
+            for a in p._actions if a.option_strings and a.dest != "help" and not a.help]
+    assert not bare
