@@ -57,13 +57,11 @@ def _wall(text: str | None):
 
 
 def cmd_forceset(args: argparse.Namespace) -> int:
-    import sys
 
-    from rigidlcp.lcp.io.files import atomic_write_text, output_dir
-    from rigidlcp.models.packing import GAP_TOL, Overlap, report
+    from rigidlcp.lcp.io.files import output_dir
+    from rigidlcp.models.packing import GAP_TOL, Overlap
     from rigidlcp.models.packing_io import read_disks, read_packing
     from rigidlcp.models.system import System
-    from rigidlcp.verify.statics.forceset import analyse
 
     gap_tol = GAP_TOL if args.gap_tol is None else args.gap_tol
     left, right = _wall(args.left), _wall(args.right)
@@ -80,7 +78,22 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         raise ValueError("--samples writes samples.npz and pf.png: give --out DIR")
     names = ["forceset.json", "forceset.png"] + (["samples.npz", "pf.png"] if args.samples
                                                   else [])
+    made = _first_missing(args.out) if args.out else None  # removed again if refused below
     out = output_dir(args.out, force=args.force, names=names) if args.out else None
+    try:
+        return _forceset(args, lat, disks, left, right, system, out)
+    except BaseException:
+        _remove_empty(made, out)
+        raise
+
+
+def _forceset(args, lat, disks, left, right, system, out) -> int:
+    import sys
+
+    from rigidlcp.lcp.io.files import atomic_write_text
+    from rigidlcp.models.packing import report
+    from rigidlcp.verify.statics.forceset import analyse
+
     bar = None
     if not args.no_progress and not args.no_ranges and lat.c >= 200:
         from rigidlcp.models.progress import new_bar
@@ -141,6 +154,31 @@ def cmd_forceset(args: argparse.Namespace) -> int:
               f"residuals {e['residuals'][0]:.2e} (balance), {e['residuals'][1]:.2e} (laws); "
               f"force fluctuation {e['fluctuation']:.4g} <R>; samples.npz, pf.png")
     return 0
+
+
+def _first_missing(path):
+    """The outermost folder of `path` that does not exist yet (None: it exists)."""
+    from pathlib import Path
+
+    p, top = Path(path).absolute(), None
+    while not p.exists():
+        p, top = p.parent, p
+    return top
+
+
+def _remove_empty(top, out) -> None:
+    """A refused command leaves nothing behind: remove the folders it created, when empty."""
+    if top is None or out is None:
+        return
+    p = out.absolute()
+    while True:
+        try:
+            p.rmdir()  # only an empty folder
+        except OSError:
+            return
+        if p == top:
+            return
+        p = p.parent
 
 
 def _box_line(lat, disks, left, right) -> str:

@@ -124,3 +124,17 @@ def test_every_option_of_every_command_has_a_help_text():
     bare = [f"{name} {a.option_strings[0]}" for name, p in sub.choices.items()
             for a in p._actions if a.option_strings and a.dest != "help" and not a.help]
     assert not bare
+
+
+def test_refused_sampling_leaves_no_folder_behind(tmp_path, capsys):
+    """`forceset --samples N --out DIR` on an unbounded set (walls that pinch) was refused after
+    DIR had been created: an empty folder was left behind. A folder that existed stays."""
+    f = tmp_path / "three.csv"
+    f.write_text(THREE)
+    out = tmp_path / "new" / "deep"
+    assert main(["forceset", str(f), "--samples", "5", "--out", str(out)]) == 2
+    assert "--cap" in capsys.readouterr().err
+    assert not (tmp_path / "new").exists()
+    (tmp_path / "mine").mkdir()
+    assert main(["forceset", str(f), "--samples", "5", "--out", str(tmp_path / "mine")]) == 2
+    assert (tmp_path / "mine").is_dir()
