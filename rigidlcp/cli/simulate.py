@@ -12,17 +12,21 @@ import numpy as np
 
 from rigidlcp.cli.main import seed
 
+#: --lattice, --lx, --ly of the commands that take a system (their defaults).
+ARRAY_DEFAULTS = ("rect", 10, 4)
+
 
 def add_system_arguments(p: argparse.ArgumentParser) -> None:
     """The options that define a system (shared with other commands)."""
     from rigidlcp.models.system import DEFAULT_MU
 
     g = p.add_argument_group("system")
-    g.add_argument("--lattice", choices=("rect", "tri"), default="rect",
-                   help="rectangular or triangular array (default rect)")
-    g.add_argument("--lx", type=int, default=10,
-                   help="disks in the rows touching both walls (default 10)")
-    g.add_argument("--ly", type=int, default=4, help="number of rows (default 4)")
+    lattice, lx, ly = ARRAY_DEFAULTS
+    g.add_argument("--lattice", choices=("rect", "tri"), default=lattice,
+                   help=f"rectangular or triangular array (default {lattice})")
+    g.add_argument("--lx", type=int, default=lx,
+                   help=f"disks in the rows touching both walls (default {lx})")
+    g.add_argument("--ly", type=int, default=ly, help=f"number of rows (default {ly})")
     for name, text in (("mu_pp", "particle-particle"), ("mu_plane", "particle-plane"),
                        ("mu_wall", "particle-wall")):
         g.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
@@ -44,6 +48,10 @@ def system_from_args(args):
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
         from rigidlcp.models.packing_io import read_packing
+
+        if (args.lattice, args.lx, args.ly) != ARRAY_DEFAULTS:  # else silently ignored
+            raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
+                             "--ly describe an array, give one or the other")
         from rigidlcp.models.system import System
 
         return System(read_packing(args.packing), mu_pp=args.mu_pp, mu_plane=args.mu_plane,

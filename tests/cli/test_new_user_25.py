@@ -138,3 +138,16 @@ def test_refused_sampling_leaves_no_folder_behind(tmp_path, capsys):
     (tmp_path / "mine").mkdir()
     assert main(["forceset", str(f), "--samples", "5", "--out", str(tmp_path / "mine")]) == 2
     assert (tmp_path / "mine").is_dir()
+
+
+@pytest.mark.parametrize("array", [["--lx", "5"], ["--lattice", "tri"], ["--ly", "2"]])
+def test_packing_with_array_options_is_refused(tmp_path, capsys, array):
+    """`simulate --packing F --lx 5` ran the packing and ignored --lx without a word."""
+    f = tmp_path / "three.csv"
+    f.write_text(THREE)
+    out = tmp_path / "run.npz"
+    assert main(["simulate", "--packing", str(f), *array, "--out", str(out),
+                 "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--packing takes its disks from the file" in err and "\n" not in err
+    assert list(tmp_path.iterdir()) == [f]
