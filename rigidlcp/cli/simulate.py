@@ -73,6 +73,13 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
     from rigidlcp.models.engine.simulate import SPARSE_INSTEAD, check_dense_memory
     from rigidlcp.models.lattice import MAX_DISKS
 
+    if getattr(args, "packing", None):  # its disks count, not the array options' defaults
+        from rigidlcp.models.packing_io import read_disks
+
+        p = len(read_disks(args.packing).r)
+        check_dense_memory(p, f"{what} of a packing of {p} disks (at least {p} contacts)",
+                           instead=instead or SPARSE_INSTEAD)
+        return
     p = args.lx * args.ly
     if 0 < p <= MAX_DISKS:  # beyond MAX_DISKS the lattice refuses the size itself
         check_dense_memory(p, f"{what} of a {args.lx} x {args.ly} array (at least {p} "

@@ -151,3 +151,16 @@ def test_packing_with_array_options_is_refused(tmp_path, capsys, array):
     err = capsys.readouterr().err.strip()
     assert "--packing takes its disks from the file" in err and "\n" not in err
     assert list(tmp_path.iterdir()) == [f]
+
+
+@pytest.mark.parametrize("command", ["forces", "timestep"])
+def test_dense_commands_estimate_a_packings_memory_from_its_disks(tmp_path, capsys, command):
+    """The up-front memory check of the dense-only commands counted the array defaults
+    (10 x 4) for --packing; 10^5 disks on the plane need at least 64 (10^5)^2 bytes."""
+    f = tmp_path / "row.csv"
+    f.write_text("x,y,r\n" + "".join(f"{2 * k + 1},1,1\n" for k in range(100_000)))
+    out = ["--out", str(tmp_path / ("f" if command == "forces" else "ts.npz"))]
+    assert main([command, "--packing", str(f), *out]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "packing of 100000 disks" in err and "GiB" in err and "\n" not in err
+    assert list(tmp_path.iterdir()) == [f]
