@@ -94,19 +94,20 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
     from rigidlcp.models.packing import report
     from rigidlcp.verify.statics.forceset import analyse
 
-    bar = None
-    if not args.no_progress and not args.no_ranges and lat.c >= 200:
-        from rigidlcp.models.progress import new_bar
-
-        bar = new_bar(desc="force ranges", unit="LP")
+    bars: list = []  # opened at the first range LP (none for an empty set: nothing to count)
+    show = not args.no_progress and not args.no_ranges and lat.c >= 200
 
     def progress(done: int, total: int, stage: str) -> None:
-        bar.total = total
-        bar.n = done
-        bar.refresh()
+        if not bars:
+            from rigidlcp.models.progress import new_bar
 
-    fs = analyse(system, ranges=not args.no_ranges, progress=progress if bar is not None else None)
-    if bar is not None:
+            bars.append(new_bar(total=total, desc="force ranges", unit="LP"))
+        bars[0].total = total
+        bars[0].n = done
+        bars[0].refresh()
+
+    fs = analyse(system, ranges=not args.no_ranges, progress=progress if show else None)
+    for bar in bars:
         bar.close()
     ens = None
     if args.samples and fs.exists:  # before any file is written: a refusal leaves nothing

@@ -164,3 +164,18 @@ def test_dense_commands_estimate_a_packings_memory_from_its_disks(tmp_path, caps
     err = capsys.readouterr().err.strip()
     assert "packing of 100000 disks" in err and "GiB" in err and "\n" not in err
     assert list(tmp_path.iterdir()) == [f]
+
+
+def test_no_progress_bar_when_there_is_nothing_to_range(tmp_path, capsys):
+    """The bar 'force ranges: 0LP [00:00, ?LP/s]' was opened before the existence check and
+    shown for a pile with no equilibrium (no LP to run); it now opens at the first range LP."""
+    from rigidlcp.models.deposition import deposit
+    from rigidlcp.models.packing_io import write_packing
+
+    pile = deposit(100, seed=2, radii=(0.8, 1.2))
+    assert pile.c >= 200  # large enough for the bar
+    f = tmp_path / "pile.csv"
+    write_packing(f, pile)
+    assert main(["forceset", str(f)]) == 0  # default friction: a Farkas certificate
+    cap = capsys.readouterr()
+    assert "no equilibrium" in cap.out and cap.err == ""
