@@ -11,8 +11,9 @@ Durability: a line is written by a single `write` on a file opened with O_APPEND
 as soon as its point finishes, by the one process that owns the file (the workers only compute).
 A killed sweep (Ctrl-C, kill -9) therefore loses at most the points that were running; a torn
 last line (a kill inside the write) is ignored on reading. Rerunning the same command skips
-every point whose line exists: a point is identified by all its parameters and run options,
-so changing an option reruns the points. When every point of the grid is done the file is
+every point whose line exists: a point is identified by all its parameters and run options.
+OUT holding another grid or other options (its sweep.json) is refused unless forced, which
+then adds the new points to the same results.jsonl. When every point of the grid is done the file is
 rewritten (atomically: temporary file + rename) in grid order, so the finished file does not
 depend on the executor, on the order in which points completed, nor on interruptions. Wall
 times vary from run to run and go to `OUT/timings.jsonl` instead.
@@ -36,7 +37,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from rigidlcp.lcp.errors import InvalidInput, OutputExists
+from rigidlcp.lcp.errors import InvalidFile, InvalidInput, OutputExists
 
 from .executors import default_jobs, iter_map
 from .results_file import (
@@ -285,6 +286,31 @@ def check_out(out: str | os.PathLike, force: bool = False) -> Path:
     return out
 
 
+def _check_same_sweep(out: Path, sweep: Sweep) -> None:
+    """Refuse (`OutputExists`) to resume into OUT when its sweep.json holds another grid or
+    other options: the new points would be merged silently into the other sweep's
+    results.jsonl. `InvalidFile` for an unreadable sweep.json."""
+    spec = out / SPEC
+    if not spec.exists():
+        return
+    try:
+        old = json.loads(spec.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InvalidFile(f"{spec} is not a sweep's {SPEC} ({exc})") from None
+    new = json.loads(json.dumps(sweep.to_dict()))
+    if old == new:
+        return
+    if not isinstance(old, dict):
+        raise InvalidFile(f"{spec} is not a sweep's {SPEC} (not a JSON object)")
+    diff = []
+    for part in ("axes", "fixed", "options"):
+        a, b = old.get(part) or {}, new.get(part) or {}
+        diff += [f"{k}: {a.get(k)!r} there, {b.get(k)!r} here"
+                 for k in sorted(set(a) | set(b)) if a.get(k) != b.get(k)]
+    raise OutputExists(f"{out} holds another sweep ({'; '.join(diff[:3])}); use another --out, "
+                       "or pass --force (force=True) to add these points to it")
+
+
 def run_sweep(sweep: Sweep, out: str | os.PathLike, *, jobs: int | None = None,
               dask: str | None = None, progress: bool = True, save_runs: bool = False,
               log: Callable[[str], None] | None = None, force: bool = False) -> SweepResult:
@@ -297,6 +323,8 @@ def run_sweep(sweep: Sweep, out: str | os.PathLike, *, jobs: int | None = None,
     if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
         raise ValueError(f"jobs must be an integer >= 1, got {jobs!r}")
     out = check_out(out, force)
+    if not force:
+        _check_same_sweep(out, sweep)
     out.mkdir(parents=True, exist_ok=True)
     log = log or (lambda msg: print(msg, file=sys.stderr))
     _atomic_write_text(out / SPEC, json.dumps(sweep.to_dict(), indent=1) + "\n")

@@ -197,3 +197,20 @@ def test_sweep_bad_input(tmp_path, args, message, capsys):
 def test_effective_needs_results(tmp_path, capsys):
     assert main(["effective", str(tmp_path)]) == 2
     assert "no sweep results" in capsys.readouterr().err.lower()
+
+
+def test_a_folder_of_another_sweep_is_refused_not_merged(tmp_path):
+    """user25: a 3x1 sweep into a folder of a 10x1 sweep was merged into its results.jsonl."""
+    from rigidlcp.lcp.errors import OutputExists
+    from rigidlcp.models.sweep import Sweep, run_sweep
+
+    out = tmp_path / "sw"
+    first = Sweep({"gamma": [0.05]}, {"lx": 3, "ly": 1})
+    run_sweep(first, out, jobs=1, progress=False, log=lambda m: None)
+    lines = (out / "results.jsonl").read_text()
+    other = Sweep({"gamma": [0.05]}, {"lx": 4, "ly": 1})
+    with pytest.raises(OutputExists, match="another sweep.*lx"):
+        run_sweep(other, out, jobs=1, progress=False, log=lambda m: None)
+    assert (out / "results.jsonl").read_text() == lines
+    again = run_sweep(first, out, jobs=1, progress=False, log=lambda m: None)  # resume: same
+    assert again.ran == 0 and again.skipped == 1

@@ -35,6 +35,7 @@ from rigidlcp import lcp
 from rigidlcp.lcp import LCP, MLCP, NotApplicable, Solution, enumerate_solutions
 from rigidlcp.lcp.acceptance.accuracy import assess_problem
 from rigidlcp.lcp.acceptance.residual import check
+from rigidlcp.lcp.errors import InvalidInput
 
 from .friction import forces_map, friction_certificate
 from .stages import OTHER, UNIQUE, certify_stages
@@ -135,7 +136,7 @@ def certify(
     asked too.
     """
     if uniqueness not in UNIQUENESS_METHODS:
-        raise ValueError(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
+        raise InvalidInput(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
     t0 = time.perf_counter()
     obs: dict[str, np.ndarray] = {}
     fc_residual = None
@@ -161,7 +162,7 @@ def certify(
     z = np.asarray(solution.z if isinstance(solution, Solution) else solution, dtype=float)
     z = z.reshape(-1)
     if z.size != problem.n:
-        raise ValueError(f"the solution has {z.size} entries, the problem {problem.n} pairs")
+        raise InvalidInput(f"the solution has {z.size} entries, the problem {problem.n} pairs")
     notes: list[str] = []
     lcp_form: LCP | None
     if isinstance(problem, MLCP):
