@@ -183,14 +183,19 @@ def cmd_simulate(args) -> int:
     if not summary["paper_regime"]:
         print(f"warning: the run left the paper's regime ({run.status}): "
               f"{summary['regime_note']}", file=sys.stderr)
+    if run.status == "detachment" and run.final is not None:
+        summary["detachment_check"] = detachment_check(system, run.final)
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
         lat = system.lattice
-        print(f"{lat.name} {lat.lx}x{lat.ly}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
               f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
               f"gamma = {system.gamma} g, V0 = {system.V0}")
-        rows = [("status", run.status), ("message", run.message), ("events", run.n_events),
+        rows = [("status", run.status), ("message", run.message)]
+        if "detachment_check" in summary:
+            rows.append(("detachment check", summary["detachment_check"]))
+        rows += [("events", run.n_events),
                 ("wall time (s)", f"{run.wall_time:.3f}"), ("method", run.method)]
         if run.records:
             last = run.last
@@ -213,6 +218,28 @@ def cmd_simulate(args) -> int:
         for k, v in rows:
             print(f"  {k:<{width}}  {v}")
     return 0 if run.status in ("steady", "time_limit", "event_limit") else 1
+
+
+def title(lat) -> str:
+    """"rect 10x4" for an array, "packing" for any other set of disks (whose lx, ly are only a
+    box estimate)."""
+    return f"{lat.name} {lat.lx}x{lat.ly}" if lat.regular else lat.name
+
+
+def detachment_check(system, state) -> str:
+    """Whether the detachment at `state` is forced (verify.statics.regime): every solution of
+    the event opens a contact (a checked Farkas certificate), or forces keeping the disks in
+    place exist and the detachment is the selected solution's."""
+    from rigidlcp.verify.statics.regime import regime
+
+    r = regime(system, state)
+    if r.exists is False:
+        return "proved: " + r.text()
+    if r.exists:
+        return ("not forced: forces that keep every disk in place exist at this event (checked "
+                "witness); the selected solution of the event's LCP opens a contact anyway "
+                "(another --selection may keep it closed)")
+    return r.text()
 
 
 def cmd_plot(args) -> int:
