@@ -244,7 +244,7 @@ def detachment_check(system, state) -> str:
 
 def cmd_plot(args) -> int:
     from rigidlcp.lcp.io.files import output_dir
-    from rigidlcp.models.plot import PLOT_FILES, plot_run
+    from rigidlcp.models.plot import plot_files, plot_run
     from rigidlcp.models.runio import load_run
 
     run = load_run(args.run)
@@ -252,7 +252,7 @@ def cmd_plot(args) -> int:
         raise ValueError(f"{args.run} has no event to draw")
     if not -run.n_events <= args.event < run.n_events:
         raise ValueError(f"--event must be in [-{run.n_events}, {run.n_events - 1}]")
-    out = output_dir(args.out, force=args.force, names=PLOT_FILES)
+    out = output_dir(args.out, force=args.force, names=plot_files(run.system))
     for path in plot_run(run, out, event=args.event):
         print(path)
     return 0
