@@ -87,3 +87,21 @@ def test_groove_dynamics_by_hand(mu):
     assert abs(rec.R[a1] - R1) <= 1e-10 and abs(rec.R[a2] - R2) <= 1e-10
     assert abs(rec.S[a1] - mu * R1) <= 1e-10 and abs(rec.S[a2] - mu * R2) <= 1e-10
     assert abs(rec.omega_dot[2] + 2 * mu * (R1 + R2)) <= 1e-10
+
+
+def test_groove_event_ranges_over_every_solution():
+    """verify.ranges.event_ranges on a packing: the spinning top disk's angular acceleration is
+    the same, -2 mu (R1 + R2), over every solution of the event (the lower disks' plane and
+    wall forces are not: the walls can pinch them, so mu_g is unbounded)."""
+    from rigidlcp.verify.ranges.event import event_ranges
+
+    mu = 0.3
+    system = _groove(mu)
+    state = models.initial_state(system, omega=np.array([0.0, 0.0, 1.0]))
+    ratio = (0.6 + 0.8 * mu) / (0.6 - 0.8 * mu)
+    R2 = 1.0 / (ratio * (0.8 + 0.6 * mu) + 0.8 - 0.6 * mu)
+    want = -2 * mu * (ratio + 1) * R2
+    er = event_ranges(models.event_problem(system, state), time_limit=10)
+    top = er.every["alpha[2]"]
+    assert top.lo.status == top.hi.status == "optimal"
+    assert abs(top.lo.value - want) <= 1e-9 and abs(top.hi.value - want) <= 1e-9
