@@ -109,3 +109,17 @@ def test_deposited_pile_runs_to_a_steady_state_in_the_regime():
     assert np.max(np.abs(dyn.relative_accelerations(lam)[: system.c])) <= 1e-9 * scale
     assert regime(system, run.final).exists is True
     assert not _lp_says_infeasible(system, run.final)
+
+
+def test_time_stepper_reaches_the_same_steady_state_on_the_pile():
+    """Moreau-Jean (h = 0.02) on the same pile ends steady in the same contact states with the
+    same mu_g as the event engine (an independent integrator: docs/integrators.md)."""
+    from rigidlcp.models.timestepping import moreau_jean
+
+    pile = deposit(12, seed=5, radii=(0.8, 1.2), width=6.0)
+    system = models.System(pile, mu_pp=0.1, mu_plane=0.1, mu_wall=0.1, gamma=0.1)
+    ev = models.simulate(system, seed=1)
+    ts = moreau_jean(system, seed=1, h=0.02, t_max=8)
+    assert ev.status == ts.status == "steady"
+    assert np.array_equal(ev.last.s, ts.records[-1].s)
+    assert abs(ev.last.mu_g - ts.summary()["mu_g"]) <= 1e-9
