@@ -42,10 +42,9 @@ def system_from_args(args):
     from rigidlcp.models.system import make_system
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
-        from rigidlcp.models.packing_io import read_packing
         from rigidlcp.models.system import System
 
-        return System(read_packing(args.packing), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
+        return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                       mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
     return make_system(args.lattice, args.lx, args.ly, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                        mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
@@ -56,6 +55,16 @@ DENSE_ONLY = ("this command is dense only: use a smaller array (the event-driven
               "large arrays: rigidlcp simulate --method sparse-pivoting --select none)")
 
 
+def packing_of(args):
+    """The lattice of --packing FILE, read once (kept on args for system_from_args)."""
+    lat = getattr(args, "_packing_lattice", None)
+    if lat is None:
+        from rigidlcp.models.packing_io import read_packing
+
+        lat = args._packing_lattice = read_packing(args.packing)
+    return lat
+
+
 def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> None:
     """One line and exit 2, in a second and before anything is built or written, when the
     dense matrices of `what` for the --lx x --ly array cannot fit in memory (c >= p = lx ly
@@ -64,6 +73,11 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
     from rigidlcp.models.engine.simulate import SPARSE_INSTEAD, check_dense_memory
     from rigidlcp.models.lattice import MAX_DISKS
 
+    if getattr(args, "packing", None):  # its contacts, once the file is read
+        lat = packing_of(args)
+        check_dense_memory(lat.c, f"{what} of {args.packing} ({lat.c} contacts)",
+                           instead=instead or SPARSE_INSTEAD)
+        return
     p = args.lx * args.ly
     if 0 < p <= MAX_DISKS:  # beyond MAX_DISKS the lattice refuses the size itself
         check_dense_memory(p, f"{what} of a {args.lx} x {args.ly} array (at least {p} "

@@ -98,3 +98,22 @@ def test_ranges_of_an_equal_radii_packing_run_are_the_arrays(tmp_path, capsys):
     assert lat["status"]["mu_g"] == pack["status"]["mu_g"] == ["optimal", "optimal"]
     assert np.allclose(lat["mu_g"], pack["mu_g"], rtol=1e-9, atol=1e-12)
     assert np.allclose(lat["own_states"]["mu_g"], pack["own_states"]["mu_g"], rtol=1e-9)
+
+
+@pytest.mark.parametrize("command", ["simulate", "timestep", "compare-integrators"])
+def test_dense_memory_check_counts_the_packings_contacts(pile_run, tmp_path, monkeypatch,
+                                                          capsys, command):
+    """A packing's dense matrices are sized by its own contacts (24 here), not by --lx --ly's
+    defaults: with memory for 23 contacts only, refused in one line before any output."""
+    import importlib
+
+    engine = importlib.import_module("rigidlcp.models.engine.simulate")  # the module
+
+    _, _, csv = pile_run
+    monkeypatch.setattr(engine, "available_bytes", lambda: engine.dense_bytes(23))
+    out = tmp_path / "never.npz"
+    args = [command, "--packing", str(csv)]
+    args += ["--out", str(out)] if command != "compare-integrators" else []
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "(24 contacts)" in err and not out.exists()
