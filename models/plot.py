@@ -15,6 +15,15 @@ from .system import System
 PLOT_FILES = ("angular_acceleration.png", "angular_velocity.png",
               "angular_acceleration_rows.png", "normal_forces.png", "friction_forces.png",
               "mu_g.png", "dissipation.png")
+#: The files `plot_run` writes for a packing (no rows: the contact states instead).
+PACKING_PLOT_FILES = tuple("contact_states.png" if f == "angular_acceleration_rows.png" else f
+                           for f in PLOT_FILES)
+
+
+def plot_files(system: System) -> tuple[str, ...]:
+    """The files `plot_run` writes for a run of `system`: PLOT_FILES for an array, else
+    PACKING_PLOT_FILES."""
+    return PLOT_FILES if system.lattice.regular else PACKING_PLOT_FILES
 
 
 def _plt():
@@ -112,6 +121,40 @@ def force_key(ax, fmax: float, max_width: float, name: str = "R", signed: bool =
               ncol=min(len(labels), 3), fontsize="x-small", frameon=False, handlelength=2.5)
 
 
+#: The colours of the contact states (draw_states): state -> (colour, legend).
+STATE_STYLE = {"NT": ("0.6", "not transmitting (R = 0)"), "NS": ("tab:green", "non-sliding"),
+               "+": ("tab:red", "sliding, v_t > 0"), "-": ("tab:blue", "sliding, v_t < 0")}
+
+
+def contact_states(R: np.ndarray, s: np.ndarray, tol: float = 0.0) -> list[str]:
+    """Each contact's state after an event: NT (R <= tol), else NS, + or - (its s)."""
+    return ["NT" if Ra <= tol else {0: "NS", 1: "+", -1: "-"}[int(sa)] for Ra, sa in zip(R, s)]
+
+
+def draw_states(ax, system: System, R: np.ndarray, s: np.ndarray, max_width: float = 6.0
+                ) -> int:
+    """Every contact as a segment (centre to centre, or to the obstacle) coloured by its state
+    (STATE_STYLE), width proportional to R (NT contacts thin and dashed); returns the number of
+    segments drawn (one per contact)."""
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+
+    a, b = contact_points(system)
+    tol = 1e-12 * max(float(np.max(np.abs(R), initial=0.0)), 1e-300)
+    states = contact_states(R, s, tol)
+    rmax = max(float(np.max(R, initial=0.0)), 1e-12)
+    widths = [0.6 if st == "NT" else 0.8 + max_width * Ra / rmax for st, Ra in zip(states, R)]
+    coll = LineCollection(np.stack([a, b], axis=1), linewidths=widths,
+                          colors=[STATE_STYLE[st][0] for st in states],
+                          linestyles=["--" if st == "NT" else "-" for st in states])
+    ax.add_collection(coll)
+    seen = [k for k in STATE_STYLE if k in states]
+    ax.legend([Line2D([], [], color=STATE_STYLE[k][0], lw=3) for k in seen],
+              [f"{STATE_STYLE[k][1]}: {states.count(k)}" for k in seen], loc="upper center",
+              bbox_to_anchor=(0.5, 0.0), ncol=2, fontsize="x-small", frameon=False)
+    return len(states)
+
+
 def plot_rows(fig, system: System, omega_dot: np.ndarray, title: str = "") -> None:
     """Fig. 9: the angular accelerations against the position along each row, one panel per
     row (top row at the top, shared axes), so that rows with equal values do not hide each
@@ -200,10 +243,16 @@ def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
         draw_lattice(ax, system, values, label=f"{label} ({unit})")
         ax.set_title(f"{label} at {when}")
         save(fig, f"{name}.png")
-    # Fig. 9: angular accelerations against the position in each row.
-    fig = plt.figure(figsize=(6.5, 1.0 + 1.1 * lat.ly), layout="constrained")
-    plot_rows(fig, system, rec.omega_dot, title=f"angular accelerations by row, {when}")
-    save(fig, "angular_acceleration_rows.png")
+    if lat.regular:  # Fig. 9: angular accelerations against the position in each row.
+        fig = plt.figure(figsize=(6.5, 1.0 + 1.1 * lat.ly), layout="constrained")
+        plot_rows(fig, system, rec.omega_dot, title=f"angular accelerations by row, {when}")
+        save(fig, "angular_acceleration_rows.png")
+    else:  # a packing has no rows: its contact states and normal forces
+        fig, ax = plt.subplots(figsize=size)
+        draw_lattice(ax, system)
+        draw_states(ax, system, rec.R, rec.s)
+        ax.set_title(f"contact states at {when}; width ~ R")
+        save(fig, "contact_states.png")
     for name, F, signed, title, sym in (
             ("normal_forces", rec.R, False, "normal forces R", "R"),
             ("friction_forces", rec.S, True, "friction forces S", "S")):
@@ -230,6 +279,7 @@ def plot_run(run: Run, outdir: str | Path, event: int = -1) -> list[Path]:
     return files
 
 
-__all__ = ["PLOT_FILES", "UNITS", "plot_run", "draw_lattice", "draw_forces", "force_key",
+__all__ = ["PLOT_FILES", "PACKING_PLOT_FILES", "plot_files", "draw_states", "contact_states",
+           "UNITS", "plot_run", "draw_lattice", "draw_forces", "force_key",
            "plot_rows", "time_axis", "TIME_LINTHRESH", "dissipation_curve", "step_series",
            "LEFT_WALL", "RIGHT_WALL", "PLANE"]

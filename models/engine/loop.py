@@ -12,7 +12,8 @@ only solves the event problem of a state and returns an `Outcome`. The run stops
 
 * "steady": no future event (every a_t has the sign of its v_t, or both are zero, Sec. IV A);
 * "time_limit" / "event_limit": the limits given;
-* "detachment": a contact would open (a_n > 0): the no-displacement regime of the paper ends;
+* "detachment": a contact would open (a_n > 0), or a disk would translate with its contacts
+  closed (a mechanism of a packing): the no-displacement regime of the paper ends;
 * "no_solution": the solver ends without a solution (e.g. a Lemke ray), contacts named;
 * "zeno": events accumulate (more than `zeno_events` within `zeno_time`);
 * "solver_failed": a solution whose residual exceeds `check_tol` (times the problem's scale).
@@ -100,7 +101,8 @@ def run_events(system: System, state: State, backend: Backend, limits: Limits = 
             break
         last = _record(system, backend.dyn, state, out, clock.tol_a)
         run.records.append(last if records == "full" else _light(last))
-        if _detached(run, state, out, clock.tol_a):
+        if _detached(run, state, out, clock.tol_a) or _translating(run, state, out, backend.dyn,
+                                                                 clock.tol_a):
             break
         state = clock.advance(run, state, last)
         if run.status != "running":
@@ -157,6 +159,28 @@ def _detached(run: Run, state: State, out: Outcome, tol_a: float) -> bool:
                       for a in opening[:5])
     run.message = (f"t = {state.t:.6g}: contact(s) would open, the no-displacement regime "
                    f"ends: {names}")
+    return True
+
+
+#: A disk translates when its acceleration exceeds this many times the acceleration tolerance
+#: (the arrays' runs keep |v'| below 1e-11 g: their contacts block every translation).
+TRANSLATION_FACTOR = 100.0
+
+
+def _translating(run: Run, state: State, out: Outcome, dyn: Dynamics, tol_a: float) -> bool:
+    """Every contact stays closed but a disk would translate (v' != 0): a mechanism of the
+    packing (a disk or a cluster free to slide, e.g. a pile touching no wall pushed along the
+    plane), which the arrays of the paper never have; the no-displacement regime ends too."""
+    p = run.system.p
+    v_dot = dyn.accelerations(np.concatenate([out.R, out.S]))[:2 * p].reshape(2, p)
+    size = np.hypot(v_dot[0], v_dot[1])
+    moving = np.flatnonzero(size > max(TRANSLATION_FACTOR * tol_a, 10 * out.residual))
+    if not moving.size:
+        return False
+    run.status, run.contacts = "detachment", []
+    names = "; ".join(f"disk {k} (|v'| = {size[k]:.3g})" for k in moving[:5])
+    run.message = (f"t = {state.t:.6g}: disk(s) would translate with every contact closed, the "
+                   f"no-displacement regime ends: {names}")
     return True
 
 

@@ -43,6 +43,9 @@ def add_nullspace(sub) -> None:
                    help="rectangular or triangular array (default rect)")
     p.add_argument("--lx", type=int, default=4, help="disks in the rows touching both walls")
     p.add_argument("--ly", type=int, default=3, help="number of rows")
+    p.add_argument("--packing", metavar="FILE", default=None,
+                   help="disks from a packing file (.csv/.npz/LAMMPS dump) or a saved run "
+                   "(RUN.npz) instead of --lattice/--lx/--ly (docs/packings.md)")
     p.add_argument("--states", default="tangential", metavar="normal|tangential|FILE",
                    help="the paper's states of Eq. (3.3) or (3.4) (default tangential), or a "
                    "JSON file of per-contact states (docs/verification.md)")
@@ -65,6 +68,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
 
     from rigidlcp import models
     from rigidlcp.cli.simulate import DENSE_ONLY, refuse_too_large_for_dense
+    from rigidlcp.models.engine.simulate import check_dense_memory
     from rigidlcp.verify.nullspace.contact import (
         null_space,
         paper_states,
@@ -72,9 +76,18 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
         rotation_loops,
     )
 
-    refuse_too_large_for_dense(args, "the dense contact matrix and its SVD", DENSE_ONLY)
-    system = models.System(models.make_lattice(args.lattice, args.lx, args.ly),
-                           mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
+    if args.packing:
+        if (args.lattice, args.lx, args.ly) != ("rect", 4, 3):  # else silently ignored
+            raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
+                             "--ly describe an array, give one or the other")
+        lattice = packing_lattice(args.packing)
+        check_dense_memory(lattice.c, f"the dense contact matrix of {args.packing} "
+                           f"({lattice.c} contacts)", instead=DENSE_ONLY)
+    else:
+        refuse_too_large_for_dense(args, "the dense contact matrix and its SVD", DENSE_ONLY)
+        lattice = models.make_lattice(args.lattice, args.lx, args.ly)
+    system = models.System(lattice, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
+                           mu_wall=args.mu_wall)
     if args.plot:  # checked before the SVD: never overwrite a user's file without --force
         from pathlib import Path
 
@@ -119,13 +132,29 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     return 0
 
 
+def packing_lattice(path: str):
+    """The geometry of a packing file, or of the system of a run saved by `rigidlcp simulate
+    --out` (RUN.npz with its RUN.json: an array or a packing)."""
+    from pathlib import Path
+
+    from rigidlcp.models.packing_io import read_packing
+
+    if Path(path).suffix.lower() == ".npz" and Path(path).with_suffix(".json").is_file():
+        from rigidlcp.models.runio import load_run
+
+        return load_run(path).system.lattice
+    return read_packing(path)
+
+
 def _print_null_space(ns, states: str, loops) -> None:
+    from rigidlcp.cli.simulate import title
+
     sysm = ns.system
     lat = sysm.lattice
     n_t = int(ns.normal.sum())
     n_ns = int((ns.tangential == 0).sum())
-    print(f"{lat.title() if lat.regular else 'packing'}: {lat.p} disks, {lat.c} contacts; "
-          f"mu_pp = {sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
+    print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+          f"{sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
     print(f"states: {states} ({n_t} T, {lat.c - n_t} NT; {n_ns} NS, {lat.c - n_ns} sliding or "
           "frictionless)")
     kept, dropped = ns.gap

@@ -34,16 +34,22 @@ def register(sub) -> None:
 def cmd_ranges(args: argparse.Namespace) -> int:
     from rigidlcp.models.runio import load_run
     from rigidlcp.verify.ranges import steady_ranges
+    from rigidlcp.verify.ranges.steady import NoVelocityBound
 
     if not args.time_limit > 0:
         raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
     if args.box is not None and not args.box > 0:
         raise ValueError(f"--box must be > 0, got {args.box}")
     run = load_run(args.run)
-    if run.status == "steady":  # else refused in one line by steady_ranges, without the note
-        _warn_long(run.system, args)
-    result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
-                           box=args.box)
+    r = run.system.lattice.radii
+    if run.status == "steady" and float(r.max()) == float(r.min()):
+        _warn_long(run.system, args)  # else refused in one line below, without the note
+    try:
+        result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
+                               box=args.box)
+    except NoVelocityBound as exc:
+        raise NoVelocityBound(f"{args.run}: {unit_forms_note(run.system.lattice)} ({exc})"
+                              ) from None
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
@@ -71,3 +77,15 @@ def _warn_long(system, args: argparse.Namespace) -> None:
     print(f"rigidlcp ranges: {2 * n} MILP ends ({what}), each up to {args.time_limit:g} s: "
           f"up to about {span}; `--observables mu_g` for mu_g alone, --time-limit S to stop "
           "each end sooner", file=sys.stderr, flush=True)
+
+
+def unit_forms_note(lattice) -> str:
+    """Why the steady ranges refuse a system: they need every tangential velocity of the form
+    +-u_i +- u_j with u = r omega, which unequal radii break (v_t = -(r_i omega_i + r_j omega_j)
+    between two disks, docs/mechanics.md)."""
+    r = lattice.radii
+    if r.size and float(r.max()) != float(r.min()):
+        return (f"the ranges over all valid steady states need equal radii (v_t = +-u_i +- u_j, "
+                f"u = r omega); this packing's radii span {r.min():.6g} to {r.max():.6g}, so a "
+                "disk-disk contact has v_t = -(r_i omega_i + r_j omega_j): not handled")
+    return "the ranges over all valid steady states do not handle this system"

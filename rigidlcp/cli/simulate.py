@@ -47,14 +47,12 @@ def system_from_args(args):
     from rigidlcp.models.system import make_system
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
-        from rigidlcp.models.packing_io import read_packing
-
         if (args.lattice, args.lx, args.ly) != ARRAY_DEFAULTS:  # else silently ignored
             raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
                              "--ly describe an array, give one or the other")
         from rigidlcp.models.system import System
 
-        return System(read_packing(args.packing), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
+        return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                       mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
     return make_system(args.lattice, args.lx, args.ly, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                        mu_wall=args.mu_wall, gamma=args.gamma, V0=args.v0, inertia=args.inertia)
@@ -63,6 +61,16 @@ def system_from_args(args):
 #: The advice of the commands that have no sparse path.
 DENSE_ONLY = ("this command is dense only: use a smaller array (the event-driven evolution of "
               "large arrays: rigidlcp simulate --method sparse-pivoting --select none)")
+
+
+def packing_of(args):
+    """The lattice of --packing FILE, read once (kept on args for system_from_args)."""
+    lat = getattr(args, "_packing_lattice", None)
+    if lat is None:
+        from rigidlcp.models.packing_io import read_packing
+
+        lat = args._packing_lattice = read_packing(args.packing)
+    return lat
 
 
 def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> None:
@@ -200,14 +208,19 @@ def cmd_simulate(args) -> int:
     if not summary["paper_regime"]:
         print(f"warning: the run left the paper's regime ({run.status}): "
               f"{summary['regime_note']}", file=sys.stderr)
+    if run.status == "detachment" and run.final is not None:
+        summary["detachment_check"] = detachment_check(system, run.final)
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
         lat = system.lattice
-        print(f"{lat.title() if lat.regular else 'packing'}: {lat.p} disks, {lat.c} contacts; "
-              f"mu_pp = {system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
+        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+              f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
               f"gamma = {system.gamma} g, V0 = {system.V0}")
-        rows = [("status", run.status), ("message", run.message), ("events", run.n_events),
+        rows = [("status", run.status), ("message", run.message)]
+        if "detachment_check" in summary:
+            rows.append(("detachment check", summary["detachment_check"]))
+        rows += [("events", run.n_events),
                 ("wall time (s)", f"{run.wall_time:.3f}"), ("method", run.method)]
         if run.records:
             last = run.last
@@ -232,9 +245,31 @@ def cmd_simulate(args) -> int:
     return 0 if run.status in ("steady", "time_limit", "event_limit") else 1
 
 
+def title(lat) -> str:
+    """"rect 10x4" for an array, "packing" for any other set of disks (whose lx, ly are only a
+    box estimate)."""
+    return f"{lat.name} {lat.lx}x{lat.ly}" if lat.regular else lat.name
+
+
+def detachment_check(system, state) -> str:
+    """Whether the detachment at `state` is forced (verify.statics.regime): every solution of
+    the event opens a contact (a checked Farkas certificate), or forces keeping the disks in
+    place exist and the detachment is the selected solution's."""
+    from rigidlcp.verify.statics.regime import regime
+
+    r = regime(system, state)
+    if r.exists is False:
+        return "proved: " + r.text()
+    if r.exists:
+        return ("not forced: forces that keep every disk in place exist at this event (checked "
+                "witness); the selected solution of the event's LCP opens a contact anyway "
+                "(another --selection may keep it closed)")
+    return r.text()
+
+
 def cmd_plot(args) -> int:
     from rigidlcp.lcp.io.files import output_dir
-    from rigidlcp.models.plot import PLOT_FILES, plot_run
+    from rigidlcp.models.plot import plot_files, plot_run
     from rigidlcp.models.runio import load_run
 
     run = load_run(args.run)
@@ -242,7 +277,7 @@ def cmd_plot(args) -> int:
         raise ValueError(f"{args.run} has no event to draw")
     if not -run.n_events <= args.event < run.n_events:
         raise ValueError(f"--event must be in [-{run.n_events}, {run.n_events - 1}]")
-    out = output_dir(args.out, force=args.force, names=PLOT_FILES)
+    out = output_dir(args.out, force=args.force, names=plot_files(run.system))
     for path in plot_run(run, out, event=args.event):
         print(path)
     return 0

@@ -17,7 +17,8 @@ PLANE = 0  # contact 0 of rect 1 x 1 is the disk on the plane (then the two wall
 
 
 class Scripted:
-    """A backend whose event solution is prescribed: omega_dot (or a failure), forces zero."""
+    """A backend whose event solution is prescribed: omega_dot (or a failure); forces: the
+    plane's R = m g, the others zero."""
 
     method = "scripted"
     info = None
@@ -37,7 +38,10 @@ class Scripted:
         a = self.dyn.H @ np.concatenate([np.zeros(2 * p), od]) + self.dyn.u_obs_dot
         a_n = a[:c].copy()
         a_n[PLANE] = self.a_n
-        return Outcome("solved", self.method, R=np.zeros(c), S=np.zeros(c), omega_dot=od,
+        R = np.zeros(c)
+        R[PLANE] = self.system.masses[0] * self.system.g  # the plane holds the weight: the
+        # disk does not translate (the loop stops a run whose disks would)
+        return Outcome("solved", self.method, R=R, S=np.zeros(c), omega_dot=od,
                        a_n=a_n, a_t=a[c:], residual=self.residual, scale=1.0, n_lcp=c)
 
 
@@ -117,3 +121,14 @@ def test_records_light_keeps_only_the_last_arrays(system):
     assert run.records[0].omega.size == 0 and run.records[-1].omega.size == 1
     with pytest.raises(ValueError, match="records"):
         run_events(system, start(system), Scripted(system), records="some")
+
+
+def test_a_translating_disk_ends_the_regime():
+    """A disk on the plane alone (no wall) dragged by the sliding plane: every contact stays
+    closed (a_n = 0) but the friction mu m g accelerates it sideways; the paper's regime ends
+    (the arrays never have such a mechanism: their contacts block every translation)."""
+    lat = models.make_packing(np.array([[3.0, 1.0]]), [1.0], left=0.0, right=None)
+    system = models.System(lat, mu_plane=0.2, gamma=0.0, V0=1.0)
+    run = models.simulate(system, omega=np.zeros(1))
+    assert run.status == "detachment" and run.n_events == 1
+    assert "would translate" in run.message and "|v'| = 0.2" in run.message
