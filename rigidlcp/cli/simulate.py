@@ -84,8 +84,11 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
     if getattr(args, "packing", None):  # its disks count, not the array options' defaults
         from rigidlcp.models.packing_io import read_disks
 
-        p = len(read_disks(args.packing).r)
+        p = len(read_disks(args.packing).r)  # cheap first: c >= p before contacts are found
         check_dense_memory(p, f"{what} of a packing of {p} disks (at least {p} contacts)",
+                           instead=instead or SPARSE_INSTEAD)
+        lat = packing_of(args)  # then its own contacts
+        check_dense_memory(lat.c, f"{what} of a packing of {p} disks ({lat.c} contacts)",
                            instead=instead or SPARSE_INSTEAD)
         return
     p = args.lx * args.ly
