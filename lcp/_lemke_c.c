@@ -542,6 +542,58 @@ static PyObject *py_check(PyObject *self, PyObject *args)
     return Py_BuildValue("Od", finite ? Py_True : Py_False, qmin);
 }
 
+/* The format of a buffer of native float64 values ("d", with the native byte order mark or
+ * none)? */
+static int native_double(const Py_buffer *v)
+{
+    const char *f = v->format ? v->format : "B";
+#if PY_BIG_ENDIAN
+    if (*f == '>' || *f == '!' || *f == '=' || *f == '@') f++;
+#else
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+#endif
+    return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
+}
+
+/* plain(M, q) -> bool: lcp.LCP's quick route -- is q a C-contiguous native float64 vector of
+ * n >= 1 entries and M a C-contiguous native float64 n x n matrix, all entries finite? (Then
+ * M and q need no conversion, only the copies.) False for anything else, never an error: the
+ * general validation runs and names the problem. One call for the dtype, shape, order and
+ * finiteness tests. */
+static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "plain(M, q): two arguments");
+        return NULL;
+    }
+    Py_buffer vq, vM;
+    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
+    if (PyObject_GetBuffer(args[1], &vq, flags) < 0) {
+        PyErr_Clear();
+        Py_RETURN_FALSE;
+    }
+    if (PyObject_GetBuffer(args[0], &vM, flags) < 0) {
+        PyErr_Clear();
+        PyBuffer_Release(&vq);
+        Py_RETURN_FALSE;
+    }
+    idx n = vq.ndim == 1 ? vq.shape[0] : 0;
+    int ok = n >= 1 && native_double(&vq) && native_double(&vM) && vM.ndim == 2 &&
+             vM.shape[0] == n && vM.shape[1] == n;
+    if (ok) {
+        const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+        int finite = 1; /* as `check`: branch-free, |x| <= DBL_MAX false for inf and NaN */
+        for (idx k = 0; k < n * n; k++) finite &= fabs(M[k]) <= DBL_MAX;
+        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
+        ok = finite;
+    }
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    if (ok) Py_RETURN_TRUE;
+    Py_RETURN_FALSE;
+}
+
 /* ------------------------------------------------------------------ one whole problem */
 #include "_balanced.h" /* balanced_units, pow2_near: shared with solvers/_pivot_c.c */
 
@@ -818,7 +870,7 @@ done:
 /* After solve_problem's code 0: the basic z's into basis (sorted; returns their number) and,
  * when the numbers are safe, assess_one of z (zs: the solver's z, out: the answer, polished or
  * as given); res = (berr, ferr, refined). Returns the acceptance code: 0 done, 1 not handled
- * (out = zs: the numpy code decides), -1 unsafe (nothing assessed). */
+ * (the numpy code decides), -1 unsafe (nothing assessed); out = zs unless 0. */
 static int accept_one(idx n, const double *M, const double *q, const double *zs,
                       const int8_t *bz, const double bound[3], int64_t *basis, idx *nb,
                       double *out, double res[3])
@@ -828,8 +880,9 @@ static int accept_one(idx n, const double *M, const double *q, const double *zs,
         if (bz[j]) basis[m++] = j;
     *nb = m;
     res[0] = res[1] = res[2] = 0.0;
-    if (!((double)n * bound[0] * (bound[2] + 1.0) + bound[1] < SAFE)) return -1;
-    int code = m <= MAX_M ? assess_one(n, M, q, zs, basis, m, out, res) : 1;
+    int code = -1;
+    if ((double)n * bound[0] * (bound[2] + 1.0) + bound[1] < SAFE)
+        code = m <= MAX_M ? assess_one(n, M, q, zs, basis, m, out, res) : 1;
     if (code) memcpy(out, zs, (size_t)n * sizeof(double));
     return code;
 }
@@ -906,22 +959,24 @@ done:
  * pivot; else setup + run), on the data as given (mode 0) or equilibrated here when balanced
  * (mode 1, as `solve_eq` with r = c = None: code NEEDS_RUIZ for the others). Writes z (k n,
  * the original units), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
- * (solved) leaves a usable z: the caller solves the others again one by one. */
+ * (solved) leaves a usable z: the caller solves the others again one by one. acc (optional,
+ * k x 4 float64): each solved answer is also assessed as `solve_accept` does (`accept_one`),
+ * acc[p] = (acode, berr, ferr, refined) and Z[p] the answer (polished when refined). */
 static PyObject *py_solve_batch(PyObject *self, PyObject *args)
 {
-    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op;
+    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op, *oacc = Py_None;
     double tol;
     long long max_iter;
     int mode = 0;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOdLOOOO|i", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
-                          &op, &mode))
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO|iO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
+                          &op, &mode, &oacc))
         return NULL;
     if (mode != 0 && mode != 1) {
         PyErr_SetString(PyExc_ValueError, "mode: 0 or 1");
         return NULL;
     }
-    Py_buffer vd, vc, vp, vM, vq, vZ, vB;
+    Py_buffer vd, vc, vp, vM, vq, vZ, vB, va = {0};
     idx n = PyObject_Length(od), k = PyObject_Length(oc);
     if (n < 1 || k < 0) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "d: empty");
@@ -938,8 +993,19 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "basic_z: expected k n int8 values");
         goto b7;
     }
+    if (oacc != Py_None && get_buffer(oacc, &va, "acc", 'd', 4 * k, 0) < 0) goto b7;
+    double *acc = (double *)va.buf, *zs = NULL;
+    int64_t *ab = NULL;
     Work w;
     int failed = work_init(&w, n, tol, NULL) < 0;
+    if (!failed && acc) {
+        zs = (double *)malloc((size_t)n * (sizeof(double) + sizeof(int64_t)));
+        ab = (int64_t *)(zs + n);
+        if (!zs) {
+            work_free(&w);
+            failed = 1;
+        }
+    }
     if (!failed) {
         const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
                      *d = (const double *)vd.buf;
@@ -950,18 +1016,29 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         for (idx p = 0; p < k; p++) {
             long long pivots = 0;
             double bound[3];
-            int code = solve_problem(&w.L, w.T, Ms + p * n * n, qs + p * n, d, NULL, NULL, mode,
-                                     max_iter, Z + p * n, B + p * n, &pivots, bound);
+            const double *Mp = Ms + p * n * n, *qp = qs + p * n;
+            int code = solve_problem(&w.L, w.T, Mp, qp, d, NULL, NULL, mode, max_iter,
+                                     acc ? zs : Z + p * n, B + p * n, &pivots, bound);
             if (code < 0) {
                 failed = 1;
                 break;
+            }
+            if (acc) {
+                double res[3] = {0.0, 0.0, 0.0};
+                idx nb;
+                acc[4 * p] = code ? 1.0 : (double)accept_one(n, Mp, qp, zs, B + p * n, bound,
+                                                               ab, &nb, Z + p * n, res);
+                if (code) memcpy(Z + p * n, zs, (size_t)n * sizeof(double));
+                acc[4 * p + 1] = res[0], acc[4 * p + 2] = res[1], acc[4 * p + 3] = res[2];
             }
             codes[p] = code;
             piv[p] = pivots;
         }
         Py_END_ALLOW_THREADS
+        free(zs);
         work_free(&w);
     }
+    release(&va);
     PyBuffer_Release(&vB);
     PyBuffer_Release(&vZ);
     PyBuffer_Release(&vq);
@@ -1179,8 +1256,8 @@ static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
-     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0): k LCPs by "
-     "Lemke."},
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None): k "
+     "LCPs by Lemke (and the acceptance of each answer into acc)."},
     {"solve_accept", py_solve_accept, METH_VARARGS,
      "solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr, "
      "refined): solve_eq's default Lemke and the acceptance of its answer in one call."},
@@ -1194,6 +1271,8 @@ static PyMethodDef methods[] = {
     {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
      "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
+    {"plain", (PyCFunction)(void (*)(void))py_plain, METH_FASTCALL,
+     "plain(M, q) -> bool: C-contiguous native float64 q (n >= 1) and M (n x n), all finite."},
     {"setup", py_setup, METH_VARARGS,
      "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},
     {"run", py_run, METH_VARARGS,

@@ -148,11 +148,13 @@ def _builtin_lemke():
 def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of,
                  repair: bool = True) -> list[Solution]:
     """`solve`'s first attempt for every problem in C (lcp.fast_lemke's steps: the
-    equilibration of a balanced M, Lemke, z back; `_kernel.solve_batch`), then its check,
-    lcp.residual's measure, for all at once (`_kernel.measure_batch`: M z by numpy, the rest in
-    C, the same numbers as `check`). A problem not solved or not accepted there -- a ray, a
+    equilibration of a balanced M, Lemke, z back, and judge_lcp's `assess_lcp` of the answer;
+    `_kernel.solve_batch` with `acc`), then the rest of its check, lcp.residual's measure, for
+    all at once (`_kernel.measure_batch`: M z by numpy, the rest in C, the same numbers as
+    `check`): each answer judged once. A problem not solved or not accepted there -- a ray, a
     limit, a cycle, an M that is not balanced, an answer that fails the test -- is solved by
     `solve` itself, which answers it as a single call does."""
+    from .acceptance.accuracy import FERR_TOL, _accuracy_c
     from .acceptance.residual import TOL
     from .solvers.lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
 
@@ -164,28 +166,35 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     basic = np.empty((k, n), dtype=np.int8)
     codes = np.empty(k, dtype=np.int64)
     pivots = np.empty(k, dtype=np.int64)
+    # acceptance in C only where judge_lcp would use it (the C `assess` built)
+    acc = np.empty((k, 4)) if _accuracy_c is not None else None
     _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots,
-                        equilibrate=on)
+                        equilibrate=on, acc=acc)
     with np.errstate(all="ignore"):  # as `check`: an overflow is measured, never accepted
         W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
     measured = _kernel.measure_batch(Ms, qs, Z, W)
     if measured is None:  # not compiled as numpy sums: measure one by one
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
+    if acc is None:  # every answer to judge_lcp
+        acc = np.ones((k, 4))
     rows, cols = np.nonzero(basic)  # the basis of problem i: cols[ends[i - 1]:ends[i]]
     ends = [0, *np.cumsum(np.bincount(rows, minlength=k)).tolist()]
     sols: list[Solution] = []
-    for i, (code, piv, raw, scaled, z, w) in enumerate(zip(
+    for i, (code, piv, raw, scaled, (acode, berr, ferr, refined), z, w) in enumerate(zip(
             codes.tolist(), pivots.tolist(), measured[:, 0].tolist(),
-            measured[:, 1].tolist(), Z, W)):
+            measured[:, 1].tolist(), acc.tolist(), Z, W)):
         basis = cols[ends[i]:ends[i + 1]]
         ok = False
-        if code == _kernel.SOLVED and scaled <= TOL:  # then lcp.trust's verdict, as solve's
-            ok, z, w, raw, scaled, acc = judge_lcp(Ms[i], qs[i], z, basis)
+        if code == _kernel.SOLVED and acode == 0:  # assessed in C: judge_lcp's verdict
+            ok = scaled <= TOL and berr <= TOL and ferr <= FERR_TOL
+        elif code == _kernel.SOLVED and acode == 1:  # judge_lcp's numpy steps
+            ok, z, w, raw, scaled, a = judge_lcp(Ms[i], qs[i], z, basis)
+            berr, ferr, refined = a.berr, a.ferr, a.refined
         if ok:
-            info = {"equilibrated": on, "polished": True} if acc.refined else {"equilibrated": on}
+            info = {"equilibrated": on, "polished": True} if refined else {"equilibrated": on}
             sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, basis,
                                    "" if piv else "q >= 0: z = 0 solves the LCP", info,
-                                   acc.berr, acc.ferr))
+                                   berr, ferr))
         else:  # see the docstring: the single call gives the answer and its evidence
             sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
     return sols

@@ -15,8 +15,9 @@ with the same roundings, and the check of `lcp.accuracy.judge_lcp`, the verdict
 unit of q) one C call (`_lemke_c.solve_accept`) does the equilibration, the pivots, z back and
 judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`); numpy
 then computes M z and C the rest of lcp.residual's measure. Otherwise `ruiz` runs in numpy,
-its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it returns the same
-Solution (z, w, pivots, basis, residuals, message, info) as the general path, bit for bit
+its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it
+returns the same Solution (z, w, pivots, basis, residuals, message, info) as the general path,
+bit for bit
 (tests/lcp/test_fast_lemke.py), and None in every other case -- data that are not plain finite
 float64 arrays, a ray, a pivot limit, a cycle, an answer that fails the acceptance test, or
 numbers large enough for the check to overflow -- where the caller then runs the general path
