@@ -58,6 +58,7 @@ _solve_eq = _kernel._lemke_c.solve_eq if _kernel.COMPILED else None
 #: judge_lcp measures in numpy, and so must this path)
 _solve_accept = (_kernel._lemke_c.solve_accept
                  if _kernel.COMPILED and _accuracy.__dict__.get("_accuracy_c") else None)
+_measure = _kernel._lemke_c.lcp_measure if _kernel.COMPILED else None
 _empty, _intp = np.empty, np.intp
 
 
@@ -90,7 +91,12 @@ def solve_lemke(problem) -> Solution | None:
         return _judged(M, q, z, basis, pivots)
     # judge_lcp's verdict after `assess_lcp` (done in C above): z is the answer (polished when
     # refined), then lcp.residual's measure
-    w, raw, scaled, _, _ = lcp_measure(M, q, z)
+    w = M.dot(z)  # lcp_measure's steps, inlined: numpy's M z, the rest in C
+    got = _measure(M, q, z, w) if n <= _kernel.sums_verified_upto() else None
+    if got is None:  # measured by numpy (lcp_measure recomputes w)
+        w, raw, scaled, _, _ = lcp_measure(M, q, z)
+    else:
+        raw, scaled = got[0], got[1]
     if not (scaled <= TOL and berr <= TOL and ferr <= FERR_TOL):
         return None
     info = {"equilibrated": True, "polished": True} if refined else {"equilibrated": True}
