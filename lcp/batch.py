@@ -27,6 +27,7 @@ from .api import check_options, get_method, solve
 from .problems.problem import LCP, MLCP, InvalidProblem
 from .problems.solution import Solution, solved_lcp
 
+_Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it gives it
 #: Methods whose batch path runs the whole loop over the problems in compiled code (the others
 #: are a loop of their Python function with one lookup and one option check).
 COMPILED_BATCH = ("lemke",)
@@ -58,13 +59,13 @@ def solve_many(
 
     problems = list(problems)
     for i, p in enumerate(problems):
-        if not isinstance(p, (LCP, MLCP, FrictionContact2D)):
+        if type(p) is not LCP and not isinstance(p, (LCP, MLCP, FrictionContact2D)):
             raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
                                  f"lcp.FrictionContact2D, got {type(p).__name__}")
     out: list[Solution | None] = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
-        if not isinstance(p, LCP) or not p.M.flags.c_contiguous:
+        if not (type(p) is LCP or isinstance(p, LCP)) or not p.M.flags.c_contiguous:
             # MLCP (u, reductions), friction problem, or an M in Fortran order (numpy's M z
             # rounds otherwise than on the stacked C-ordered copy): one by one
             out[i] = solve(p, method, repair=repair, **options)
@@ -177,24 +178,37 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
     if acc is None:  # every answer to judge_lcp
         acc = np.ones((k, 4))
-    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[ends[i - 1]:ends[i]]
-    ends = [0, *np.cumsum(np.bincount(rows, minlength=k)).tolist()]
+    raw, scaled = measured[:, 0], measured[:, 1]
+    acode, berr, ferr, refined = acc.T
+    # judge_lcp's verdict, for all at once (NaN -- a problem not measured -- fails every test)
+    solved = codes == _kernel.SOLVED
+    accepted = (solved & (acode == 0) & (scaled <= TOL) & (berr <= TOL)
+                & (ferr <= FERR_TOL)).tolist()
+    numpy_judged = (solved & (acode == 1)).tolist()  # to judge_lcp's numpy steps
+    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[starts[i]:ends[i]]
+    ends = np.cumsum(np.bincount(rows, minlength=k)).tolist()
+    starts = [0, *ends[:-1]]
+    piv, raw, scaled = pivots.tolist(), raw.tolist(), scaled.tolist()
+    berr, ferr, refined = berr.tolist(), ferr.tolist(), refined.tolist()
+    Zs, Ws = list(Z), list(W)  # each problem's row (a view)
     sols: list[Solution] = []
-    for i, (code, piv, raw, scaled, (acode, berr, ferr, refined), z, w) in enumerate(zip(
-            codes.tolist(), pivots.tolist(), measured[:, 0].tolist(),
-            measured[:, 1].tolist(), acc.tolist(), Z, W)):
-        basis = cols[ends[i]:ends[i + 1]]
-        ok = False
-        if code == _kernel.SOLVED and acode == 0:  # assessed in C: judge_lcp's verdict
-            ok = scaled <= TOL and berr <= TOL and ferr <= FERR_TOL
-        elif code == _kernel.SOLVED and acode == 1:  # judge_lcp's numpy steps
-            ok, z, w, raw, scaled, a = judge_lcp(Ms[i], qs[i], z, basis)
-            berr, ferr, refined = a.berr, a.ferr, a.refined
-        if ok:
-            info = {"equilibrated": on, "polished": True} if refined else {"equilibrated": on}
-            sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, basis,
-                                   "" if piv else "q >= 0: z = 0 solves the LCP", info,
-                                   berr, ferr))
-        else:  # see the docstring: the single call gives the answer and its evidence
-            sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
+    for i in range(k):
+        basis = cols[starts[i]:ends[i]]
+        if accepted[i]:  # assessed in C, measured above
+            sols.append(solved_lcp(
+                Zs[i], Ws[i], "lemke", piv[i], raw[i], scaled[i], basis,
+                "" if piv[i] else _Q_NONNEGATIVE,
+                {"equilibrated": on, "polished": True} if refined[i] else {"equilibrated": on},
+                berr[i], ferr[i]))
+            continue
+        if numpy_judged[i]:
+            ok, z, w, r, sc, a = judge_lcp(Ms[i], qs[i], Zs[i], basis)
+            if ok:
+                info = {"equilibrated": on, "polished": True} if a.refined else {
+                    "equilibrated": on}
+                sols.append(solved_lcp(z, w, "lemke", piv[i], r, sc, basis,
+                                       "" if piv[i] else _Q_NONNEGATIVE, info, a.berr, a.ferr))
+                continue
+        # see the docstring: the single call gives the answer and its evidence
+        sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
     return sols
