@@ -18,21 +18,47 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 
+def _accepts(compiler, flag: str) -> bool:
+    """Does the C compiler accept `flag`? (A one-line file compiled with it.)"""
+    import os
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        src = os.path.join(tmp, "flag.c")
+        with open(src, "w") as fh:
+            fh.write("int main(void) { return 0; }\n")
+        try:
+            compiler.compile([src], output_dir=tmp, extra_postargs=[flag])
+        except Exception:  # noqa: BLE001 - any failure means "not accepted"
+            return False
+    return True
+
+
 class BuildExt(build_ext):
     def build_extensions(self):
         if self.compiler.compiler_type != "msvc":
+            flags = ["-ffp-contract=off"]
+            # Loops on 32-byte boundaries: the vectorized update of Lemke's dictionary ran
+            # 1.35x slower at n = 100 when an unrelated change moved its loop across a 64-byte
+            # line (AMD EPYC); the numbers do not depend on it. Skipped by a compiler without it.
+            if _accepts(self.compiler, "-falign-loops=32"):
+                flags.append("-falign-loops=32")
             for ext in self.extensions:
-                ext.extra_compile_args = [*ext.extra_compile_args, "-ffp-contract=off"]
+                ext.extra_compile_args = [*ext.extra_compile_args, *flags]
         super().build_extensions()
 
 
 setup(
     ext_modules=[
-        Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True),
+        Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True,
+                  depends=["lcp/_balanced.h", "lcp/acceptance/_accuracy_core.h",
+                           "lcp/acceptance/_lu_core.h"]),
         Extension("rigidlcp.lcp.solvers._pivot_c", sources=["lcp/solvers/_pivot_c.c"],
-                  optional=True),
+                  optional=True, depends=["lcp/_balanced.h"]),
         Extension("rigidlcp.lcp.acceptance._accuracy_c",
-                  sources=["lcp/acceptance/_accuracy_c.c"], optional=True),
+                  sources=["lcp/acceptance/_accuracy_c.c"], optional=True,
+                  depends=["lcp/acceptance/_accuracy_core.h",
+                           "lcp/acceptance/_lu_core.h"]),
     ],
     cmdclass={"build_ext": BuildExt},
 )

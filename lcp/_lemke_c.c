@@ -32,6 +32,8 @@
 
 typedef Py_ssize_t idx;
 
+#include "acceptance/_accuracy_core.h" /* assess_one: the acceptance of solve_accept */
+
 typedef struct {
     idx n;
     idx ld; /* column stride of T: n for a dictionary from Python; in the work array of
@@ -540,78 +542,60 @@ static PyObject *py_check(PyObject *self, PyObject *args)
     return Py_BuildValue("Od", finite ? Py_True : Py_False, qmin);
 }
 
+/* The format of a buffer of native float64 values ("d", with the native byte order mark or
+ * none)? */
+static int native_double(const Py_buffer *v)
+{
+    const char *f = v->format ? v->format : "B";
+#if PY_BIG_ENDIAN
+    if (*f == '>' || *f == '!' || *f == '=' || *f == '@') f++;
+#else
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+#endif
+    return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
+}
+
+/* plain(M, q) -> bool: lcp.LCP's quick route -- is q a C-contiguous native float64 vector of
+ * n >= 1 entries and M a C-contiguous native float64 n x n matrix, all entries finite? (Then
+ * M and q need no conversion, only the copies.) False for anything else, never an error: the
+ * general validation runs and names the problem. One call for the dtype, shape, order and
+ * finiteness tests. */
+static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "plain(M, q): two arguments");
+        return NULL;
+    }
+    Py_buffer vq, vM;
+    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
+    if (PyObject_GetBuffer(args[1], &vq, flags) < 0) {
+        PyErr_Clear();
+        Py_RETURN_FALSE;
+    }
+    if (PyObject_GetBuffer(args[0], &vM, flags) < 0) {
+        PyErr_Clear();
+        PyBuffer_Release(&vq);
+        Py_RETURN_FALSE;
+    }
+    idx n = vq.ndim == 1 ? vq.shape[0] : 0;
+    int ok = n >= 1 && native_double(&vq) && native_double(&vM) && vM.ndim == 2 &&
+             vM.shape[0] == n && vM.shape[1] == n;
+    if (ok) {
+        const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+        int finite = 1; /* as `check`: branch-free, |x| <= DBL_MAX false for inf and NaN */
+        for (idx k = 0; k < n * n; k++) finite &= fabs(M[k]) <= DBL_MAX;
+        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
+        ok = finite;
+    }
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    if (ok) Py_RETURN_TRUE;
+    Py_RETURN_FALSE;
+}
+
 /* ------------------------------------------------------------------ one whole problem */
-/* The equilibration of lcp/scaling.py's `ruiz`, done here for a balanced M (every row and
- * column maximum of |M| at least 1/BALANCED of the largest entry: `ruiz` then makes no sweep
- * and only changes the unit of q: r = 1/s, c = s, s the power of 2 nearest |q|_inf). */
-#define BALANCED 16.0
-#define NEEDS_RUIZ 4 /* mode 1 and M not balanced (or s not decided here): equilibrate in numpy */
-#define NOT_FINITE 5 /* the equilibrated data are not finite: lemke() would refuse them */
-
-/* The power of 2 nearest x > 0 in the log sense, numpy's exp2(round(log2(x))) in
- * lcp/scaling.py's `_pow2`, read from the bits of x = (1 + f) 2^e: 2^e if 1 + f < sqrt 2, else
- * 2^(e + 1). Returns 0 (the caller then leaves it to numpy) when x is not a positive normal
- * number, when 1 + f is within 1e-9 of sqrt 2 (where the last bit of a computed log2 could
- * decide the rounding) or when 2^-e would not be a normal number. */
-static double pow2_near(double x)
-{
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    int be = (int)((u >> 52) & 0x7FF);
-    if (be == 0 || be == 0x7FF || (u >> 63)) return 0.0;
-    double f = (double)(u & 0xFFFFFFFFFFFFFULL) / 4503599627370496.0; /* 2^52: exact */
-    double gap = f - 0.41421356237309504880;                           /* sqrt 2 - 1 */
-    if (gap < 1e-9 && gap > -1e-9) return 0.0;
-    int k = be - 1023 + (gap > 0);
-    if (k < -1000 || k > 1000) return 0.0;
-    uint64_t v = (uint64_t)(k + 1023) << 52;
-    double s;
-    memcpy(&s, &v, sizeof s);
-    return s;
-}
-
-/* Mode 1: is M (finite) balanced? Then *rs = 1/s, *cs = s (or 1, 1 when q = 0) and 0 is
- * returned; NEEDS_RUIZ otherwise, NOT_FINITE if M or q has a NaN or an infinity. colmax:
- * scratch of n doubles. */
-static int balanced_units(idx n, const double *M, const double *q, double *colmax, double *rs,
-                          double *cs)
-{
-    /* Branch-free maxima (x > m ? x : m) and finiteness test (|x| <= DBL_MAX is false for
-     * inf and NaN): random data would defeat the branch predictor. */
-    double top = 0.0, rmin = DBL_MAX;
-    int finite = 1;
-    for (idx j = 0; j < n; j++) colmax[j] = 0.0;
-    for (idx i = 0; i < n; i++) {
-        const double *Mi = M + i * n;
-        double rm = 0.0;
-        for (idx j = 0; j < n; j++) {
-            double a = fabs(Mi[j]), cm = colmax[j];
-            finite &= a <= DBL_MAX;
-            rm = a > rm ? a : rm;
-            colmax[j] = a > cm ? a : cm;
-        }
-        top = rm > top ? rm : top;
-        rmin = rm < rmin ? rm : rmin;
-    }
-    double qmax = 0.0;
-    for (idx i = 0; i < n; i++) {
-        double a = fabs(q[i]);
-        finite &= a <= DBL_MAX;
-        qmax = a > qmax ? a : qmax;
-    }
-    if (!finite) return NOT_FINITE;
-    double cmin = DBL_MAX;
-    for (idx j = 0; j < n; j++) cmin = colmax[j] < cmin ? colmax[j] : cmin;
-    if (!(top > 0 && rmin >= top / BALANCED && cmin >= top / BALANCED)) return NEEDS_RUIZ;
-    *rs = *cs = 1.0;
-    if (qmax > 0) {
-        double s = pow2_near(qmax);
-        if (s == 0.0) return NEEDS_RUIZ;
-        *rs = 1.0 / s;
-        *cs = 1.0 * s;
-    }
-    return 0;
-}
+#include "_balanced.h" /* balanced_units, pow2_near: shared with solvers/_pivot_c.c */
 
 /* T = [M~ / mu, d / delta, q~ / nu] (as `fill`) for the equilibrated data M~ = (M r) c and
  * q~ = q r, rounded as numpy rounds scaling.py's M * r[:, None] * c[None, :] and q * r; r and c
@@ -878,27 +862,121 @@ done:
     return result;
 }
 
+/* ------------------------------------------------------------------ solve and accept */
+/* Above this bound on n max|M| (max|z| + 1) + max|q|, numpy's part of the check could overflow
+ * (lcp/solvers/fast_lemke.py's _SAFE): the caller runs the general path. */
+#define SAFE 1e300
+
+/* After solve_problem's code 0: the basic z's into basis (sorted; returns their number) and,
+ * when the numbers are safe, assess_one of z (zs: the solver's z, out: the answer, polished or
+ * as given); res = (berr, ferr, refined). Returns the acceptance code: 0 done, 1 not handled
+ * (the numpy code decides), -1 unsafe (nothing assessed); out = zs unless 0. */
+static int accept_one(idx n, const double *M, const double *q, const double *zs,
+                      const int8_t *bz, const double bound[3], int64_t *basis, idx *nb,
+                      double *out, double res[3])
+{
+    idx m = 0;
+    for (idx j = 0; j < n; j++)
+        if (bz[j]) basis[m++] = j;
+    *nb = m;
+    res[0] = res[1] = res[2] = 0.0;
+    int code = -1;
+    if ((double)n * bound[0] * (bound[2] + 1.0) + bound[1] < SAFE)
+        code = m <= MAX_M ? assess_one(n, M, q, zs, basis, m, out, res) : 1;
+    if (code) memcpy(out, zs, (size_t)n * sizeof(double));
+    return code;
+}
+
+/* solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr,
+ * refined): `solve_eq` with r = c = d = None (lcp.solve's default Lemke) and, on code 0, the
+ * acceptance steps of lcp/acceptance/accuracy.py's `assess_lcp` on the answer and its basis
+ * (`accept_one`: acode 0 = assessed, z the answer, polished when refined; 1 = not handled
+ * here, z the solver's; -1 = numbers too large for the fast check). One crossing from Python
+ * for the solve and its acceptance (lcp/solvers/fast_lemke.py); the same numbers as the two
+ * calls. */
+static PyObject *py_solve_accept(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq, *oz, *ob;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOdLOO", &oM, &oq, &tol, &max_iter, &oz, &ob)) return NULL;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    Py_buffer vM = {0}, vq = {0}, vz = {0}, vb = {0};
+    PyObject *result = NULL;
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto done;
+    if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
+    if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
+    Work w;
+#if defined(__GNUC__)
+    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
+#else
+    uint64_t stack[STACK_WORDS];
+#endif
+    if (work_init(&w, n, tol, stack) < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    long long pivots = 0;
+    double bound[3] = {0.0, 0.0, 0.0}, res[3] = {0.0, 0.0, 0.0};
+    idx nb = 0;
+    int code, acode = 1;
+    double zbuf[64], *zs = n <= 64 ? zbuf : (double *)malloc((size_t)n * sizeof(double));
+    if (!zs) {
+        work_free(&w);
+        PyErr_NoMemory();
+        goto done;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, &pivots,
+                         bound);
+    if (code == 0)
+        acode = accept_one(n, M, q, zs, w.bz, bound, (int64_t *)vb.buf, &nb,
+                           (double *)vz.buf, res);
+    Py_END_ALLOW_THREADS
+    if (zs != zbuf) free(zs);
+    work_free(&w);
+    if (code < 0)
+        PyErr_NoMemory();
+    else
+        result = Py_BuildValue("iLniddi", code, pivots, nb, acode, res[0], res[1], (int)res[2]);
+done:
+    release(&vb);
+    release(&vz);
+    release(&vM);
+    release(&vq);
+    return result;
+}
+
 /* solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode): k problems of size n
  * (Ms: k n n C-contiguous, qs: k n; finite) by the steps of lemke() (q >= 0: z = 0 and no
  * pivot; else setup + run), on the data as given (mode 0) or equilibrated here when balanced
  * (mode 1, as `solve_eq` with r = c = None: code NEEDS_RUIZ for the others). Writes z (k n,
  * the original units), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
- * (solved) leaves a usable z: the caller solves the others again one by one. */
+ * (solved) leaves a usable z: the caller solves the others again one by one. acc (optional,
+ * k x 4 float64): each solved answer is also assessed as `solve_accept` does (`accept_one`),
+ * acc[p] = (acode, berr, ferr, refined) and Z[p] the answer (polished when refined). */
 static PyObject *py_solve_batch(PyObject *self, PyObject *args)
 {
-    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op;
+    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op, *oacc = Py_None;
     double tol;
     long long max_iter;
     int mode = 0;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOdLOOOO|i", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
-                          &op, &mode))
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO|iO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
+                          &op, &mode, &oacc))
         return NULL;
     if (mode != 0 && mode != 1) {
         PyErr_SetString(PyExc_ValueError, "mode: 0 or 1");
         return NULL;
     }
-    Py_buffer vd, vc, vp, vM, vq, vZ, vB;
+    Py_buffer vd, vc, vp, vM, vq, vZ, vB, va = {0};
     idx n = PyObject_Length(od), k = PyObject_Length(oc);
     if (n < 1 || k < 0) {
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "d: empty");
@@ -915,8 +993,19 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "basic_z: expected k n int8 values");
         goto b7;
     }
+    if (oacc != Py_None && get_buffer(oacc, &va, "acc", 'd', 4 * k, 0) < 0) goto b7;
+    double *acc = (double *)va.buf, *zs = NULL;
+    int64_t *ab = NULL;
     Work w;
     int failed = work_init(&w, n, tol, NULL) < 0;
+    if (!failed && acc) {
+        zs = (double *)malloc((size_t)n * (sizeof(double) + sizeof(int64_t)));
+        ab = (int64_t *)(zs + n);
+        if (!zs) {
+            work_free(&w);
+            failed = 1;
+        }
+    }
     if (!failed) {
         const double *Ms = (const double *)vM.buf, *qs = (const double *)vq.buf,
                      *d = (const double *)vd.buf;
@@ -927,18 +1016,29 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         for (idx p = 0; p < k; p++) {
             long long pivots = 0;
             double bound[3];
-            int code = solve_problem(&w.L, w.T, Ms + p * n * n, qs + p * n, d, NULL, NULL, mode,
-                                     max_iter, Z + p * n, B + p * n, &pivots, bound);
+            const double *Mp = Ms + p * n * n, *qp = qs + p * n;
+            int code = solve_problem(&w.L, w.T, Mp, qp, d, NULL, NULL, mode, max_iter,
+                                     acc ? zs : Z + p * n, B + p * n, &pivots, bound);
             if (code < 0) {
                 failed = 1;
                 break;
+            }
+            if (acc) {
+                double res[3] = {0.0, 0.0, 0.0};
+                idx nb;
+                acc[4 * p] = code ? 1.0 : (double)accept_one(n, Mp, qp, zs, B + p * n, bound,
+                                                               ab, &nb, Z + p * n, res);
+                if (code) memcpy(Z + p * n, zs, (size_t)n * sizeof(double));
+                acc[4 * p + 1] = res[0], acc[4 * p + 2] = res[1], acc[4 * p + 3] = res[2];
             }
             codes[p] = code;
             piv[p] = pivots;
         }
         Py_END_ALLOW_THREADS
+        free(zs);
         work_free(&w);
     }
+    release(&va);
     PyBuffer_Release(&vB);
     PyBuffer_Release(&vZ);
     PyBuffer_Release(&vq);
@@ -1156,8 +1256,11 @@ static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
-     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0): k LCPs by "
-     "Lemke."},
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None): k "
+     "LCPs by Lemke (and the acceptance of each answer into acc)."},
+    {"solve_accept", py_solve_accept, METH_VARARGS,
+     "solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr, "
+     "refined): solve_eq's default Lemke and the acceptance of its answer in one call."},
     {"solve_eq", py_solve_eq, METH_VARARGS,
      "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
      "LCP by Lemke on its equilibrated data."},
@@ -1168,6 +1271,8 @@ static PyMethodDef methods[] = {
     {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
      "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
+    {"plain", (PyCFunction)(void (*)(void))py_plain, METH_FASTCALL,
+     "plain(M, q) -> bool: C-contiguous native float64 q (n >= 1) and M (n x n), all finite."},
     {"setup", py_setup, METH_VARARGS,
      "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},
     {"run", py_run, METH_VARARGS,

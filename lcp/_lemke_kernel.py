@@ -97,14 +97,18 @@ def plain_finite(M, q) -> tuple[bool, float]:
 
 def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_iter: int,
                 Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray,
-                equilibrate: bool = False) -> None:
+                equilibrate: bool = False, acc: np.ndarray | None = None) -> None:
     """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
     z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
     leaves a z; the others are to be solved again one by one for their evidence.
     equilibrate: each problem on its equilibrated data, as `solve_eq` with r = c = None (code
-    NEEDS_RUIZ for a problem whose M is not balanced); z in the original units."""
+    NEEDS_RUIZ for a problem whose M is not balanced); z in the original units.
+    acc (k x 4 float64): each solved answer also assessed on (M, q) as `lcp.acceptance.accuracy.
+    assess_lcp` does in C, acc[p] = (acode, berr, ferr, refined) -- acode 0: done, Z[p] the
+    answer (polished when refined); 1: to be judged in numpy; -1: numbers too large for the
+    fast check (solve it alone)."""
     _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots,
-                         int(bool(equilibrate)))
+                         int(bool(equilibrate)), acc)
 
 
 def solve_eq(M: np.ndarray, q: np.ndarray, r: np.ndarray | None, c: np.ndarray | None,

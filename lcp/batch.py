@@ -27,6 +27,7 @@ from .api import check_options, get_method, solve
 from .problems.problem import LCP, MLCP, InvalidProblem
 from .problems.solution import Solution, solved_lcp
 
+_Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it gives it
 #: Methods whose batch path runs the whole loop over the problems in compiled code (the others
 #: are a loop of their Python function with one lookup and one option check).
 COMPILED_BATCH = ("lemke",)
@@ -58,13 +59,13 @@ def solve_many(
 
     problems = list(problems)
     for i, p in enumerate(problems):
-        if not isinstance(p, (LCP, MLCP, FrictionContact2D)):
+        if type(p) is not LCP and not isinstance(p, (LCP, MLCP, FrictionContact2D)):
             raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
                                  f"lcp.FrictionContact2D, got {type(p).__name__}")
     out: list[Solution | None] = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
-        if not isinstance(p, LCP) or not p.M.flags.c_contiguous:
+        if not (type(p) is LCP or isinstance(p, LCP)) or not p.M.flags.c_contiguous:
             # MLCP (u, reductions), friction problem, or an M in Fortran order (numpy's M z
             # rounds otherwise than on the stacked C-ordered copy): one by one
             out[i] = solve(p, method, repair=repair, **options)
@@ -148,11 +149,13 @@ def _builtin_lemke():
 def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of,
                  repair: bool = True) -> list[Solution]:
     """`solve`'s first attempt for every problem in C (lcp.fast_lemke's steps: the
-    equilibration of a balanced M, Lemke, z back; `_kernel.solve_batch`), then its check,
-    lcp.residual's measure, for all at once (`_kernel.measure_batch`: M z by numpy, the rest in
-    C, the same numbers as `check`). A problem not solved or not accepted there -- a ray, a
+    equilibration of a balanced M, Lemke, z back, and judge_lcp's `assess_lcp` of the answer;
+    `_kernel.solve_batch` with `acc`), then the rest of its check, lcp.residual's measure, for
+    all at once (`_kernel.measure_batch`: M z by numpy, the rest in C, the same numbers as
+    `check`): each answer judged once. A problem not solved or not accepted there -- a ray, a
     limit, a cycle, an M that is not balanced, an answer that fails the test -- is solved by
     `solve` itself, which answers it as a single call does."""
+    from .acceptance.accuracy import FERR_TOL, _accuracy_c
     from .acceptance.residual import TOL
     from .solvers.lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
 
@@ -164,28 +167,48 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     basic = np.empty((k, n), dtype=np.int8)
     codes = np.empty(k, dtype=np.int64)
     pivots = np.empty(k, dtype=np.int64)
+    # acceptance in C only where judge_lcp would use it (the C `assess` built)
+    acc = np.empty((k, 4)) if _accuracy_c is not None else None
     _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots,
-                        equilibrate=on)
+                        equilibrate=on, acc=acc)
     with np.errstate(all="ignore"):  # as `check`: an overflow is measured, never accepted
         W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
     measured = _kernel.measure_batch(Ms, qs, Z, W)
     if measured is None:  # not compiled as numpy sums: measure one by one
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
-    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[ends[i - 1]:ends[i]]
-    ends = [0, *np.cumsum(np.bincount(rows, minlength=k)).tolist()]
+    if acc is None:  # every answer to judge_lcp
+        acc = np.ones((k, 4))
+    raw, scaled = measured[:, 0], measured[:, 1]
+    acode, berr, ferr, refined = acc.T
+    # judge_lcp's verdict, for all at once (NaN -- a problem not measured -- fails every test)
+    solved = codes == _kernel.SOLVED
+    accepted = (solved & (acode == 0) & (scaled <= TOL) & (berr <= TOL)
+                & (ferr <= FERR_TOL)).tolist()
+    numpy_judged = (solved & (acode == 1)).tolist()  # to judge_lcp's numpy steps
+    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[starts[i]:ends[i]]
+    ends = np.cumsum(np.bincount(rows, minlength=k)).tolist()
+    starts = [0, *ends[:-1]]
+    piv, raw, scaled = pivots.tolist(), raw.tolist(), scaled.tolist()
+    berr, ferr, refined = berr.tolist(), ferr.tolist(), refined.tolist()
+    Zs, Ws = list(Z), list(W)  # each problem's row (a view)
     sols: list[Solution] = []
-    for i, (code, piv, raw, scaled, z, w) in enumerate(zip(
-            codes.tolist(), pivots.tolist(), measured[:, 0].tolist(),
-            measured[:, 1].tolist(), Z, W)):
-        basis = cols[ends[i]:ends[i + 1]]
-        ok = False
-        if code == _kernel.SOLVED and scaled <= TOL:  # then lcp.trust's verdict, as solve's
-            ok, z, w, raw, scaled, acc = judge_lcp(Ms[i], qs[i], z, basis)
-        if ok:
-            info = {"equilibrated": on, "polished": True} if acc.refined else {"equilibrated": on}
-            sols.append(solved_lcp(z, w, "lemke", piv, raw, scaled, basis,
-                                   "" if piv else "q >= 0: z = 0 solves the LCP", info,
-                                   acc.berr, acc.ferr))
-        else:  # see the docstring: the single call gives the answer and its evidence
-            sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
+    for i in range(k):
+        basis = cols[starts[i]:ends[i]]
+        if accepted[i]:  # assessed in C, measured above
+            sols.append(solved_lcp(
+                Zs[i], Ws[i], "lemke", piv[i], raw[i], scaled[i], basis,
+                "" if piv[i] else _Q_NONNEGATIVE,
+                {"equilibrated": on, "polished": True} if refined[i] else {"equilibrated": on},
+                berr[i], ferr[i]))
+            continue
+        if numpy_judged[i]:
+            ok, z, w, r, sc, a = judge_lcp(Ms[i], qs[i], Zs[i], basis)
+            if ok:
+                info = {"equilibrated": on, "polished": True} if a.refined else {
+                    "equilibrated": on}
+                sols.append(solved_lcp(z, w, "lemke", piv[i], r, sc, basis,
+                                       "" if piv[i] else _Q_NONNEGATIVE, info, a.berr, a.ferr))
+                continue
+        # see the docstring: the single call gives the answer and its evidence
+        sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
     return sols

@@ -20,8 +20,9 @@ import rigidlcp.lcp._lemke_kernel as _kernel
 from ..errors import InvalidProblem, NotApplicable
 from ..io.files import atomic_write
 
-_F64 = np.dtype(np.float64)
-_check_finite = _kernel._lemke_c.check if _kernel.COMPILED else None
+_ND = np.ndarray
+#: The quick route's test (lcp/_lemke_c.c: plain); None when the C extension is not built.
+_plain = _kernel._lemke_c.plain if _kernel.COMPILED else None
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
@@ -82,24 +83,22 @@ class LCP:
     name: str = ""
     meta: dict = field(default_factory=dict)
 
-    def __post_init__(self) -> None:
-        M, q = self.M, self.q
-        if (_check_finite is not None and type(M) is np.ndarray and type(q) is np.ndarray
-                and M.dtype is _F64 and q.dtype is _F64 and q.ndim == 1 and q.size
-                and M.shape == (q.size, q.size) and M.flags.c_contiguous
-                and q.flags.c_contiguous and _check_finite(M, q)[0]):
-            # plain finite float64 data (the common call): the copies `as_matrix` and
-            # `as_vector` would make, with one finiteness test in C for both (anything else,
+    def __init__(self, M: Any, q: Any, name: str = "", meta: dict | None = None) -> None:
+        # written out (the dataclass keeps its fields, repr and replace): half the cost of the
+        # generated __init__ and __post_init__ for the common call
+        d = self.__dict__  # frozen: the fields are set once, here
+        if type(M) is _ND and type(q) is _ND and _plain is not None and _plain(M, q):
+            # plain finite float64 data, C-contiguous (one test in C for dtype, shape, order and
+            # finiteness): the copies `as_matrix` and `as_vector` would make (anything else,
             # including a NaN, takes the general route below and its error message)
-            object.__setattr__(self, "M", M.copy())
-            object.__setattr__(self, "q", q.copy())
-            return
-        M = as_matrix("M", M, (None, None))
-        if M.shape[0] != M.shape[1]:
-            raise InvalidProblem(f"M must be square, got shape {M.shape}")
-        q = as_vector("q", q, M.shape[0])
-        object.__setattr__(self, "M", M)
-        object.__setattr__(self, "q", q)
+            d["M"], d["q"] = M.copy(), q.copy()
+        else:
+            M = as_matrix("M", M, (None, None))
+            if M.shape[0] != M.shape[1]:
+                raise InvalidProblem(f"M must be square, got shape {M.shape}")
+            d["M"], d["q"] = M, as_vector("q", q, M.shape[0])
+        d["name"] = name
+        d["meta"] = {} if meta is None else meta
 
     @property
     def n(self) -> int:

@@ -42,9 +42,6 @@ static dot_t *ddot;
 
 #define SOLVED 0
 #define DECLINE 1
-#define NEEDS_RUIZ 4
-#define NOT_FINITE 5
-#define BALANCED 16.0 /* lcp/acceptance/scaling.py */
 #define RCOND 1e-13   /* lcp/solvers/pivoting.py */
 #define FLOOR 1e-4    /* lcp/solvers/pivoting.py */
 
@@ -62,59 +59,7 @@ static void matvec(int m, const double *A, const double *x, double *y)
     gemv(&t, &m, &m, &alpha, (double *)A, &m, (double *)x, &one, &beta, y, &one);
 }
 
-/* The power of 2 nearest x > 0 as lcp/acceptance/scaling.py's `_pow2` (see _lemke_c.c: 0 when undecided) */
-static double pow2_near(double x)
-{
-    uint64_t u;
-    memcpy(&u, &x, sizeof u);
-    int be = (int)((u >> 52) & 0x7FF);
-    if (be == 0 || be == 0x7FF || (u >> 63)) return 0.0;
-    double f = (double)(u & 0xFFFFFFFFFFFFFULL) / 4503599627370496.0;
-    double gap = f - 0.41421356237309504880;
-    if (gap < 1e-9 && gap > -1e-9) return 0.0;
-    int k = be - 1023 + (gap > 0);
-    if (k < -1000 || k > 1000) return 0.0;
-    uint64_t v = (uint64_t)(k + 1023) << 52;
-    double s;
-    memcpy(&s, &v, sizeof s);
-    return s;
-}
-
-/* `ruiz` of a balanced M (as _lemke_c.c's balanced_units): 0 with *rs = 1/s, *cs = s. */
-static int balanced_units(idx n, const double *M, const double *q, double *colmax, double *rs,
-                          double *cs)
-{
-    double top = 0.0, rmin = DBL_MAX, qmax = 0.0, cmin = DBL_MAX;
-    int finite = 1;
-    for (idx j = 0; j < n; j++) colmax[j] = 0.0;
-    for (idx i = 0; i < n; i++) {
-        double rm = 0.0;
-        for (idx j = 0; j < n; j++) {
-            double a = fabs(M[i * n + j]), cm = colmax[j];
-            finite &= a <= DBL_MAX;
-            rm = a > rm ? a : rm;
-            colmax[j] = a > cm ? a : cm;
-        }
-        top = rm > top ? rm : top;
-        rmin = rm < rmin ? rm : rmin;
-    }
-    for (idx i = 0; i < n; i++) {
-        double a = fabs(q[i]);
-        finite &= a <= DBL_MAX;
-        qmax = a > qmax ? a : qmax;
-    }
-    if (!finite) return NOT_FINITE;
-    for (idx j = 0; j < n; j++) cmin = colmax[j] < cmin ? colmax[j] : cmin;
-    if (!(top > 0 && rmin >= top / BALANCED && cmin >= top / BALANCED)) return NEEDS_RUIZ;
-    *rs = *cs = 1.0;
-    if (qmax > 0) {
-        double s = pow2_near(qmax);
-        if (s == 0.0) return NEEDS_RUIZ;
-        *rs = 1.0 / s;
-        *cs = 1.0 * s;
-    }
-    return 0;
-}
+#include "../_balanced.h" /* balanced_units, pow2_near: shared with _lemke_c.c */
 
 /* A complementary basis (pivoting.py's _Basis): a (m indices), Maa row-major, lu column-major. */
 typedef struct {

@@ -9,12 +9,15 @@ The general path (lcp.api.solve -> lcp.trust.solve_checked) runs, for such a cal
     check(problem, z).accepted         lcp.residual: the one acceptance test
 
 and returns the answer when it is "solved" and accepted. `solve_lemke` does these same steps
-with the same roundings, but the first three in one C call (`_lemke_kernel.solve_eq`: the
-equilibration of a balanced M -- `ruiz` then makes no sweep and only changes the unit of q --
-is done there; otherwise `ruiz` runs in numpy and its factors are passed), and the check by
-`lcp.accuracy.judge_lcp`, the verdict `lcp.trust.Run.judge` gives on an LCP (polish on the
-basis, backward and forward errors, `lcp.residual.lcp_measure`). So it returns the same
-Solution (z, w, pivots, basis, residuals, message, info) as the general path, bit for bit
+with the same roundings, and the check of `lcp.accuracy.judge_lcp`, the verdict
+`lcp.trust.Run.judge` gives on an LCP (polish on the basis, backward and forward errors,
+`lcp.residual.lcp_measure`). For a balanced M (`ruiz` then makes no sweep and only changes the
+unit of q) one C call (`_lemke_c.solve_accept`) does the equilibration, the pivots, z back and
+judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`); numpy
+then computes M z and C the rest of lcp.residual's measure. Otherwise `ruiz` runs in numpy,
+its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it
+returns the same Solution (z, w, pivots, basis, residuals, message, info) as the general path,
+bit for bit
 (tests/lcp/test_fast_lemke.py), and None in every other case -- data that are not plain finite
 float64 arrays, a ray, a pivot limit, a cycle, an answer that fails the acceptance test, or
 numbers large enough for the check to overflow -- where the caller then runs the general path
@@ -28,7 +31,9 @@ import numpy as np
 import rigidlcp.lcp._lemke_kernel as _kernel
 
 from .. import registry
-from ..acceptance.accuracy import judge_lcp
+from ..acceptance import accuracy as _accuracy
+from ..acceptance.accuracy import FERR_TOL, judge_lcp
+from ..acceptance.residual import TOL, lcp_measure
 from ..acceptance.scaling import ruiz
 from ..problems.solution import Solution, solved_lcp
 from .lemke import DEFAULT_TOL
@@ -49,6 +54,12 @@ def applies() -> bool:
 
 _F64 = np.dtype(np.float64)
 _solve_eq = _kernel._lemke_c.solve_eq if _kernel.COMPILED else None
+#: Lemke and `assess_lcp`'s C steps in one call; only with the C acceptance built as well (else
+#: judge_lcp measures in numpy, and so must this path)
+_solve_accept = (_kernel._lemke_c.solve_accept
+                 if _kernel.COMPILED and _accuracy.__dict__.get("_accuracy_c") else None)
+_measure = _kernel._lemke_c.lcp_measure if _kernel.COMPILED else None
+_empty, _intp = np.empty, np.intp
 
 
 def solve_lemke(problem) -> Solution | None:
@@ -60,14 +71,48 @@ def solve_lemke(problem) -> Solution | None:
             and applies()):
         return None
     n = q.size
-    z = np.empty(n)
-    basis = np.empty(n, dtype=np.intp)
+    z = _empty(n)
+    basis = _empty(n, dtype=_intp)
     max_iter = 1000 + 100 * n  # lemke()'s default
+    if _solve_accept is None:
+        return _solve_ruiz(M, q, n, max_iter, z, basis, balanced=True)
     try:  # C-contiguous finite float64 data only (else ValueError or BufferError)
-        # _kernel.solve_eq's C function itself (its arguments are already of the right types)
-        code, pivots, m, bounds = _solve_eq(M, q, None, None, None, DEFAULT_TOL, max_iter, z,
-                                            basis)
+        # the solve and `assess_lcp`'s C steps in one call (lcp/_lemke_c.c: solve_accept)
+        code, pivots, m, acode, berr, ferr, refined = _solve_accept(M, q, DEFAULT_TOL,
+                                                                    max_iter, z, basis)
         if code == _kernel.NEEDS_RUIZ:
+            return _solve_ruiz(M, q, n, max_iter, z, basis)
+    except (ValueError, BufferError):  # e.g. a Fortran-ordered or read-only M: general path
+        return None
+    if code != _kernel.SOLVED or acode < 0:  # not solved, or numbers the check could overflow
+        return None
+    basis = basis[:m]
+    if acode:  # not handled in C (e.g. a singular pattern): judge_lcp's numpy steps
+        return _judged(M, q, z, basis, pivots)
+    # judge_lcp's verdict after `assess_lcp` (done in C above): z is the answer (polished when
+    # refined), then lcp.residual's measure
+    w = M.dot(z)  # lcp_measure's steps, inlined: numpy's M z, the rest in C
+    got = _measure(M, q, z, w) if n <= _kernel.sums_verified_upto() else None
+    if got is None:  # measured by numpy (lcp_measure recomputes w)
+        w, raw, scaled, _, _ = lcp_measure(M, q, z)
+    else:
+        raw, scaled = got[0], got[1]
+    if not (scaled <= TOL and berr <= TOL and ferr <= FERR_TOL):
+        return None
+    info = {"equilibrated": True, "polished": True} if refined else {"equilibrated": True}
+    return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis,
+                      "" if pivots else _Q_NONNEGATIVE, info, berr, ferr)
+
+
+def _solve_ruiz(M, q, n: int, max_iter: int, z, basis, balanced: bool = False
+                ) -> Solution | None:
+    """The fast path for an M that is not balanced (lcp.scaling.ruiz in numpy, then Lemke on
+    its factors in C) or, `balanced`, without `solve_accept`: then `judge_lcp`."""
+    try:
+        if balanced:
+            code, pivots, m, bounds = _solve_eq(M, q, None, None, None, DEFAULT_TOL, max_iter,
+                                                z, basis)
+        if not balanced or code == _kernel.NEEDS_RUIZ:
             eq = ruiz(M, q)
             code, pivots, m, bounds = _kernel.solve_eq(M, q, eq.r, eq.c, DEFAULT_TOL,
                                                        max_iter, z, basis)
@@ -76,9 +121,13 @@ def solve_lemke(problem) -> Solution | None:
     mmax, qmax, zmax = bounds
     if code != _kernel.SOLVED or not n * mmax * (zmax + 1.0) + qmax < _SAFE:
         return None
-    ok, z, w, raw, scaled, acc = judge_lcp(M, q, z, basis[:m])
+    return _judged(M, q, z, basis[:m], pivots)
+
+
+def _judged(M, q, z, basis, pivots: int) -> Solution | None:
+    ok, z, w, raw, scaled, acc = judge_lcp(M, q, z, basis)
     if not ok:  # lcp.trust.Run.judge's verdict, with no equality part
         return None
     info = {"equilibrated": True, "polished": True} if acc.refined else {"equilibrated": True}
-    return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis[:m],
+    return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis,
                       "" if pivots else _Q_NONNEGATIVE, info, acc.berr, acc.ferr)

@@ -106,3 +106,31 @@ def test_repair_false_reaches_every_single_solve():
     sols = assert_same_as_loop(problems, max_iter=20, repair=False)
     assert sols[4].status == "infeasible"
     assert_same_as_loop(problems, "pivoting", repair=False)
+
+
+@pytest.mark.skipif(not kernel.enabled(), reason="the C extension is not built or is off")
+def test_each_answer_is_judged_once(monkeypatch):
+    """The compiled batch assesses each answer in the solver's own C call (backward error,
+    polishing, forward bound) and measures it once: neither the numpy `judge_lcp` nor a single
+    `lcp.solve` runs for an answer the batch accepts, and the answers, with their bounds, are a
+    loop of `lcp.solve`'s, bit for bit."""
+    from rigidlcp.lcp import batch
+    from rigidlcp.lcp.acceptance import accuracy
+
+    if accuracy._accuracy_c is None:
+        pytest.skip("the accuracy extension is not built")
+    problems = random_lcps(12, 9, 5)
+    loop = [lcp.solve(p) for p in problems]
+    calls = []
+    monkeypatch.setattr(batch, "judge_lcp", lambda *a: calls.append("judge") or None)
+    monkeypatch.setattr(batch, "solve", lambda *a, **k: calls.append("solve") or None)
+    many = lcp.solve_many(problems)
+    assert calls == []
+    for got, one in zip(many, loop):
+        assert got.status == one.status == "solved"
+        for field in ("z", "w", "basis"):
+            assert getattr(got, field).tobytes() == getattr(one, field).tobytes()
+        for field in ("residual", "scaled_residual", "backward_error", "forward_error",
+                      "iterations"):
+            assert repr(getattr(got, field)) == repr(getattr(one, field))
+        assert got.info == one.info

@@ -199,3 +199,33 @@ def test_c_assess_agrees_with_the_numpy_assess(n):
             assert np.abs(out - ref.v).max() <= 1e-12 * scale
             assert c_ferr <= ref.ferr * (1 + 1e-6) + 1e-15
             assert (c_ferr <= accuracy.FERR_TOL) == (ref.ferr <= accuracy.FERR_TOL)
+
+
+@compiled
+@pytest.mark.parametrize("k", range(0, 19, 2))
+def test_c_assess_singularity_test_across_conditioning(k):
+    """The C `assess` declines (code 1: the numpy code's SVD path decides) a pattern system
+    singular to working precision -- Skeel's condition || |K^-1| |K| 1 || beyond 1 / (m eps) --
+    and handles a well-conditioned one, whether its cheap upper bound settles the test or Hager's
+    estimate has to (lcp/acceptance/_accuracy_core.h: skeel_bound). Conditions 1 .. 1e18, away
+    from the threshold by a factor 100 either way (near it the estimate, a lower bound, may
+    fall on either side)."""
+    from rigidlcp.lcp.acceptance import accuracy
+
+    if accuracy._accuracy_c is None:
+        pytest.skip("the accuracy extension is not built")
+    m = 8
+    rng = np.random.default_rng(k)
+    U, _ = np.linalg.qr(rng.standard_normal((m, m)))
+    V, _ = np.linalg.qr(rng.standard_normal((m, m)))
+    K = U @ np.diag(np.logspace(0, -k, m)) @ V.T
+    q = rng.standard_normal(m)
+    with np.errstate(all="ignore"):
+        skeel = float(np.max(np.abs(np.linalg.inv(K)) @ np.abs(K).sum(axis=1)))
+    out = np.empty(m)
+    code = accuracy._accuracy_c.assess(K, q, np.abs(rng.standard_normal(m)),
+                                       np.arange(m, dtype=np.int64), out)[0]
+    if skeel * m * np.finfo(float).eps > 100:
+        assert code == 1
+    elif skeel * m * np.finfo(float).eps < 0.01:
+        assert code == 0

@@ -1,0 +1,306 @@
+/* lcp/acceptance/accuracy.py's `assess` of an LCP answer on its basis, in C: the steps (backward
+ * error, LU of the pattern's system, refinement with long double residuals, LAPACK's forward
+ * error bound by Hager's estimator, the polished point kept when not worse). Included by
+ * lcp/acceptance/_accuracy_c.c (the binding `assess`) and by lcp/_lemke_c.c (`solve_accept`:
+ * the solve and its acceptance in one call), so that both run the same code. The includer
+ * defines `idx` (Py_ssize_t) and includes <float.h>, <math.h>, <stdint.h>, <stdlib.h> and
+ * <string.h>. assess_one returns 0 (done) or 1 (not handled here: the numpy code decides). */
+#ifndef RIGIDLCP_ACCURACY_CORE_H
+#define RIGIDLCP_ACCURACY_CORE_H
+
+/* max / min of numbers that are not NaN (fmax / fmin are library calls unless inlined) */
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+static inline double dmin(double a, double b) { return a < b ? a : b; }
+#define MAX_M 400
+#define STEPS 5
+
+/* berr of lcp/accuracy.py (nu = 0). */
+static double backward_error(idx n, const double *M, const double *q, const double *x,
+                             double mmax, double qmax, double floor)
+{
+    double xmax = 0.0;
+    for (idx i = 0; i < n; i++) xmax = dmax(xmax, fabs(x[i]));
+    double vs = dmax(xmax, mmax > 0 ? qmax / mmax : 0.0);
+    if (!(vs > 0)) vs = 1.0;
+    double out = 0.0;
+    double rb[4], sb[4];
+    for (idx i = 0; i < n; i++) {
+        const double *row = M + i * n;
+        double res, s;
+        if (i % 4 == 0 && i + 4 <= n) {  /* four rows at once: independent sums, each in
+                                          * its own order (the same numbers, sooner) */
+            const double *r1 = row + n, *r2 = r1 + n, *r3 = r2 + n;
+            double a0 = q[i], a1 = q[i + 1], a2 = q[i + 2], a3 = q[i + 3];
+            double b0 = fabs(q[i]), b1 = fabs(q[i + 1]), b2 = fabs(q[i + 2]), b3 = fabs(q[i + 3]);
+            for (idx j = 0; j < n; j++) {
+                double xj = x[j], axj = fabs(xj);
+                a0 += row[j] * xj;
+                b0 += fabs(row[j]) * axj;
+                a1 += r1[j] * xj;
+                b1 += fabs(r1[j]) * axj;
+                a2 += r2[j] * xj;
+                b2 += fabs(r2[j]) * axj;
+                a3 += r3[j] * xj;
+                b3 += fabs(r3[j]) * axj;
+            }
+            rb[0] = a0, rb[1] = a1, rb[2] = a2, rb[3] = a3;
+            sb[0] = b0, sb[1] = b1, sb[2] = b2, sb[3] = b3;
+        }
+        if (i - i % 4 + 4 <= n) {
+            res = rb[i % 4];
+            s = sb[i % 4];
+        } else {
+            res = q[i];
+            s = fabs(q[i]);
+            for (idx j = 0; j < n; j++) {
+                res += row[j] * x[j];
+                s += fabs(row[j]) * fabs(x[j]);
+            }
+        }
+        s = dmax(s, floor);
+        double wr = s > 0 ? res / s : (res == 0 ? 0.0 : copysign(INFINITY, res));
+        double v = x[i] / vs, mn = v < wr ? v : wr;
+        if (isnan(mn)) return INFINITY;
+        out = dmax(out, fabs(mn));
+    }
+    return out;
+}
+
+#include "_lu_core.h" /* lu, lu_solve: the LU of the pattern's system */
+
+/* || |K^-1| g ||_inf = || diag(g) K^-T ||_1, by Hager's 1-norm estimator (Higham 2002,
+ * Alg. 15.4; LAPACK's xLACN2 does the same for xGERFS's FERR): B x = g .* (K^-T x),
+ * B^T x = K^-1 (g .* x). x, y: scratch of length m. */
+static double abs_inv_norm(idx m, const double *A, const idx *perm, const double *g,
+                           double *x, double *y)
+{
+    for (idx i = 0; i < m; i++) x[i] = 1.0 / (double)m;
+    double est = 0.0;
+    idx jprev = -1;  /* x = e_jprev, or 1/m everywhere while -1 */
+    for (int it = 0; it < 5; it++) {
+        memcpy(y, x, (size_t)m * sizeof(double));
+        lu_solve(m, A, perm, y, 1);
+        double norm = 0.0;
+        for (idx i = 0; i < m; i++) {
+            y[i] *= g[i];
+            norm += fabs(y[i]);
+        }
+        if (it > 0 && norm <= est) break;
+        est = norm;
+        for (idx i = 0; i < m; i++) x[i] = g[i] * (y[i] >= 0 ? 1.0 : -1.0);
+        lu_solve(m, A, perm, x, 0);  /* z = B^T sign(y) */
+        idx j = 0;
+        double zx = 0.0;
+        for (idx i = 0; i < m; i++) {
+            if (fabs(x[i]) > fabs(x[j])) j = i;
+            zx += x[i] / (double)m;
+        }
+        if (jprev >= 0) zx = x[jprev];
+        if (fabs(x[j]) <= zx) break;
+        for (idx i = 0; i < m; i++) x[i] = 0.0;
+        x[j] = 1.0;
+        jprev = j;
+    }
+    /* Higham's alternative vector: guards the estimate against special structure */
+    for (idx i = 0; i < m; i++)
+        x[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + (double)i / (double)(m > 1 ? m - 1 : 1));
+    lu_solve(m, A, perm, x, 1);
+    double alt = 0.0;
+    for (idx i = 0; i < m; i++) alt += fabs(g[i] * x[i]);
+    alt = 2.0 * alt / (3.0 * (double)m);
+    return dmax(est, alt);
+}
+
+/* An upper bound of || |K^-1| b ||_inf for b >= 0 from the LU of `lu` (K = P^T L U): |K^-1| <=
+ * |U^-1| |L^-1| P <= C(U)^-1 C(L)^-1 P elementwise, C(T) the comparison matrix of a triangular
+ * T (|T_ii| on the diagonal, -|T_ij| off it; Higham 2002, Sec. 8.2), applied by two
+ * substitutions in which every term is >= 0 (so rounding changes the bound by a relative
+ * O(m eps) at most). One substitution pair instead of the estimator's five to eleven. x:
+ * scratch of length m. */
+static double skeel_bound(idx m, const double *A, const idx *perm, const double *b, double *x)
+{
+    memcpy(x, b, (size_t)m * sizeof(double));
+    for (idx k = 0; k < m; k++)
+        if (perm[k] != k) {
+            double t = x[k];
+            x[k] = x[perm[k]];
+            x[perm[k]] = t;
+        }
+    for (idx i = 0; i < m; i++)
+        for (idx j = 0; j < i; j++) x[i] += fabs(A[i * m + j]) * x[j];
+    double top = 0.0;
+    for (idx i = m - 1; i >= 0; i--) {
+        for (idx j = i + 1; j < m; j++) x[i] += fabs(A[i * m + j]) * x[j];
+        x[i] /= fabs(A[i * m + i]);
+        top = dmax(top, x[i]);
+    }
+    return top;
+}
+
+/* The bound settles Skeel's test when bound m eps <= SKEEL_MARGIN: Hager's estimate (a lower
+ * bound of the norm, up to its rounding and the factor 4/3 of its alternative vector) is then
+ * far below 1 / (m eps) too, and the test's outcome is the one the estimate would give. */
+#define SKEEL_MARGIN 1e-3
+
+/* r = K y + k, accumulated in long double, rounded to double. */
+static void residual_ld(idx m, const double *K, const double *k, const double *y, double *r)
+{
+    idx i0 = 0;
+    for (; i0 + 4 <= m; i0 += 4) {  /* four rows at once, each summed in its own order */
+        const double *K0 = K + i0 * m, *K1 = K0 + m, *K2 = K1 + m, *K3 = K2 + m;
+        long double s0 = (long double)k[i0], s1 = (long double)k[i0 + 1],
+                    s2 = (long double)k[i0 + 2], s3 = (long double)k[i0 + 3];
+        for (idx j = 0; j < m; j++) {
+            long double yj = (long double)y[j];
+            s0 += (long double)K0[j] * yj;
+            s1 += (long double)K1[j] * yj;
+            s2 += (long double)K2[j] * yj;
+            s3 += (long double)K3[j] * yj;
+        }
+        r[i0] = (double)s0, r[i0 + 1] = (double)s1, r[i0 + 2] = (double)s2,
+        r[i0 + 3] = (double)s3;
+    }
+    for (idx i = i0; i < m; i++) {
+        long double s = (long double)k[i];
+        for (idx j = 0; j < m; j++) s += (long double)K[i * m + j] * (long double)y[j];
+        r[i] = (double)s;
+    }
+}
+
+static int assess_one(idx n, const double *M, const double *q, const double *z,
+                      const int64_t *a, idx m, double *out, double *res)
+{
+    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
+    double mmax = 0.0, qmax = 0.0, norm = 0.0;
+    for (idx i = 0; i < n; i++) qmax = dmax(qmax, fabs(q[i]));
+    for (idx i = 0; i < n; i++)
+        if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
+    /* |M|_max and ||M||_inf in one pass, for the data's scale (lcp/accuracy.py's data_scale):
+     * |q| + ||M||_inf |q| / |M|_max */
+    for (idx i = 0; i < n; i++) {
+        double s = 0.0;
+        for (idx j = 0; j < n; j++) {
+            double v = fabs(M[i * n + j]);
+            s += v;
+            mmax = dmax(mmax, v);
+        }
+        norm = dmax(norm, s);
+    }
+    if (!isfinite(norm)) return 1;
+    double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
+    char *mark = (char *)calloc((size_t)n, 1);
+    if (!mark) return 1;
+    for (idx i = 0; i < m; i++) {
+        if (a[i] < 0 || a[i] >= n || mark[a[i]]) {
+            free(mark);
+            return 1;
+        }
+        mark[a[i]] = 1;
+    }
+    int64_t *sorted = (int64_t *)malloc(((size_t)m + 1) * sizeof(int64_t));
+    if (!sorted) {
+        free(mark);
+        return 1;
+    }
+    for (idx i = 0, k = 0; i < n; i++)
+        if (mark[i]) sorted[k++] = i;
+    a = sorted;  /* the pattern in increasing order, whatever order the basis came in */
+    double berr = -1.0;  /* of z as given: computed only when needed (below) */
+    double ferr = 0.0;
+    int refined = 0;
+    double *buf = (double *)malloc(((size_t)3 * m * m + 6 * (size_t)m + 1) * sizeof(double));
+    idx *perm = (idx *)malloc(((size_t)m + 1) * sizeof(idx));
+    if (!buf || !perm) {
+        free(buf);
+        free(perm);
+        free(mark);
+        free(sorted);
+        return 1;
+    }
+    double *K = buf, *A = K + m * m, *inv = A + m * m, *kp = inv + m * m, *y = kp + m,
+           *r = y + m, *d = r + m, *g = d + m, *rows = g + m;
+    for (idx i = 0; i < m; i++) {
+        kp[i] = q[a[i]];
+        y[i] = z[a[i]];
+        rows[i] = 0.0;
+        for (idx j = 0; j < m; j++) {
+            K[i * m + j] = M[a[i] * n + a[j]];
+            rows[i] += fabs(K[i * m + j]);
+        }
+    }
+    memcpy(A, K, (size_t)m * m * sizeof(double));
+    int code = 0;
+    if (m > 0) {
+        if (lu(m, A, perm) < 0) code = 1;  /* singular: numpy's SVD path */
+        if (!code) {
+            double prev = INFINITY;
+            for (int step = 0; step < STEPS; step++) {
+                residual_ld(m, K, kp, y, r);
+                memcpy(d, r, (size_t)m * sizeof(double));
+                lu_solve(m, A, perm, d, 0);
+                double size = 0.0, ymax = 0.0;
+                for (idx i = 0; i < m; i++) size = dmax(size, fabs(d[i]));
+                if (!isfinite(size) || size >= prev) break;
+                for (idx i = 0; i < m; i++) {
+                    y[i] -= d[i];
+                    ymax = dmax(ymax, fabs(y[i]));
+                }
+                prev = size;
+                if (size <= eps * ymax) break;
+            }
+            residual_ld(m, K, kp, y, r);
+            double ymax = 0.0;
+            for (idx i = 0; i < m; i++) {
+                double s = fabs(kp[i]);
+                for (idx j = 0; j < m; j++) s += fabs(K[i * m + j]) * fabs(y[j]);
+                g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * s;
+                ymax = dmax(ymax, fabs(y[i]));
+            }
+            double bound = abs_inv_norm(m, A, perm, g, d, inv);
+            ferr = bound / dmax(ymax, 1e-300) + eps;
+            /* Skeel's condition || |K^-1| |K| 1 ||: singular to working precision beyond
+             * 1 / (m eps), as the numpy code's test (its SVD path decides then). Its estimate
+             * is needed only when a cheap upper bound does not already settle the test */
+            if (!(skeel_bound(m, A, perm, rows, d) * (double)m * eps <= SKEEL_MARGIN) &&
+                abs_inv_norm(m, A, perm, rows, d, inv) * (double)m * eps > 1.0)
+                code = 1;
+            if (!isfinite(ferr)) ferr = INFINITY;
+        }
+    }
+    if (!code) {
+        for (idx i = 0; i < n; i++) out[i] = 0.0;
+        int finite = 1;
+        for (idx i = 0; i < m; i++) {
+            if (!isfinite(y[i])) finite = 0;
+            out[a[i]] = y[i] > 0.0 ? y[i] : 0.0;
+        }
+        double bp = finite ? backward_error(n, M, q, out, mmax, qmax, floor) : INFINITY;
+        /* kept when its backward error is at rounding level or not larger than z's */
+        if (!(finite && bp <= 8.0 * (double)n * eps))
+            berr = backward_error(n, M, q, z, mmax, qmax, floor);
+        if (finite && (bp <= 8.0 * (double)n * eps || bp <= berr)) {
+            berr = bp;
+            refined = 1;
+        } else {
+            double xs = 0.0, gap = 0.0;
+            for (idx i = 0; i < n; i++) xs = dmax(xs, fabs(z[i]));
+            xs = dmax(xs, 1e-300);
+            for (idx i = 0; i < m; i++) gap = dmax(gap, fabs(z[a[i]] - y[i]));
+            for (idx i = 0; i < n; i++)
+                if (!mark[i]) gap = dmax(gap, fabs(z[i]));
+            ferr = ferr + gap / xs;
+            if (!isfinite(ferr)) ferr = INFINITY;
+            memcpy(out, z, (size_t)n * sizeof(double));
+        }
+    }
+    free(buf);
+    free(perm);
+    free(mark);
+    free(sorted);
+    res[0] = berr;
+    res[1] = ferr;
+    res[2] = refined;
+    return code;
+}
+
+#endif /* RIGIDLCP_ACCURACY_CORE_H */
