@@ -246,7 +246,6 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
     od_prev, P_prev = None, None
     quiet = 0
     rule = Selection.parse(opts.selection)
-    rng = rule.rng()  # "random:SEED": one generator per run
     start = _time.perf_counter()
     for step in range(opts.max_steps):
         V_next = V + system.gamma * h
@@ -269,7 +268,7 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
             points = [sol.z]
             if rule.rule != "none":  # the rule's point first, the solver's if it fails
                 stick = np.arange(sp.n) < c + sp.k
-                y, how = select(problem, sol.z, sp.G, c, stick, rule, rng)
+                y, how = select(problem, sol.z, sp.G, c, stick, rule)
                 if not how.startswith("failed"):
                     points.insert(0, y)
             for z in points:
