@@ -16,9 +16,12 @@ then follow one point, chosen by a *rule*, a parameter of every run (never a hid
   the face (capped as above). The functionals and weights are a function of the face: drawn
   from numpy's default_rng([SEED, fingerprint]), the fingerprint a hash of the face's support
   (which pairs have w = 0 and which z may be positive, i.e. the contact states it fixes;
-  `Selection.face_rng`). The same face gives the same point, so a run whose contact states
-  stop changing can settle (the time-stepper's steady test needs forces unchanged over 20
-  steps); another SEED draws another point of each face.
+  `Selection.face_rng`). The same face gives the same point, so a time-stepper run whose
+  contact states stop changing can settle (its steady test needs forces unchanged over 20
+  steps); another SEED draws another point of each face. The event engine passes its own
+  generator instead, default_rng(SEED), one per run (`Selection.rng`): an event is solved
+  once and a steady event needs no repetition, while the same point on every return to a face
+  can lock a run into a Zeno cycle of events (Fig. 9 under random:1 to random:4).
 * "global" (events only): the least sum R over the whole solution set by a MILP.
 * "none": the solver's own solution: the time-stepper's default.
 
@@ -107,14 +110,21 @@ class Selection:
                                  digest_size=8).digest()
         return np.random.default_rng([int(self.seed or 0), int.from_bytes(digest, "little")])
 
+    def rng(self) -> np.random.Generator | None:
+        """One generator per run (the event engine's "random:SEED"); None for other rules."""
+        return np.random.default_rng(self.seed) if self.rule == "random" else None
+
 
 def select(problem: LCP, z: np.ndarray, G: np.ndarray, c: int, stick_side: np.ndarray,
-           selection: Selection) -> tuple[np.ndarray, str]:
+           selection: Selection, rng: np.random.Generator | None = None
+           ) -> tuple[np.ndarray, str]:
     """The point of `selection` (not "global" / "none") from the accepted solution z of
     `problem`, whose first c unknowns are the normal forces (or impulses) R; G maps z to the
     forces [R; S]; stick_side: the side of degenerate pairs (see lcp.face.face_minimum_norm).
     Returns (point, status): "selected", "capped" (sum R unbounded: the cap was reached),
-    "unique" (the face is a point), or "failed: ..." (then the point is z)."""
+    "unique" (the face is a point), or "failed: ..." (then the point is z). rng: "random"'s
+    generator (the event engine's, one per run); None (the time-stepper): the face's own,
+    `Selection.face_rng` (module doc)."""
     least = np.zeros(problem.n)
     least[:c] = 1.0
     base = face_minimum_norm(problem, z, G, c=least, z_side=stick_side)
@@ -126,7 +136,8 @@ def select(problem: LCP, z: np.ndarray, G: np.ndarray, c: int, stick_side: np.nd
     face = _Face(problem, stick_side, selection.cap * max(float(z0[:c].sum()), 1e-300), c)
     if selection.rule == "max-sum-R":
         return face.walk(z0, -least)
-    return face.random_point(z0, selection.face_rng(face.support(z0)))
+    return face.random_point(z0, rng if rng is not None else
+                             selection.face_rng(face.support(z0)))
 
 
 class _Face:

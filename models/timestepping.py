@@ -268,7 +268,7 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
             points = [sol.z]
             if rule.rule != "none":  # the rule's point first, the solver's if it fails
                 stick = np.arange(sp.n) < c + sp.k
-                y, how = select(problem, sol.z, sp.G, c, stick, rule)
+                y, how = select(problem, sol.z, sp.G, c, stick, rule)  # random: the face's
                 if not how.startswith("failed"):
                     points.insert(0, y)
             for z in points:

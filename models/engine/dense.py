@@ -63,6 +63,7 @@ class DenseBackend:
     _prev: EventSolution | None = field(default=None, repr=False)
     _events: int = field(default=0, repr=False)
     _rule: Selection | None = field(default=None, repr=False)
+    _rng: np.random.Generator | None = field(default=None, repr=False)
     #: events where the rule's face was unbounded in sum R (the cap applied) / where the rule's
     #: point failed the acceptance test (the face-min-norm point was kept)
     capped: int = field(default=0, repr=False)
@@ -70,6 +71,7 @@ class DenseBackend:
 
     def __post_init__(self) -> None:
         self._rule = Selection.parse(self.select)  # InvalidSelection (a ValueError) naming RULES
+        self._rng = self._rule.rng()  # "random:SEED": one generator per run
         for name in (self.method, self.fallback):
             if name is not None:
                 lcp.get_method(name)  # raises InvalidProblem naming the available methods
@@ -136,7 +138,7 @@ class DenseBackend:
         kept only if it passes the acceptance test the solver's point passed."""
         stick_side = np.zeros(ep.lcp.n, bool)
         stick_side[: self.system.c + ep.k] = True
-        y, status = select(ep.lcp, z0, ep.G, self.system.c, stick_side, self._rule)
+        y, status = select(ep.lcp, z0, ep.G, self.system.c, stick_side, self._rule, self._rng)
         if status.startswith("failed"):
             self.rejected += 1
             return z0, r0

@@ -162,9 +162,10 @@ def test_ensemble_and_command(capsys):
 
 
 def test_random_point_is_a_function_of_the_face():
-    """"random:SEED" draws its functionals and weights from SEED and a fingerprint of the face:
-    the same face gives the same point on every call (a per-run generator gave a new one at
-    every call), another seed another point, and the generator depends on the support."""
+    """Without the event engine's per-run generator (the time-stepper's case) "random:SEED"
+    draws its functionals and weights from SEED and a fingerprint of the face: the same face
+    gives the same point on every call (a per-run generator gives a new one at every call),
+    another seed another point, and the generator depends on the support."""
     system = _row()
     ep = models.event_problem(system, models.initial_state(system, seed=1))
     z = lcp.solve(ep.lcp, method="lemke").z
