@@ -13,9 +13,15 @@ then follow one point, chosen by a *rule*, a parameter of every run (never a hid
   sum R <= F times the "face-min-norm" point's sum R (F = 2 unless given) and says so.
 * "random:SEED": a random point of the face of the "face-min-norm" point: a convex combination
   (Dirichlet(1) weights) of that point and the minimizers of 3 random linear functionals over
-  the face (capped as above), drawn from numpy's default_rng(SEED), one generator per run. (In
-  the time-stepper a new point is drawn at every step, so its steady test, which needs forces
-  unchanged over 20 steps, rarely holds: such a run ends at t_max.)
+  the face (capped as above). The functionals and weights are a function of the face: drawn
+  from numpy's default_rng([SEED, fingerprint]), the fingerprint a hash of the face's support
+  (which pairs have w = 0 and which z may be positive, i.e. the contact states it fixes;
+  `Selection.face_rng`). The same face gives the same point, so a time-stepper run whose
+  contact states stop changing can settle (its steady test needs forces unchanged over 20
+  steps); another SEED draws another point of each face. The event engine passes its own
+  generator instead, default_rng(SEED), one per run (`Selection.rng`): an event is solved
+  once and a steady event needs no repetition, while the same point on every return to a face
+  can lock a run into a Zeno cycle of events (Fig. 9 under random:1 to random:4).
 * "global" (events only): the least sum R over the whole solution set by a MILP.
 * "none": the solver's own solution: the time-stepper's default.
 
@@ -27,6 +33,7 @@ residual with their own acceptance test and keep the solver's point if it fails)
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -94,7 +101,17 @@ class Selection:
             return f"max-sum-R:{self.cap:g}"
         return self.rule
 
+    def face_rng(self, support: np.ndarray) -> np.random.Generator:
+        """The generator of "random:SEED" on the face of this support (a boolean vector):
+        default_rng([SEED, fingerprint]), the fingerprint the first 8 bytes of a BLAKE2b hash
+        of the support (stable across runs and processes, unlike Python's hash)."""
+        mask = np.asarray(support, dtype=bool).reshape(-1)
+        digest = hashlib.blake2b(mask.size.to_bytes(8, "little") + np.packbits(mask).tobytes(),
+                                 digest_size=8).digest()
+        return np.random.default_rng([int(self.seed or 0), int.from_bytes(digest, "little")])
+
     def rng(self) -> np.random.Generator | None:
+        """One generator per run (the event engine's "random:SEED"); None for other rules."""
         return np.random.default_rng(self.seed) if self.rule == "random" else None
 
 
@@ -105,7 +122,9 @@ def select(problem: LCP, z: np.ndarray, G: np.ndarray, c: int, stick_side: np.nd
     `problem`, whose first c unknowns are the normal forces (or impulses) R; G maps z to the
     forces [R; S]; stick_side: the side of degenerate pairs (see lcp.face.face_minimum_norm).
     Returns (point, status): "selected", "capped" (sum R unbounded: the cap was reached),
-    "unique" (the face is a point), or "failed: ..." (then the point is z)."""
+    "unique" (the face is a point), or "failed: ..." (then the point is z). rng: "random"'s
+    generator (the event engine's, one per run); None (the time-stepper): the face's own,
+    `Selection.face_rng` (module doc)."""
     least = np.zeros(problem.n)
     least[:c] = 1.0
     base = face_minimum_norm(problem, z, G, c=least, z_side=stick_side)
@@ -117,9 +136,8 @@ def select(problem: LCP, z: np.ndarray, G: np.ndarray, c: int, stick_side: np.nd
     face = _Face(problem, stick_side, selection.cap * max(float(z0[:c].sum()), 1e-300), c)
     if selection.rule == "max-sum-R":
         return face.walk(z0, -least)
-    if rng is None:
-        raise ValueError("selection 'random' needs its generator (Selection.rng())")
-    return face.random_point(z0, rng)
+    return face.random_point(z0, rng if rng is not None else
+                             selection.face_rng(face.support(z0)))
 
 
 class _Face:

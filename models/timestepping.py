@@ -59,6 +59,7 @@ from .event import State, initial_state
 from .lattice import InvalidSystem
 from .observables import dissipation_rate, global_friction
 from .selection import Selection, select
+from .step_lcp import StepProblem, coulomb_residual
 from .system import System
 
 
@@ -118,65 +119,6 @@ def _number(name: str, value) -> float:
         raise InvalidStep(f"{name} must be a number, got {value!r}") from None
 
 
-class StepProblem:
-    """The LCP of a step for given predicted sliding contacts (P_t = -s mu P_n substituted, as
-    Eq. 2.10 at velocity level; checked a posteriori by the Coulomb residual of the whole
-    step) and candidates (the split above). M depends on that choice only; q = the free
-    velocities b."""
-
-    def __init__(self, system: System, dyn: Dynamics, s_fixed: np.ndarray):
-        c, mu = system.c, system.mu
-        self.system, self.dyn = system, dyn
-        fric = mu > 0
-        self.s_fixed = np.where(fric, s_fixed, 0).astype(int)
-        self.cand = np.flatnonzero(fric & (self.s_fixed == 0))
-        k = self.k = self.cand.size
-        n = self.n = c + 2 * k
-        G = np.zeros((2 * c, n))
-        G[np.arange(c), np.arange(c)] = 1.0
-        G[c + np.arange(c), np.arange(c)] = -self.s_fixed * mu  # sliding: P_t = -s mu P_n
-        G[c + self.cand, self.cand] = -mu[self.cand]  # candidates: P_t = tau - mu P_n
-        G[c + self.cand, c + np.arange(k)] = 1.0
-        WG = dyn.W @ G
-        M = np.zeros((n, n))
-        M[:c] = WG[:c]  # u_n
-        M[c:c + k] = WG[c:][self.cand]  # u_t ...
-        M[c:c + k, c + k:] += np.eye(k)  # ... + u_minus = u_plus
-        M[c + k + np.arange(k), self.cand] = 2.0 * mu[self.cand]  # 2 mu P_n - tau
-        M[c + k:, c:c + k] -= np.eye(k)
-        self.G, self.M = G, M
-
-    def lcp(self, b: np.ndarray, t: float) -> lcp.LCP:
-        c, k = self.system.c, self.k
-        q = np.concatenate([b[:c], b[c:][self.cand], np.zeros(k)])
-        return lcp.LCP(self.M, q, name="moreau-jean step", meta={"t": t})
-
-    def warm_active(self, P: np.ndarray, ut: np.ndarray) -> np.ndarray:
-        """Basic variables guessed from the previous step: P_n > 0; tau > 0 unless the
-        contact slid forwards (P_t = -mu P_n); u_minus > 0 when it slid backwards."""
-        c, k = self.system.c, self.k
-        active = list(np.flatnonzero(P[:c] > 0))
-        for pos, alpha in enumerate(self.cand):
-            if ut[alpha] <= 0:
-                active.append(c + pos)
-            if ut[alpha] < 0:
-                active.append(c + k + pos)
-        return np.array(sorted(active), dtype=int)
-
-
-def coulomb_residual(system: System, P: np.ndarray, u: np.ndarray, P_scale: float,
-                     u_scale: float) -> float:
-    """Scaled residual of the velocity-level laws of a step (natural maps, each 0 iff the law
-    holds): Signorini |min(P_n / Ps, u_n / us)| and Coulomb
-    |P_t - proj_[-mu P_n, mu P_n](P_t - u_t Ps / us)| / Ps, maximized over the contacts."""
-    c, mu = system.c, system.mu
-    Pn, Pt, un, ut = P[:c] / P_scale, P[c:] / P_scale, u[:c] / u_scale, u[c:] / u_scale
-    r_n = np.abs(np.minimum(Pn, un))
-    bound = mu * np.maximum(Pn, 0.0)
-    r_t = np.abs(Pt - np.clip(Pt - ut, -bound, bound))
-    return float(max(r_n.max(initial=0.0), r_t.max(initial=0.0)))
-
-
 def moreau_jean(
     system: System,
     state: State | None = None,
@@ -219,126 +161,192 @@ def moreau_jean(
 
 
 def _integrate(system, state, opts, omega, seed, progress) -> Run:
+    """The steps of `moreau_jean` (its docstring): solve (`_step`), record (`_record`), stop."""
     dyn = Dynamics(system)
-    problems: dict[bytes, StepProblem] = {}
-
-    def step_problem(s_fixed: np.ndarray) -> StepProblem:
-        key = s_fixed.astype(np.int8).tobytes()
-        if key not in problems:
-            if len(problems) > 64:
-                problems.clear()
-            problems[key] = StepProblem(system, dyn, s_fixed)
-        return problems[key]
-
     state = (initial_state(system, omega=omega, seed=seed) if state is None else state).copy()
     h, c, p = opts.h, system.c, system.p
     run = Run(system, method=f"moreau-jean h={h:g} theta={opts.theta:g} ({opts.method}"
               + (f", selection {opts.selection})" if opts.selection != "none" else ")"))
-    nu = np.concatenate([np.zeros(2 * p), state.omega])
-    t, V = state.t, state.V
-    f_theta = opts.theta * dyn.f + (1.0 - opts.theta) * dyn.f  # f does not depend on t
-    free_dnu = h * dyn.Minv * f_theta
-    acc_scale = max(system.g, abs(system.gamma), 1e-12) / system.lattice.radius
-    P_floor = h * system.mass * max(system.g, abs(system.gamma), 1e-12)
-    s_prev = np.asarray(state.s, int).copy()
-    ut_prev = dyn.velocities(state.omega, V)[c:]
-    at_prev = np.full(c, np.inf)
-    od_prev, P_prev = None, None
-    quiet = 0
-    rule = Selection.parse(opts.selection)
-    rng = rule.rng()  # "random:SEED": one generator per run
+    k = _Stepper(system, dyn, opts, state)
     start = _time.perf_counter()
     for step in range(opts.max_steps):
-        V_next = V + system.gamma * h
-        b = dyn.H @ (nu + free_dnu) + dyn.u_obs(V_next)
-        u_scale = max(float(np.abs(b).max(initial=0.0)), system.g * h, 1e-300)
-        # Contacts predicted to keep sliding (far from v_t = 0 at their rate): substituted;
-        # the prediction is checked by the residual of the whole step, else every frictional
-        # contact is a candidate.
-        keep = (s_prev != 0) & (np.abs(ut_prev) > 2.0 * h * np.abs(at_prev))
-        attempts = [np.where(keep, s_prev, 0)] if keep.any() else []
-        attempts.append(np.zeros(c, int))
-        for s_fixed in attempts:
-            sp = step_problem(s_fixed)
-            warm = (sp.warm_active(P_prev, ut_prev)
-                    if opts.warm_start and P_prev is not None else None)
-            problem = sp.lcp(b, t + h)
-            sol, used, fell_back = _solve_step(problem, opts, warm)
-            if sol.status != "solved":
-                continue
-            points = [sol.z]
-            if rule.rule != "none":  # the rule's point first, the solver's if it fails
-                stick = np.arange(sp.n) < c + sp.k
-                y, how = select(problem, sol.z, sp.G, c, stick, rule, rng)
-                if not how.startswith("failed"):
-                    points.insert(0, y)
-            for z in points:
-                P = sp.G @ z
-                dnu = dyn.Minv * (dyn.H.T @ P) + free_dnu
-                u = dyn.H @ (nu + dnu) + dyn.u_obs(V_next)
-                P_scale = max(float(np.abs(P).max(initial=0.0)), P_floor)
-                res = coulomb_residual(system, P, u, P_scale, u_scale)
-                if res <= opts.check_tol:
-                    break
-            if res <= opts.check_tol:
-                break
-        if sol.status != "solved":
-            run.status = "no_solution" if sol.status in ("ray", "infeasible") else "solver_failed"
-            run.message = (f"step {step} (t = {t:.6g} -> {t + h:.6g}): {used} ended with status "
-                           f"{sol.status!r} ({sol.message or 'no message'})")
+        got = k.step()
+        failure = _failure(got, opts)
+        if failure:
+            run.status = failure[0]
+            run.message = f"step {step} (t = {k.t:.6g} -> {k.t + h:.6g}): {failure[1]}"
             break
-        if not res <= opts.check_tol:
-            run.status = "solver_failed"
-            run.message = (f"step {step} (t = {t:.6g} -> {t + h:.6g}): Coulomb-law residual "
-                           f"{res:.3g} > check_tol {opts.check_tol:g} ({used})")
-            break
-        nu_next = nu + dnu
-        ut = u[c:]
-        s = np.where(np.abs(ut) <= 1e-9 * u_scale, 0, np.sign(ut)).astype(int)
-        s[system.mu == 0] = 0
-        omega_dot = dnu[2 * p:] / h
-        at = (ut - ut_prev) / h
-        S = P[c:] / h
-        rec = EventRecord(
-            t=t + h, V=V_next, omega=nu_next[2 * p:].copy(), omega_dot=omega_dot,
-            R=P[:c] / h, S=S, s=s, s_in=s_prev.copy(), vt=ut.copy(), at=at,
-            mu_g=global_friction(system, S) / (system.total_mass * system.g or 1.0),
-            dissipation=dissipation_rate(S, ut), iterations=int(sol.iterations),
-            residual=res, n_lcp=sp.n, method=used, fallback=fell_back)
-        opening = np.flatnonzero(u[:c] > 1e-9 * u_scale)
-        changed = not np.array_equal(s, s_prev)
-        settled = (not changed and od_prev is not None
-                   and np.abs(omega_dot - od_prev).max(initial=0.0) <= 1e-9 * acc_scale
-                   and not np.any((s != 0) & (s * (ut - ut_prev) < -1e-12 * u_scale)))
-        quiet = quiet + 1 if settled else 0
+        rec, settled = k.record(got)
+        k.quiet = k.quiet + 1 if settled else 0
+        opening = np.flatnonzero(got.u[:c] > 1e-9 * got.u_scale)
+        changed = not np.array_equal(rec.s, k.s_prev)
         if step == 0:  # the run's records start at its initial state (plots, dissipated
             # energy from t = state.t): the first step's forces, from the initial velocities
-            run.records.append(replace(rec, t=t, V=V, omega=nu[2 * p:].copy(), vt=ut_prev.copy(),
-                                       dissipation=dissipation_rate(S, ut_prev)))
-        t, V, nu, od_prev, s_prev, P_prev = t + h, V_next, nu_next, omega_dot, s, P
-        ut_prev, at_prev = ut, at
-        last = (opening.size or quiet >= opts.steady_steps or t >= opts.t_max
+            run.records.append(replace(rec, t=k.t, V=k.V, omega=k.nu[2 * p:].copy(),
+                                       vt=k.ut_prev.copy(),
+                                       dissipation=dissipation_rate(rec.S, k.ut_prev)))
+        k.advance(got, rec)
+        last = (opening.size or k.quiet >= opts.steady_steps or k.t >= opts.t_max
                 or step + 1 == opts.max_steps)
         if changed or last or (opts.record_every and (step + 1) % opts.record_every == 0):
             run.records.append(rec)
-        if opening.size:
-            run.status, run.contacts = "detachment", opening.tolist()
-            run.message = (f"t = {t:.6g}: contact(s) would open (u_n > 0), the no-displacement "
-                           f"regime ends: {opening[:5].tolist()}")
-            break
-        if quiet >= opts.steady_steps:
-            run.status, run.message = "steady", f"steady state at t = {t:.6g} (step {step + 1})"
-            break
-        if t >= opts.t_max:
-            run.status, run.message = "time_limit", f"t_max = {opts.t_max:g} reached"
+        stop = _stop(k, opening, opts, step)
+        if stop:
+            run.status, run.message = stop
+            if opening.size:
+                run.contacts = opening.tolist()
             break
         if progress is not None:
-            progress(run, t, nu[2 * p:])
+            progress(run, k.t, k.nu[2 * p:])
     else:
         run.status, run.message = "event_limit", f"{opts.max_steps} steps"
-    run.final = State(t, nu[2 * p:].copy(), V, s_prev.copy())
+    run.final = State(k.t, k.nu[2 * p:].copy(), k.V, k.s_prev.copy())
     run.wall_time = _time.perf_counter() - start
     return run
+
+
+@dataclass
+class _Step:
+    """One step's solution: the LCP's answer, who produced it, and the impulses P, velocity
+    change dnu, velocities u after the step and the Coulomb-law residual of the point kept."""
+
+    sol: lcp.Solution
+    used: str
+    fell_back: bool
+    sp: StepProblem | None
+    P: np.ndarray | None
+    dnu: np.ndarray | None
+    u: np.ndarray | None
+    res: float
+    u_scale: float
+
+
+class _Stepper:
+    """The time-stepper's state between steps (velocities, previous states, impulses and
+    tangential velocities, the steady counter) and its step problems (one per substituted
+    sliding set, cached)."""
+
+    def __init__(self, system, dyn: Dynamics, opts: StepOptions, state: State) -> None:
+        self.system, self.dyn, self.opts = system, dyn, opts
+        self.problems: dict[bytes, StepProblem] = {}
+        h, c = opts.h, system.c
+        self.nu = np.concatenate([np.zeros(2 * system.p), state.omega])
+        self.t, self.V = state.t, state.V
+        f_theta = opts.theta * dyn.f + (1.0 - opts.theta) * dyn.f  # f does not depend on t
+        self.free_dnu = h * dyn.Minv * f_theta
+        self.acc_scale = max(system.g, abs(system.gamma), 1e-12) / system.lattice.radius
+        self.P_floor = h * system.mass * max(system.g, abs(system.gamma), 1e-12)
+        self.s_prev = np.asarray(state.s, int).copy()
+        self.ut_prev = dyn.velocities(state.omega, state.V)[c:]
+        self.at_prev = np.full(c, np.inf)
+        self.od_prev: np.ndarray | None = None
+        self.P_prev: np.ndarray | None = None
+        self.quiet = 0
+        self.rule = Selection.parse(opts.selection)
+
+    def step_problem(self, s_fixed: np.ndarray) -> StepProblem:
+        key = s_fixed.astype(np.int8).tobytes()
+        if key not in self.problems:
+            if len(self.problems) > 64:
+                self.problems.clear()
+            self.problems[key] = StepProblem(self.system, self.dyn, s_fixed)
+        return self.problems[key]
+
+    def step(self) -> _Step:
+        """Solve the step from t to t + h: contacts predicted to keep sliding (far from v_t = 0
+        at their rate) substituted first, checked by the residual of the whole step, else every
+        frictional contact a candidate; the selection rule's point first, the solver's if it
+        fails the Coulomb-law check."""
+        system, dyn, opts, c, h = self.system, self.dyn, self.opts, self.system.c, self.opts.h
+        V_next = self.V + system.gamma * h
+        b = dyn.H @ (self.nu + self.free_dnu) + dyn.u_obs(V_next)
+        u_scale = max(float(np.abs(b).max(initial=0.0)), system.g * h, 1e-300)
+        keep = (self.s_prev != 0) & (np.abs(self.ut_prev) > 2.0 * h * np.abs(self.at_prev))
+        attempts = [np.where(keep, self.s_prev, 0)] if keep.any() else []
+        attempts.append(np.zeros(c, int))
+        got = None
+        for s_fixed in attempts:
+            sp = self.step_problem(s_fixed)
+            warm = (sp.warm_active(self.P_prev, self.ut_prev)
+                    if opts.warm_start and self.P_prev is not None else None)
+            problem = sp.lcp(b, self.t + h)
+            sol, used, fell_back = _solve_step(problem, opts, warm)
+            res = got.res if got is not None else np.inf
+            got = _Step(sol, used, fell_back, sp, None, None, None, res, u_scale)
+            if sol.status != "solved":
+                continue
+            points = [sol.z]
+            if self.rule.rule != "none":  # the rule's point first, the solver's if it fails
+                stick = np.arange(sp.n) < c + sp.k
+                y, how = select(problem, sol.z, sp.G, c, stick, self.rule)  # random: the face's
+                if not how.startswith("failed"):
+                    points.insert(0, y)
+            for z in points:
+                got.P = sp.G @ z
+                got.dnu = dyn.Minv * (dyn.H.T @ got.P) + self.free_dnu
+                got.u = dyn.H @ (self.nu + got.dnu) + dyn.u_obs(V_next)
+                P_scale = max(float(np.abs(got.P).max(initial=0.0)), self.P_floor)
+                got.res = coulomb_residual(system, got.P, got.u, P_scale, u_scale)
+                if got.res <= opts.check_tol:
+                    break
+            if got.res <= opts.check_tol:
+                break
+        return got
+
+    def record(self, got: _Step) -> tuple[EventRecord, bool]:
+        """The step's record (t + h, velocities after it, mean forces, states) and whether it
+        is settled (states and omega' unchanged, no sliding contact decelerating)."""
+        system, h, c, p = self.system, self.opts.h, self.system.c, self.system.p
+        nu_next = self.nu + got.dnu
+        ut = got.u[c:]
+        s = np.where(np.abs(ut) <= 1e-9 * got.u_scale, 0, np.sign(ut)).astype(int)
+        s[system.mu == 0] = 0
+        omega_dot = got.dnu[2 * p:] / h
+        at = (ut - self.ut_prev) / h
+        S = got.P[c:] / h
+        rec = EventRecord(
+            t=self.t + h, V=self.V + system.gamma * h, omega=nu_next[2 * p:].copy(),
+            omega_dot=omega_dot, R=got.P[:c] / h, S=S, s=s, s_in=self.s_prev.copy(),
+            vt=ut.copy(), at=at,
+            mu_g=global_friction(system, S) / (system.total_mass * system.g or 1.0),
+            dissipation=dissipation_rate(S, ut), iterations=int(got.sol.iterations),
+            residual=got.res, n_lcp=got.sp.n, method=got.used, fallback=got.fell_back)
+        settled = (np.array_equal(s, self.s_prev) and self.od_prev is not None
+                   and np.abs(omega_dot - self.od_prev).max(initial=0.0)
+                   <= 1e-9 * self.acc_scale
+                   and not np.any((s != 0) & (s * (ut - self.ut_prev) < -1e-12 * got.u_scale)))
+        return rec, bool(settled)
+
+    def advance(self, got: _Step, rec: EventRecord) -> None:
+        """Move to t + h."""
+        self.t, self.V, self.nu = rec.t, rec.V, self.nu + got.dnu
+        self.od_prev, self.s_prev, self.P_prev = rec.omega_dot, rec.s, got.P
+        self.ut_prev, self.at_prev = rec.vt, rec.at
+
+
+def _failure(got: _Step, opts: StepOptions) -> tuple[str, str] | None:
+    """(status, message) of a step no solver solved within check_tol, else None."""
+    sol, used = got.sol, got.used
+    if sol.status != "solved":
+        return (("no_solution" if sol.status in ("ray", "infeasible") else "solver_failed"),
+                f"{used} ended with status {sol.status!r} ({sol.message or 'no message'})")
+    if not got.res <= opts.check_tol:
+        return ("solver_failed", f"Coulomb-law residual {got.res:.3g} > check_tol "
+                f"{opts.check_tol:g} ({used})")
+    return None
+
+
+def _stop(k: _Stepper, opening: np.ndarray, opts: StepOptions, step: int
+          ) -> tuple[str, str] | None:
+    """(status, message) when the run stops after this step, else None."""
+    if opening.size:
+        return ("detachment", f"t = {k.t:.6g}: contact(s) would open (u_n > 0), the "
+                f"no-displacement regime ends: {opening[:5].tolist()}")
+    if k.quiet >= opts.steady_steps:
+        return "steady", f"steady state at t = {k.t:.6g} (step {step + 1})"
+    if k.t >= opts.t_max:
+        return "time_limit", f"t_max = {opts.t_max:g} reached"
+    return None
 
 
 def _solve_step(problem: lcp.LCP, opts: StepOptions, warm: np.ndarray | None):

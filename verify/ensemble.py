@@ -4,7 +4,8 @@ Where an event's (or a step's) solution set has more than one point, the run fol
 of a selection rule (models/selection.py). `selection_ensemble` runs the event engine, and the
 Moreau-Jean time-stepper when a step h is given, once per rule from the same initial angular
 velocities, checks each final state against the exact event laws at its configuration
-(`verify.integrators.event_check`: residual, sliding law, no sliding contact decelerating) and
+(`verify.integrators.event_check`: residual, sliding law, and the steady-state definition of
+verify.steadiness: a_n = 0, non-sliding a_t = 0, no sliding contact decelerating) and
 reports the spread of mu_g over the runs that end in a valid steady state, and how many distinct
 vectors of contact states (T/NT, NS/S+/S-) they reach. A spread of 0 does not prove the steady
 state unique (only these rules were tried); a spread > 0 proves it is not (each end is a checked
@@ -113,7 +114,7 @@ def format_ensemble(ens: Ensemble) -> str:
         modes = row_modes(sysm, rec).text()
         d = "-" if ref is None else str(int(np.sum(r.states != ref)))
         law = (f"{'valid' if r.check.valid else 'INVALID'}"
-               f"{', steady' if r.check.steady else ', decel.'} {r.check.residual:.0e}")
+               f"{', steady' if r.check.steady else ', unsteady'} {r.check.residual:.0e}")
         lines.append(f"{r.rule:<16} {r.integrator:<20} {r.run.status:<11} {rec.t:8.4g} "
                      f"{r.mu_g:11.7f} {modes:>12} {float(np.sum(rec.R)):10.4f} {d:>7} "
                      f"{law:>14} {r.seconds:6.1f}")

@@ -5,8 +5,9 @@ time-stepping (models.timestepping), and each steady state checked against the o
   problem (models.event_problem, Eqs. 2.5-2.10 at acceleration level) at that record's
   configuration and states? The forces are mapped to the event LCP's z = [R, tau, a_minus]
   (tau = mu R + S, a_minus = max(-a_t, 0) for the candidates), the substituted sliding law
-  S = -s mu R is checked, and `verify.certify` measures the residual. Also: is it steady (no
-  sliding contact decelerating, Sec. IV A)?
+  S = -s mu R is checked, and `verify.certify` measures the residual. Also: is it steady
+  (verify.steadiness's definition, docs/mechanics.md: a_n = 0, a non-sliding contact keeps
+  a_t = 0, no sliding contact decelerating, Sec. IV A)?
 * `step_check(system, record, h)`: the converse, for an event-driven record: are its forces
   times h, with u^{k+1} = u^k + h a, a solution of the velocity-level step laws of
   models.timestepping (Signorini and Coulomb on u^{k+1}, natural-map residual)?
@@ -31,6 +32,7 @@ from rigidlcp.models.modes import row_modes
 from rigidlcp.models.timestepping import coulomb_residual, moreau_jean
 
 from .certificates.certify import certify
+from .steadiness import KINEMATICS, steadiness
 
 
 @dataclass
@@ -40,7 +42,7 @@ class LawCheck:
     valid: bool
     residual: float  # scaled residual of the laws (see the function that made it)
     sliding_law: float = 0.0  # max |S + s mu R| over the sliding contacts, / force scale
-    steady: bool | None = None  # no sliding contact decelerating
+    steady: bool | None = None  # verify.steadiness's kinematic conditions hold
     omega_dot_gap: float = 0.0  # |omega' of the forces - the record's omega'|
     note: str = ""
 
@@ -66,11 +68,14 @@ def event_check(system: models.System, record: EventRecord, tol: float = 1e-8) -
     cert = certify(ep, z, tol=tol, uniqueness="none")
     es = ep.unpack(z)
     gap = float(np.abs(es.omega_dot - np.asarray(record.omega_dot)).max(initial=0.0))
-    tol_a = acceleration_tol(system)
-    steady = not np.any(sliding & (s * es.a_t < -tol_a))
+    # steady: the kinematic conditions of verify.steadiness's definition (docs/mechanics.md)
+    # at the record's states, accelerations to 1e-9 of the driving scale (acceleration_tol)
+    st = steadiness(system, R, S, s, es.a_n, es.a_t, f_scale=scale,
+                    a_scale=acceleration_tol(system) / 1e-9, trans=es.trans_acc)
     ok = cert.accepted and slide_gap <= tol
     return LawCheck(valid=bool(ok), residual=cert.scaled_residual, sliding_law=slide_gap,
-                    steady=bool(steady), omega_dot_gap=gap)
+                    steady=st.steady(1e-9, KINEMATICS), omega_dot_gap=gap,
+                    note="" if st.steady(1e-9, KINEMATICS) else st.reason(1e-9, KINEMATICS))
 
 
 def step_check(system: models.System, record: EventRecord, h: float,

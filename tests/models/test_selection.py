@@ -56,7 +56,7 @@ def test_rules_land_on_different_valid_points_of_the_row_self_stress():
     points = {}
     for rule in RULES:
         sel = Selection.parse(rule)
-        y, status = select(ep.lcp, z, ep.G, c, _stick_side(ep), sel, sel.rng())
+        y, status = select(ep.lcp, z, ep.G, c, _stick_side(ep), sel)
         assert not status.startswith("failed"), (rule, status)
         assert certify(ep, y, uniqueness="none").accepted, rule
         points[rule] = y
@@ -93,7 +93,7 @@ def test_every_selected_point_satisfies_the_laws(data, rule):
     if sol.z is None or not certify(ep, sol.z, uniqueness="none").accepted:
         return  # no solution (Painleve) or an inaccurate one: nothing to select from
     sel = Selection.parse(rule)
-    y, status = select(ep.lcp, sol.z, ep.G, system.c, _stick_side(ep), sel, sel.rng())
+    y, status = select(ep.lcp, sol.z, ep.G, system.c, _stick_side(ep), sel)
     if status.startswith("failed"):
         return  # the engine then keeps the solver's (checked) point
     assert certify(ep, y, uniqueness="none").accepted
@@ -121,7 +121,7 @@ def test_every_selected_step_point_satisfies_the_step_laws(system, seed, rule):
         return
     sel = Selection.parse(rule)
     y, status = select(problem, sol.z, sp.G, system.c, np.arange(sp.n) < system.c + sp.k,
-                       sel, sel.rng())
+                       sel)
     if status.startswith("failed"):
         return
     P = sp.G @ y
@@ -159,3 +159,48 @@ def test_ensemble_and_command(capsys):
     with pytest.raises(SystemExit) as exc:  # argparse: one line, exit status 2
         main(["timestep", "--lx", "2", "--ly", "1", "--selection", "best"])
     assert exc.value.code == 2 and "--selection" in capsys.readouterr().err
+
+
+def test_random_point_is_a_function_of_the_face():
+    """Without the event engine's per-run generator (the time-stepper's case) "random:SEED"
+    draws its functionals and weights from SEED and a fingerprint of the face: the same face
+    gives the same point on every call (a per-run generator gives a new one at every call),
+    another seed another point, and the generator depends on the support."""
+    system = _row()
+    ep = models.event_problem(system, models.initial_state(system, seed=1))
+    z = lcp.solve(ep.lcp, method="lemke").z
+    sel = Selection.parse("random:4")
+    a, _ = select(ep.lcp, z, ep.G, system.c, _stick_side(ep), sel)
+    b, _ = select(ep.lcp, z, ep.G, system.c, _stick_side(ep), sel)
+    other, _ = select(ep.lcp, z, ep.G, system.c, _stick_side(ep), Selection.parse("random:5"))
+    assert np.array_equal(a, b) and np.max(np.abs(a - other)) > 1e-6
+    mask = np.zeros(7, bool)
+    mask[[1, 3]] = True
+    draw = sel.face_rng(mask).standard_normal(3)
+    assert np.array_equal(draw, sel.face_rng(mask.copy()).standard_normal(3))
+    mask[4] = True
+    assert not np.array_equal(draw, sel.face_rng(mask).standard_normal(3))
+
+
+def test_time_stepper_random_rules_settle_in_the_ensemble():
+    """issue 21.4: the time-stepper under random:1 and random:2 (a 4x1 row, whose steps' forces
+    are a continuum) reaches steady states, each checked against the exact event laws
+    (valid, steady), and they spread mu_g beyond the event engine's face-min-norm state."""
+    system = models.System(models.rectangular(4, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.02)
+    ens = selection_ensemble(system, seed=1, rules=("face-min-norm",), h=1e-2, t_max=20,
+                             step_rules=("random:1", "random:2"))
+    assert [r.rule for r in ens.rows] == ["face-min-norm", "random:1", "random:2"]
+    for row in ens.rows:
+        assert row.run.status == "steady" and row.valid_steady, (row.rule, row.run.message)
+    lo, hi = ens.mu_g_range
+    assert hi - lo > 1e-3
+
+
+@pytest.mark.slow
+def test_compare_integrators_ensemble_with_a_random_step_rule(capsys):
+    assert main(["compare-integrators", "--lx", "4", "--ly", "1", "--gamma", "0.02",
+                 "--mu-wall", "0", "--ensemble", "face-min-norm", "--step-rules", "random:1",
+                 "--h", "0.01"]) == 0
+    out = capsys.readouterr().out
+    assert "valid steady states: 2 of 2" in out

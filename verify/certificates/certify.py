@@ -37,7 +37,7 @@ from rigidlcp.lcp.acceptance.accuracy import assess_problem
 from rigidlcp.lcp.acceptance.residual import check
 from rigidlcp.lcp.errors import InvalidInput
 
-from .friction import forces_map, friction_certificate
+from .friction import fc_accuracy, forces_map, friction_certificate
 from .stages import OTHER, UNIQUE, certify_stages
 from .uniqueness import Search, milp_search, p_matrix_test, sign_pattern
 
@@ -139,7 +139,7 @@ def certify(
         raise InvalidInput(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
     t0 = time.perf_counter()
     obs: dict[str, np.ndarray] = {}
-    fc_residual = None
+    fc_residual, fc = None, None
     if isinstance(problem, lcp.FrictionContact2D):
         fc_cert = friction_certificate(problem, solution, tol, uniqueness, Certificate)
         if fc_cert is not None:
@@ -188,8 +188,10 @@ def certify(
     )
     # lcp.accuracy's backward error and forward error bound, as lcp.solve reports them: an
     # inflated z or an O(1) forward error is not accepted (issue 23)
-    acc = assess_problem(problem, z, chk.u if isinstance(problem, MLCP) else None,
-                         getattr(solution, "basis", None))
+    # (a friction-contact answer: on the friction-contact conditions, as lcp.solve judges it)
+    acc = (fc_accuracy(fc, r) if fc is not None else
+           assess_problem(problem, z, chk.u if isinstance(problem, MLCP) else None,
+                          getattr(solution, "basis", None)))
     cert.backward_error, cert.forward_error = acc.berr, acc.ferr
     cert.accepted = cert.accepted and acc.accepted
     if fc_residual is not None:

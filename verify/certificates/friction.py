@@ -1,6 +1,8 @@
 """Certificates of 2D friction-contact answers (lcp.FrictionContact2D) for verify.certify:
-the relative natural-map residual (lcp.friction), and the map from the Glocker LCP's z to the
-forces r, so that certify's uniqueness questions are asked of r ("forces")."""
+the acceptance lcp.solve applies to them (the relative natural-map residual, and the backward
+error and forward error bound of lcp.acceptance.friction_accuracy, on the answer as given), and
+the map from the Glocker LCP's z to the forces r, so that certify's uniqueness questions are
+asked of r ("forces")."""
 
 from __future__ import annotations
 
@@ -8,6 +10,7 @@ import numpy as np
 
 from rigidlcp import lcp
 from rigidlcp.lcp import Solution
+from rigidlcp.lcp.acceptance.friction_accuracy import FCAccuracy, assess_fc2d
 
 #: Friction contact: uniqueness is asked on the dense Glocker LCP up to this many contacts.
 FC_UNIQUENESS_MAX_C = 200
@@ -24,10 +27,17 @@ def forces_map(fc: lcp.FrictionContact2D) -> np.ndarray:
     return L
 
 
+def fc_accuracy(fc: lcp.FrictionContact2D, r: np.ndarray) -> FCAccuracy:
+    """lcp.solve's friction-contact errors of the answer r as given (no polishing): an O(1)
+    forward error or an inflated r is not accepted."""
+    return assess_fc2d(fc, r, polish=False)
+
+
 def friction_certificate(fc: lcp.FrictionContact2D, solution, tol: float, uniqueness: str,
                          Certificate):
     """A FrictionContact2D answer r: the relative natural-map residual (lcp.friction) must be
-    <= tol. Returns the certificate when no uniqueness question is asked (uniqueness "none",
+    <= tol, and its backward error and forward error bound (`fc_accuracy`) within lcp.solve's
+    limits. Returns the certificate when no uniqueness question is asked (uniqueness "none",
     or more than FC_UNIQUENESS_MAX_C contacts); else None, and certify goes on with the
     Glocker LCP (z = fc.lcp_from_r(r), the forces r = L z as an observable). Certificate:
     certify's result class (passed in: this module is imported by certify)."""
@@ -36,12 +46,15 @@ def friction_certificate(fc: lcp.FrictionContact2D, solution, tol: float, unique
     if r.size != fc.n:
         raise ValueError(f"the solution has {r.size} entries, the problem {fc.n} unknowns")
     res = lcp.natural_residual(fc, r)
-    note = f"friction contact: relative natural-map residual {res:.3e}"
-    if uniqueness != "none" and fc.c <= FC_UNIQUENESS_MAX_C and res <= tol:
+    acc = fc_accuracy(fc, r)
+    note = (f"friction contact: relative natural-map residual {res:.3e}, backward error "
+            f"{acc.berr:.3g}, forward error bound {acc.ferr:.3g}")
+    ok = bool(res <= tol and acc.accepted)
+    if uniqueness != "none" and fc.c <= FC_UNIQUENESS_MAX_C and ok:
         return None
     u = fc.u(r)
-    cert = Certificate(accepted=bool(res <= tol), tol=tol, residual=res, scaled_residual=res,
-                       notes=[note])
+    cert = Certificate(accepted=ok, tol=tol, residual=res, scaled_residual=res, notes=[note])
+    cert.backward_error, cert.forward_error = acc.berr, acc.ferr
     if uniqueness != "none" and fc.c > FC_UNIQUENESS_MAX_C:
         cert.notes.append(f"{fc.c} contacts > {FC_UNIQUENESS_MAX_C}: uniqueness not assessed")
     cert.degenerate = np.flatnonzero((np.abs(r[0::2]) <= 1e-12 * max(np.abs(r).max(

@@ -30,6 +30,7 @@ from rigidlcp.models.runio import load_run
 from rigidlcp.models.sweep import ResultsFile, _atomic_write_text
 
 from ..forces.polyhedra import event_z
+from ..steadiness import KINEMATICS, steadiness
 from .stages import OTHER, UNIQUE, UNKNOWN, certify_stages
 
 LINES, SUMMARY, FIGURE, OPTIONS = ("certificates.jsonl", "summary.json", "determinacy.png",
@@ -104,31 +105,19 @@ def witness_row(ep, state, z: np.ndarray, y: np.ndarray, residual: float, found_
 
 
 def steady_state(ep, state, es, rtol: float = 1e-8) -> tuple[bool, str]:
-    """Is the event solution `es` at `state` a steady state (docs/verification.md)? Constant
-    contact states and forces from the event on need: every contact closed with a_n = 0; a
-    non-sliding frictional transmitting (R > 0) contact keeps a_t = 0; a sliding contact never
-    decelerates, sgn(v_t) a_t >= 0. Sliding: v_t != 0 at the event (state.s), or starting to
-    slide there (v_t = 0, a_t != 0: es.s, which the event's laws allow only at |S| = mu R).
-    Zero tests: rtol of max(g, |gamma|, max|a|) for accelerations, of max R for forces."""
+    """Is the event solution `es` at `state` a steady state? The definition of
+    verify.steadiness (docs/mechanics.md), its kinematic conditions (the event's laws are
+    certified apart): every contact closed with a_n = 0; a non-sliding frictional contact keeps
+    a_t = 0; a sliding contact never decelerates, sgn(v_t) a_t >= 0. The states are those after
+    the event (es.s): sliding where v_t != 0 at the event (state.s) or starting to slide there
+    (v_t = 0, a_t != 0, which the event's laws allow only at |S| = mu R). Zero tests: rtol of
+    max(g, |gamma|, max|a|) for accelerations, of max R for forces."""
     system = ep.system
-    s_in, s = np.asarray(state.s, dtype=int), np.asarray(es.s, dtype=int)
-    a_tol = rtol * max(system.g, abs(system.gamma), float(np.max(np.abs(es.a_n), initial=0.0)),
-                       float(np.max(np.abs(es.a_t), initial=0.0)))
-    r_tol = rtol * max(float(np.max(es.R, initial=0.0)), 1e-300)
-    why = []
-    opening = np.flatnonzero(np.abs(es.a_n) > a_tol)
-    if opening.size:
-        why.append(f"{opening.size} contacts with a_n != 0 (e.g. {opening[:5].tolist()})")
-    starting = np.flatnonzero((s == 0) & (system.mu > 0) & (es.R > r_tol)
-                              & (np.abs(es.a_t) > a_tol))
-    if starting.size:
-        why.append(f"{starting.size} non-sliding transmitting contacts with a_t != 0 "
-                   f"(e.g. {starting[:5].tolist()})")
-    slowing = np.flatnonzero((s_in != 0) & (s_in * es.a_t < -a_tol))
-    if slowing.size:
-        why.append(f"{slowing.size} sliding contacts decelerate (e.g. {slowing[:5].tolist()})")
-    return (not why), ("; ".join(why) or "steady: a_n = 0, non-sliding a_t = 0, no sliding "
-                       "contact decelerating")
+    a_scale = max(system.g, abs(system.gamma), float(np.max(np.abs(es.a_n), initial=0.0)),
+                  float(np.max(np.abs(es.a_t), initial=0.0)))
+    st = steadiness(system, es.R, es.S, es.s, es.a_n, es.a_t, a_scale=a_scale,
+                    f_scale=max(float(np.max(es.R, initial=0.0)), 1e-300))
+    return st.steady(rtol, KINEMATICS), st.reason(rtol, KINEMATICS)
 
 
 class _EventTask:

@@ -13,7 +13,9 @@ Three tools, from cheapest to most general:
   that the symmetric part (M + M^T)/2 be positive definite (necessary too when M is symmetric).
 * ``lcp.enumerate_solutions`` (used by verify.certify): every complementary basis, small n.
 * ``milp_search``: a mixed-integer program (scipy.optimize.milp, i.e. HiGHS) for a solution other
-  than a given z*, with binary variables y for the complementarity and big-M bounds.
+  than a given z*, with binary variables y for the complementarity and big-M bounds; each basis
+  it proposes is polished into an exact solution by LP (verify/certificates/polish.py; HiGHS's
+  options and quiet context: verify/certificates/highs.py).
 
 Scales (lcp.residual, shared with lcp.solve and verify.certify): z_s = max(|z*|_inf, |q|_inf /
 |M|_max) is the size of a solution and w_s = |q|_inf + ||M||_inf z_s bounds the size of the
@@ -23,40 +25,24 @@ Every margin below is relative to these scales.
 
 from __future__ import annotations
 
-import contextlib
 import time
-import warnings
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import Bounds, LinearConstraint, linprog, milp
+from scipy.optimize import Bounds, LinearConstraint, milp
 
 from rigidlcp.lcp.acceptance.residual import scaled_residual, scales
-from rigidlcp.lcp.quiet import quiet_stdout
 
+from .highs import HIGHS_MILP, quiet_highs
 from .pmatrix import P_MINORS_MAX_N, RCOND, PMatrixTest, p_matrix_test
+from .polish import polish_basis
 
 __all__ = ["P_MINORS_MAX_N", "RCOND", "PMatrixTest", "Search", "milp_search", "p_matrix_test",
            "quiet_highs", "scaled_residual", "scales", "sign_pattern"]
 
 #: Default box for the MILP: 0 <= z <= BOUND_FACTOR * z_s.
 BOUND_FACTOR = 1e3
-#: HiGHS tolerances for the MILP and the polishing LP (its defaults are 1e-6 / 1e-7). Options
-#: other than scipy's own five are passed to HiGHS verbatim (scipy warns; the warning is muted).
-_HIGHS_MILP = {"mip_feasibility_tolerance": 1e-9, "primal_feasibility_tolerance": 1e-9}
-_HIGHS_LP = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
-
-
-@contextlib.contextmanager
-def quiet_highs() -> Iterator[None]:
-    """Silence HiGHS's C++ debug prints (e.g. "HighsMipSolverData::transformNewInteger...") that
-    go to file descriptor 1 whatever log_to_console says (lcp.quiet.quiet_stdout), and scipy's
-    warning about passing HiGHS options verbatim."""
-    with warnings.catch_warnings(), quiet_stdout():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        yield
 
 
 # --------------------------------------------------------------------------------------------
@@ -157,7 +143,7 @@ def milp_search(
     U = float(bound) if bound is not None else BOUND_FACTOR * zs
     # HiGHS accepts y within 1e-9 of an integer, so z_i <= 1e-9 U "vanishes": a margin below
     # ~100 times this leakage would let rounding pass for a difference. Raise delta to it.
-    floor = 100.0 * _HIGHS_MILP["mip_feasibility_tolerance"] * U / zs
+    floor = 100.0 * HIGHS_MILP["mip_feasibility_tolerance"] * U / zs
     delta = max(float(delta), floor)
     res = Search("unknown", target, bound=U, delta=delta)
     model = _MilpModel(M, q, z_star, U, delta, zs, ws)
@@ -275,8 +261,9 @@ class _MilpModel:
 
 def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit: float,
                       retries: int, t0: float) -> None:
-    """Ask HiGHS; polish its basis into an exact solution (`_polish`) or cut the basis off and
-    ask again (at most `retries` times); fill `res` (see milp_search's docstring)."""
+    """Ask HiGHS; polish its basis into an exact solution (`polish_basis`, in polish.py) or
+    cut the basis off and ask again (at most `retries` times); fill `res` (see milp_search's
+    docstring)."""
     n, N = model.n, model.N
     c = np.zeros(N)
     if objective == "min-sum":
@@ -310,8 +297,9 @@ def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit
             break
         y = out.x[n:2 * n] > 0.5
         chosen = out.x[2 * n:] > 0.5
-        other, proved = _polish(model.M, model.q, model.z_star, y, res.target, chosen, model.L,
-                                model.delta, model.zs, model.ws, model.pat, model.extra)
+        other, proved = polish_basis(model.M, model.q, model.z_star, y, res.target, chosen,
+                                     model.L, model.delta, model.zs, model.ws, model.pat,
+                                     model.extra)
         if other is not None:
             res.status, res.other = "found", other
             res.deviation = model.deviation(other)
@@ -346,7 +334,7 @@ def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, opt
         left = seconds - (time.perf_counter() - t0)
         if runs and left <= 0:
             break
-        opts = dict(_HIGHS_MILP if options is None else options)
+        opts = dict(HIGHS_MILP if options is None else options)
         if not tight:
             opts.update(presolve=False, mip_feasibility_tolerance=1e-8)
         with quiet_highs():
@@ -357,59 +345,3 @@ def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, opt
         if out.status != 2:
             break
     return out, runs
-
-
-def _polish(M, q, z_star, y, target, chosen, L, delta, zs, ws, pat, extra
-            ) -> tuple[np.ndarray | None, bool]:
-    """(z, proved): an exact solution z on the MILP's basis y with the target's difference (an
-    LP per way of differing, the MILP's chosen ones first), or None; `proved` is True when every
-    one of those LPs was proved infeasible, i.e. the basis holds no such solution and cutting it
-    off loses nothing. (The MILP's binaries may pick a disjunct that rounding made look
-    satisfied while the basis holds a solution that differs elsewhere: all are tried.)"""
-    n = q.size
-    a, b = np.flatnonzero(y), np.flatnonzero(~y)
-    bounds = [(0.0, None) if y[i] else (0.0, 0.0) for i in range(n)]
-    order = np.r_[np.flatnonzero(chosen), np.flatnonzero(~chosen)]
-    ways: list[tuple[np.ndarray, float] | None] = []
-    check = None
-    if target == "pattern":
-        plus, minus = np.flatnonzero(pat == 1), np.flatnonzero(pat == -1)
-        deg = np.flatnonzero(pat == 0)
-        if np.any(~y[plus]) or np.any(y[minus]):
-            ways = [None]  # the basis itself differs from z*'s pattern
-        for k in order if not ways else []:
-            i = deg[k]
-            if y[i]:
-                row = np.zeros(n)
-                row[i] = -1.0 / zs  # z_i >= delta zs
-                ways.append((row, -delta * (1 - 1e-3)))
-            else:
-                ways.append((-M[i] / ws, q[i] / ws - delta * (1 - 1e-3)))  # w_i >= delta ws
-    else:
-        v_star = L @ z_star
-        sL = max(float(np.max(np.sum(np.abs(L), axis=1))) * zs, float(np.max(np.abs(v_star))),
-                 1e-300)
-        for k in order:
-            j, sgn = extra[k]
-            ways.append((-sgn * L[j] / sL, -sgn * v_star[j] / sL - delta * (1 - 1e-3)))
-
-        def check(z):
-            return float(np.max(np.abs(L @ (z - z_star)))) >= delta * sL * (1 - 1e-2)
-    proved = True
-    for way in ways:
-        A_ub, b_ub = [-M[b]], [q[b]]
-        if way is not None:
-            A_ub.append(way[0][None, :])
-            b_ub.append(np.array([way[1]]))
-        res = linprog(np.ones(n), A_ub=np.vstack(A_ub), b_ub=np.concatenate(b_ub),
-                      A_eq=M[a] if a.size else None, b_eq=-q[a] if a.size else None,
-                      bounds=bounds, method="highs", options=_HIGHS_LP)
-        if res.status == 2:
-            continue
-        proved = False
-        if res.status != 0 or res.x is None:
-            continue
-        z = np.maximum(res.x, 0.0)
-        if scaled_residual(M, q, z) <= 1e-8 and (check is None or check(z)):
-            return z, False
-    return None, proved

@@ -22,6 +22,8 @@ from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.observables import global_friction_coefficient
 from rigidlcp.models.system import System
 
+from ..steadiness import from_velocities
+
 
 @dataclass
 class SteadyWitness:
@@ -56,32 +58,11 @@ class SteadyWitness:
 def steady_check(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,
                  v_scale: float = 0.0) -> tuple[float, np.ndarray]:
     """(residual, s): the largest relative violation of the steady-state laws (module
-    docstring) by (omega, V, R, S), and the states read off sgn(v_t) (0 where |v_t| <= 1e-9
-    max(max|v_t|, v_scale); v_scale: the velocity scale of a run, whose rounding noise
-    (1e-16) is not a velocity)."""
-    dyn = dyn or Dynamics(system)
-    c, p, mu = system.c, system.p, system.mu
-    omega = np.asarray(omega, dtype=float)
-    R, S = np.asarray(R, dtype=float), np.asarray(S, dtype=float)
-    lam = np.concatenate([R, S])
-    fs = system.mass * max(system.g, abs(system.gamma), 1e-12)
-    fscale = max(float(np.max(np.abs(lam), initial=0.0)), fs)
-    ascale = max(system.g, abs(system.gamma), 1e-12) * fscale / fs
-    nu_dot = dyn.accelerations(lam)
-    a = dyn.H @ nu_dot + dyn.u_obs_dot
-    v = dyn.velocities(omega, V)
-    vt = v[c:]
-    vscale = max(float(np.max(np.abs(vt), initial=0.0)), v_scale, 1e-300)
-    s = np.where(np.abs(vt) <= 1e-9 * vscale, 0, np.sign(vt)).astype(int)
-    s[mu == 0] = 0
-    at = a[c:]
-    viol = [np.abs(a[:c]) / ascale, np.abs(nu_dot[:2 * p]) / ascale,
-            np.maximum(-R, 0) / fscale, np.maximum(np.abs(S) - mu * R, 0) / fscale,
-            np.where(mu == 0, np.abs(S), 0) / fscale,
-            np.where(s != 0, np.abs(S + s * mu * R), 0) / fscale,
-            np.where(s != 0, np.maximum(-s * at, 0), 0) / ascale,
-            np.where((s == 0) & (mu > 0), np.abs(at), 0) / ascale]
-    return float(max(np.max(x, initial=0.0) for x in viol)), s
+    docstring; the definition is verify.steadiness's) by (omega, V, R, S), and the states read
+    off sgn(v_t) (0 where |v_t| <= 1e-9 max(max|v_t|, v_scale); v_scale: the velocity scale of
+    a run, whose rounding noise (1e-16) is not a velocity)."""
+    st = from_velocities(system, omega, V, R, S, dyn, v_scale)
+    return st.residual, st.s
 
 
 def make_witness(system: System, omega, V: float, R, S, dyn: Dynamics | None = None,

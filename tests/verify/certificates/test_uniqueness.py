@@ -200,7 +200,7 @@ def test_milp_answers_unknown_when_a_cut_was_not_proved(monkeypatch):
     solution: a MILP made infeasible by such cuts must not answer "none"."""
     import rigidlcp.verify.certificates.uniqueness as uq
 
-    monkeypatch.setattr(uq, "_polish", lambda *a, **k: (None, False))
+    monkeypatch.setattr(uq, "polish_basis", lambda *a, **k: (None, False))
     z = np.array([2.0, 0.0, 1.0])
     res = uq.milp_search(ISSUE_M, ISSUE_Q, z, "values", ISSUE_M, retries=10)
     assert res.status == "unknown", res.message
