@@ -229,7 +229,7 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
     at_lo, at_hi = np.zeros(c), np.zeros(c)
     m_star = rotation_cap(system, dyn)
     if m_star is not None:  # the maximum principle: no LP needed for r alpha and a_t
-        ra_hi = np.full(p, _pad(m_star))
+        ra_hi = np.full(p, m_star * (1 + 1e-9) + 1e-15)  # exact up to rounding
         ra_lo = -ra_hi
         for a in np.flatnonzero(mu > 0):
             Tp, Tm = np.maximum(Tu[a], 0.0), np.minimum(Tu[a], 0.0)

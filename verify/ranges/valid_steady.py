@@ -13,12 +13,11 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
+from .milp import MilpModel
 from .observables import check_observable, steady_observables
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
 from .steady import (
@@ -34,8 +33,8 @@ from .witness import make_witness, steady_check
 
 #: A witness is accepted when its independent residual is at most this.
 WITNESS_TOL = 1e-8
-#: Contact-state sets kept as seeds (verify.ranges.valid_steady._Model.add_seed).
-MAX_SEEDS = 6
+#: A witness attains a certified bound when within this (relative to max(1, |bound|)).
+ATTAIN_TOL = 1e-9
 
 
 @dataclass
@@ -110,7 +109,7 @@ class SteadyRanges:
                              f"{o.width:>11.4g}")
         for name, r in self.ranges.items():
             for e in (r.lo, r.hi):
-                if e.note:
+                if e.note and not e.note.startswith("proved by"):
                     lines.append(f"note ({name}): {e.note}")
         return "\n".join(lines)
 
@@ -163,7 +162,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
     unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
-    model = _Model(form)
+    model = MilpModel(form)
     if start is not None:
         model.starts.append(form.start(*start))
         model.add_seed(start[4])
@@ -203,77 +202,28 @@ def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     return end
 
 
-class _Model:
-    """The MILP of a Formulation in one HiGHS instance, re-solved with new costs."""
-
-    def __init__(self, form: Formulation):
-        import highspy
-
-        A = sp.csc_matrix(form.A)
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-        lp.col_cost_ = np.zeros(A.shape[1])
-        lp.col_lower_, lp.col_upper_ = form.lb, form.ub
-        lp.row_lower_, lp.row_upper_ = form.lo, form.hi
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
-            A.indptr, A.indices, A.data)
-        lp.integrality_ = [highspy.HighsVarType.kInteger if v else
-                           highspy.HighsVarType.kContinuous for v in form.integrality]
-        with quiet_highs():
-            h = highspy.Highs()
-        for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
-                           ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
-                           ("primal_feasibility_tolerance", 1e-9)):
-            h.setOptionValue(key, value)
-        h.passModel(lp)
-        self.h, self.hs, self.n = h, highspy, A.shape[1]
-        self.starts: list[np.ndarray] = []
-        self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
-
-    def add_seed(self, s: np.ndarray) -> None:
-        """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
-        s = np.asarray(s, dtype=int)
-        self.seeds = [t for t in self.seeds if not np.array_equal(t, s)] + [s]
-        del self.seeds[:-MAX_SEEDS]
-
-    def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
-              ) -> tuple[str, np.ndarray | None]:
-        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
-        extra: MIP starts for this objective only."""
-        h, hs = self.h, self.hs
-        h.clearSolver()
-        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
-        h.setOptionValue("time_limit", float(time_limit))
-        starts = [*self.starts, *extra]
-        # the best valid state as the MIP start (a later setSolution replaces an earlier one)
-        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
-            sol = hs.HighsSolution()
-            sol.col_value = list(x)
-            sol.value_valid = True
-            h.setSolution(sol)
-        with quiet_highs():
-            h.run()
-        st = h.getModelStatus()
-        has_x = h.getInfo().primal_solution_status == 2
-        x = np.asarray(h.getSolution().col_value) if has_x else None
-        if st == hs.HighsModelStatus.kOptimal:
-            return OPTIMAL, x
-        if st == hs.HighsModelStatus.kInfeasible:
-            return INFEASIBLE, None
-        if st == hs.HighsModelStatus.kTimeLimit:
-            return TIME_LIMIT, x
-        return "failed", x
-
-
-def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit: float
+def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_limit: float
          ) -> End:
     """min (sense +1) or max (sense -1) of L . x over the valid steady states."""
     t0 = time.perf_counter()
     c, p = form.system.c, form.system.p
     cost = np.zeros(model.n)
     cost[:2 * c] = sense * L
-    mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
+    # A checked valid steady state that attains the relaxation's certified bound is an
+    # extreme: no branching (verify.ranges.milp). First the states met so far, then the seeds.
+    bound = model.relaxation_bound(cost)
+    tol = ATTAIN_TOL * max(1.0, abs(bound)) if np.isfinite(bound) else 0.0
+    xm, mstat, how = None, None, ""
+    for pool in (lambda: model.starts, lambda: _seed_starts(form, model, L, sense)):
+        cands = pool()
+        best = min(cands, key=lambda x: float(cost @ x), default=None)
+        if best is not None and float(cost @ best) <= bound + tol:
+            xm, mstat = best, OPTIMAL
+            how = (f"proved by the relaxation's certified bound {sense * bound:.12g} "
+                   "(no branching)")
+            break
+    if xm is None:
+        mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
     if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
@@ -290,7 +240,7 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
         x = xm[:2 * c]
     wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
-              seconds=time.perf_counter() - t0)
+              seconds=time.perf_counter() - t0, note=how)
     if wit.residual > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
@@ -328,7 +278,7 @@ def seed_states(form: Formulation) -> list[np.ndarray]:
     return out
 
 
-def _seed_starts(form: Formulation, model: _Model, L: np.ndarray, sense: int
+def _seed_starts(form: Formulation, model: MilpModel, L: np.ndarray, sense: int
                  ) -> list[np.ndarray]:
     """MIP starts for one end: the extreme of L over each seed state set (a linear program),
     where it is finite and its witness passes steady_check."""
