@@ -3,7 +3,8 @@ verify.ranges.steady (docs/mechanics.md, "Valid steady states and their ranges",
 bounds").
 
 Every valid steady state lies in the relaxation P = {x = [R; S]: a_n = 0, no translation,
-R >= 0, |S| <= mu R, S = 0 where mu = 0}. Linear programs over P give
+R >= 0, |S| <= mu R, S = 0 where mu = 0, |r alpha| <= M* where the rotation cap M* is
+proved}. Linear programs over P give
 
 * |S_a| <= S_abs[a] and the bounds of r alpha (linear in S): valid for *every* steady state;
 * R_a <= R_hi[a] for the contacts whose R is bounded over P.
@@ -68,7 +69,10 @@ class _P:
     """The relaxation P in one HiGHS instance; `extreme(L)` = (min, max) of L x over P (+-inf
     where unbounded), or None if P is empty or an LP fails."""
 
-    def __init__(self, system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray):
+    def __init__(self, system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray,
+                 ra_rows: np.ndarray | None = None, ra_cap: float = np.inf):
+        """ra_rows, ra_cap: also |ra_rows @ x| <= ra_cap (the rotation cap, valid on every
+        valid steady state: P then stays a relaxation of them)."""
         import highspy
 
         c, mu = system.c, system.mu
@@ -81,13 +85,17 @@ class _P:
                           sp.csr_matrix((np.r_[mu[fr], -np.ones(F)],
                                          (np.r_[np.arange(F), np.arange(F)], np.r_[fr, c + fr])),
                                         shape=(F, 2 * c))]).tocsc()
+        row_lo, row_hi = np.r_[e, np.zeros(2 * F)], np.r_[e, np.full(2 * F, np.inf)]
+        if ra_rows is not None and np.isfinite(ra_cap):
+            rows = sp.vstack([rows, sp.csr_matrix(ra_rows)]).tocsc()
+            row_lo = np.r_[row_lo, np.full(ra_rows.shape[0], -ra_cap)]
+            row_hi = np.r_[row_hi, np.full(ra_rows.shape[0], ra_cap)]
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = 2 * c, rows.shape[0]
         lp.col_cost_ = np.zeros(2 * c)
         lp.col_lower_ = np.r_[np.zeros(c), np.where(mu > 0, -np.inf, 0.0)]
         lp.col_upper_ = np.r_[np.full(c, np.inf), np.where(mu > 0, np.inf, 0.0)]
-        lp.row_lower_ = np.r_[e, np.zeros(2 * F)]
-        lp.row_upper_ = np.r_[e, np.full(2 * F, np.inf)]
+        lp.row_lower_, lp.row_upper_ = row_lo, row_hi
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
             rows.indptr, rows.indices, rows.data)
@@ -208,7 +216,10 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
     d_a unbounded). E x = e: a_n = 0 and no translation (verify.ranges.steady)."""
     c, p, mu = system.c, system.p, system.mu
     r = system.lattice.radius
-    P = _P(system, dyn, E, e)
+    HT = dyn.H.T.toarray()
+    Lra = (r * dyn.Minv[2 * p:])[:, None] * HT[2 * p:]
+    m_star = rotation_cap(system, dyn)
+    P = _P(system, dyn, E, e, Lra, np.inf if m_star is None else m_star * (1 + 1e-9) + 1e-15)
     S_abs, R_hi = np.zeros(c), np.full(c, np.inf)
     I2 = np.eye(2 * c)
     for a in range(c):
@@ -222,12 +233,9 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
             if ext is None or not np.all(np.isfinite(ext)):
                 return None
             S_abs[a] = _pad(max(abs(ext[0]), abs(ext[1])))
-    HT = dyn.H.T.toarray()
-    Lra = (r * dyn.Minv[2 * p:])[:, None] * HT[2 * p:]
     Tu = dyn.H[c:].toarray()[:, 2 * p:] / r
     gam = dyn.u_obs(1.0)[c:] * system.gamma
     at_lo, at_hi = np.zeros(c), np.zeros(c)
-    m_star = rotation_cap(system, dyn)
     if m_star is not None:  # the maximum principle: no LP needed for r alpha and a_t
         ra_hi = np.full(p, m_star * (1 + 1e-9) + 1e-15)  # exact up to rounding
         ra_lo = -ra_hi
