@@ -18,13 +18,16 @@ of optimality, and lowered by a rounding margin.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import scipy.sparse as sp
 
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
+from .kinematics import realizable
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
-from .steady import Formulation
+from .steady import Formulation, states_of
 
 #: Contact-state sets kept as seeds (MilpModel.add_seed).
 MAX_SEEDS = 6
@@ -48,21 +51,37 @@ def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.nda
 
 
 class MilpModel:
-    """The MILP of a Formulation in one HiGHS instance, and its relaxation in another."""
+    """The MILP of a Formulation in one HiGHS instance, and its relaxation in another.
 
-    def __init__(self, form: Formulation):
+    kinematics "lazy" (default): the MILP drops the velocities' big-M rows (a relaxation) and
+    each optimum's contact states are checked by verify.ranges.kinematics; a set the
+    velocities do not admit is cut off (the states of its negative cycle cannot all hold) and
+    the MILP solved again, until the optimum's states are admitted: then it is the optimum
+    over every valid steady state. "big-M": the velocity rows stay (module steady)."""
+
+    def __init__(self, form: Formulation, kinematics: str = "lazy"):
         import highspy
 
+        if kinematics not in ("lazy", "big-M"):
+            raise ValueError(f"kinematics must be 'lazy' or 'big-M', got {kinematics!r}")
         A = sp.csc_matrix(form.A)
-        self.A, self.form = sp.csr_matrix(form.A), form
+        self.A, self.form, self.lazy = sp.csr_matrix(form.A), form, kinematics == "lazy"
         self.hs, self.n = highspy, A.shape[1]
+        self.cuts = 0
+        F = form.fric.size
+        self.base = 2 * form.system.c + 2 * form.system.p + 1  # y+ at base + k, y- base + F + k
+        self.fpos = {int(a): k for k, a in enumerate(form.fric)}
+        self.F = F
 
         def model(integer: bool):
             lp = highspy.HighsLp()
             lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
             lp.col_cost_ = np.zeros(A.shape[1])
             lp.col_lower_, lp.col_upper_ = form.lb, form.ub
-            lp.row_lower_, lp.row_upper_ = form.lo, form.hi
+            lo = np.array(form.lo, float)
+            if integer and self.lazy:
+                lo[form.v_rows[0]:form.v_rows[1]] = -np.inf
+            lp.row_lower_, lp.row_upper_ = lo, form.hi
             lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
             lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
                 A.indptr, A.indices, A.data)
@@ -107,10 +126,48 @@ class MilpModel:
         return max(lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, y),
                    lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, -y))
 
+    def cut(self, s: np.ndarray, contacts: list[int]) -> None:
+        """Forbid the states s on `contacts` together: sum of their indicators <= |C| - 1
+        (indicator of +1: y+, of -1: y-, of 0: 1 - y+ - y-)."""
+        idx, val, rhs = [], [], len(contacts) - 1.0
+        for a in contacts:
+            k = self.fpos[int(a)]
+            if s[a] > 0:
+                idx, val = idx + [self.base + k], val + [1.0]
+            elif s[a] < 0:
+                idx, val = idx + [self.base + self.F + k], val + [1.0]
+            else:
+                idx, val = idx + [self.base + k, self.base + self.F + k], val + [-1.0, -1.0]
+                rhs -= 1.0
+        self.h.addRow(-np.inf, rhs, len(idx), np.array(idx, dtype=np.int32),
+                      np.array(val, float))
+        self.cuts += 1
+
     def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
               ) -> tuple[str, np.ndarray | None]:
         """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
-        extra: MIP starts for this objective only."""
+        extra: MIP starts for this objective only. Lazy: the point's contact states are
+        admitted by the velocities (else it is None)."""
+        if not self.lazy:
+            return self._solve(cost, time_limit, extra)
+        t0 = time.perf_counter()
+        while True:
+            left = time_limit - (time.perf_counter() - t0)
+            if left <= 0:
+                return TIME_LIMIT, None
+            st, x = self._solve(cost, left, extra)
+            if x is None:
+                return st, None
+            s = states_of(self.form, x)
+            ok, info = realizable(self.form, s)
+            if ok:
+                return st, x
+            self.cut(s, info)
+            if st != OPTIMAL:
+                return st, None
+
+    def _solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
+               ) -> tuple[str, np.ndarray | None]:
         h, hs = self.h, self.hs
         h.clearSolver()
         h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)

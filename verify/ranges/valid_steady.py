@@ -17,6 +17,7 @@ import numpy as np
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 
+from .kinematics import realizable
 from .milp import MilpModel
 from .observables import check_observable, steady_observables
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
@@ -136,13 +137,14 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None) -> SteadyRanges:
+                  V_mode: str | None = None, kinematics: str = "lazy") -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
     also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
-    box: the force box when no bound is proved. Raises NotSteady when no valid steady state
-    exists or the run is not steady."""
+    box: the force box when no bound is proved. kinematics: "lazy" (velocities checked on
+    each optimum, verify.ranges.milp) or "big-M" (in the MILP). Raises NotSteady when no
+    valid steady state exists or the run is not steady."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -162,7 +164,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
     unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
-    model = MilpModel(form)
+    model = MilpModel(form, kinematics)
     if start is not None:
         model.starts.append(form.start(*start))
         model.add_seed(start[4])
@@ -214,8 +216,12 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     bound = model.relaxation_bound(cost)
     tol = ATTAIN_TOL * max(1.0, abs(bound)) if np.isfinite(bound) else 0.0
     xm, mstat, how = None, None, ""
-    for pool in (lambda: model.starts, lambda: _seed_starts(form, model, L, sense)):
+    seeds: list[np.ndarray] = []
+    for k, pool in enumerate((lambda: model.starts,
+                              lambda: _seed_starts(form, model, L, sense))):
         cands = pool()
+        if k:
+            seeds = cands
         best = min(cands, key=lambda x: float(cost @ x), default=None)
         if best is not None and float(cost @ best) <= bound + tol:
             xm, mstat = best, OPTIMAL
@@ -223,7 +229,9 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
                    "(no branching)")
             break
     if xm is None:
-        mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
+        mstat, xm = model.solve(cost, time_limit, seeds)
+        if xm is None and mstat == TIME_LIMIT:  # the best checked state met, not a bound
+            xm = min([*model.starts, *seeds], key=lambda x: float(cost @ x), default=None)
     if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
@@ -233,9 +241,11 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     s = states_of(form, xm)
     status, x, ray = state_extreme(form, s, L, sense)
     vel = state_velocities(form, s)
-    if vel is None:  # the LP disagrees with the MILP's kinematics: keep the MILP's velocities
+    if vel is None:  # the LP disagrees: the shortest-path velocities, else the MILP's
         r = form.system.lattice.radius
-        vel = (xm[2 * c + p:2 * c + 2 * p] / r, float(xm[2 * c + 2 * p]))
+        ok, xv = realizable(form, s)
+        xv = xv if ok else xm[2 * c + p:2 * c + 2 * p + 1]
+        vel = (np.asarray(xv[:p]) / r, float(xv[p]))
     if x is None:
         x = xm[:2 * c]
     wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
