@@ -175,6 +175,16 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         hi = _end(form, model, L, -1, time_limit)
         scope = "all valid steady states" if form.proved_for(L) else unproved
         ranges[name] = Range(name, lo, hi, scope)
+    # The ends left at their time limit, again against the states met since (a later end's
+    # witness may attain an earlier end's certified bound): no new search.
+    for name, L in obs.items():
+        for side, sense in (("lo", +1), ("hi", -1)):
+            old = getattr(ranges[name], side)
+            if old.status == TIME_LIMIT:
+                new = _end(form, model, L, sense, 0.0, seeds=False)
+                if new.status == OPTIMAL:
+                    new.seconds += old.seconds
+                    setattr(ranges[name], side, new)
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
             ranges[name].selected = run_values[name]
@@ -204,9 +214,10 @@ def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     return end
 
 
-def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_limit: float
-         ) -> End:
-    """min (sense +1) or max (sense -1) of L . x over the valid steady states."""
+def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_limit: float,
+         seeds: bool = True) -> End:
+    """min (sense +1) or max (sense -1) of L . x over the valid steady states; seeds: also
+    the seed states' extremes (linear programs) before the search."""
     t0 = time.perf_counter()
     c, p = form.system.c, form.system.p
     cost = np.zeros(model.n)
@@ -216,12 +227,12 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     bound = model.relaxation_bound(cost)
     tol = ATTAIN_TOL * max(1.0, abs(bound)) if np.isfinite(bound) else 0.0
     xm, mstat, how = None, None, ""
-    seeds: list[np.ndarray] = []
-    for k, pool in enumerate((lambda: model.starts,
-                              lambda: _seed_starts(form, model, L, sense))):
+    pools = [lambda: model.starts, lambda: _seed_starts(form, model, L, sense)]
+    found: list[np.ndarray] = []
+    for k, pool in enumerate(pools[:2 if seeds else 1]):
         cands = pool()
         if k:
-            seeds = cands
+            found = cands
         best = min(cands, key=lambda x: float(cost @ x), default=None)
         if best is not None and float(cost @ best) <= bound + tol:
             xm, mstat = best, OPTIMAL
@@ -229,9 +240,10 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
                    "(no branching)")
             break
     if xm is None:
-        mstat, xm = model.solve(cost, time_limit, seeds)
+        mstat, xm = (model.solve(cost, time_limit, found) if time_limit > 0
+                     else (TIME_LIMIT, None))
         if xm is None and mstat == TIME_LIMIT:  # the best checked state met, not a bound
-            xm = min([*model.starts, *seeds], key=lambda x: float(cost @ x), default=None)
+            xm = min([*model.starts, *found], key=lambda x: float(cost @ x), default=None)
     if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
