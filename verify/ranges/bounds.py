@@ -223,11 +223,11 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
     S_abs, R_hi = np.zeros(c), np.full(c, np.inf)
     I2 = np.eye(2 * c)
     for a in range(c):
-        ext = P.extreme(I2[a])
-        if ext is None:
+        top = P._opt(-I2[a])  # max R_a (one LP: R >= 0 needs no lower bound)
+        if top is None:
             return None
-        if np.isfinite(ext[1]):
-            R_hi[a] = _pad(max(ext[1], 0.0))
+        if np.isfinite(top):
+            R_hi[a] = _pad(max(-top, 0.0))
         if mu[a] > 0:
             ext = P.extreme(I2[c + a])
             if ext is None or not np.all(np.isfinite(ext)):
