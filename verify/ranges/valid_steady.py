@@ -110,7 +110,7 @@ class SteadyRanges:
                              f"{o.width:>11.4g}")
         for name, r in self.ranges.items():
             for e in (r.lo, r.hi):
-                if e.note and not e.note.startswith("proved by"):
+                if e.note and not e.note.startswith(("proved by", "optimal by")):
                     lines.append(f"note ({name}): {e.note}")
         return "\n".join(lines)
 
@@ -277,6 +277,11 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
         end.note = "the contact states of the MILP's point admit no force (rounding)"
     elif sense * (end.value - float(L @ xm[:2 * c])) < -1e-9 * max(1.0, abs(end.value)):
         end.note = "the extreme of these contact states lies beyond the force box"
+    elif not how and sense * end.value <= bound + tol:  # the search's optimum, certified too
+        end.note = (f"proved by the relaxation's certified bound {sense * bound:.12g} "
+                    "(attained by the search's witness)")
+    elif not how:
+        end.note = "optimal by HiGHS's branch and bound (gap closed; bound not re-checked)"
     if end.status == OPTIMAL:
         model.starts.append(form.start(wit.R, wit.S, wit.omega, wit.V, wit.s))
     if end.status in (OPTIMAL, TIME_LIMIT):
