@@ -30,7 +30,7 @@ from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
 from .steady import Formulation, states_of
 
 #: Contact-state sets kept as seeds (MilpModel.add_seed).
-MAX_SEEDS = 6
+MAX_SEEDS = 10
 
 
 def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,

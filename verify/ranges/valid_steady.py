@@ -289,19 +289,58 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     return end
 
 
+def _two_colouring(system: System) -> np.ndarray | None:
+    """sigma = +-1 per disk with sigma_i = -sigma_j across every disk-disk contact, or None
+    (the contact graph is not bipartite)."""
+    lat, p = system.lattice, system.p
+    nbr: list[list[int]] = [[] for _ in range(p)]
+    for i, j in zip(lat.i, lat.j):
+        if 0 <= i < p and 0 <= j < p:
+            nbr[int(i)].append(int(j))
+            nbr[int(j)].append(int(i))
+    sigma = np.zeros(p)
+    for root in range(p):
+        if sigma[root]:
+            continue
+        sigma[root], stack = 1.0, [root]
+        while stack:
+            i = stack.pop()
+            for j in nbr[i]:
+                if not sigma[j]:
+                    sigma[j] = -sigma[i]
+                    stack.append(j)
+                elif sigma[j] == sigma[i]:
+                    return None
+    return sigma
+
+
 def seed_states(form: Formulation) -> list[np.ndarray]:
-    """Contact-state sets of simple velocities, tried at every end: no rotation (omega = 0)
-    with V = +1 and -1 (V free) or V of the run's sign: every disk-disk contact non-sliding,
-    every frictional contact with the plane sliding the same way (the locked array)."""
+    """Contact-state sets of simple velocities, tried at every end (each kept when its
+    velocities and some forces exist): V = +1 and -1 (V free) or V of the run's sign, with
+    no rotation (omega = 0: every disk-disk contact non-sliding, every frictional contact with
+    the plane sliding the same way: the locked array), and, where the disk-disk contacts
+    2-colour the disks, the rolling checkerboards r omega_i = +-sigma_i V (every disk-disk
+    contact non-sliding, the first-row disks of one colour rolling: Fig. 9's least mu_g
+    met, 0.1050919, is one)."""
     system, dyn = form.system, form.dyn
     Vs = {"free": (1.0, -1.0), "zero": (0.0,), "positive": (1.0,),
           "negative": (-1.0,)}[form.V_mode]
-    out = []
+    sigma = _two_colouring(system)
+    spins = [np.zeros(system.p)] + ([] if sigma is None else [sigma, -sigma])
+    out: list[np.ndarray] = []
+    zero = np.zeros(2 * system.c)
     for V in Vs:
-        vt = dyn.velocities(np.zeros(system.p), V)[system.c:]
-        s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
-        if state_velocities(form, s) is not None:
-            out.append(s)
+        for spin in spins:
+            u = spin * V
+            if V == 0 and np.any(u):
+                continue
+            vt = dyn.velocities(u / system.lattice.radius, V)[system.c:]
+            s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
+            if any(np.array_equal(s, t) for t in out):
+                continue
+            if (state_velocities(form, s) is not None
+                    and state_extreme(form, s, zero, 1)[0] == OPTIMAL):
+                out.append(s)
     return out
 
 
