@@ -50,6 +50,29 @@ def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.nda
     return total - margin
 
 
+def certified_result(h, hs, cost: np.ndarray, A: sp.csr_matrix, lo: np.ndarray,
+                     hi: np.ndarray, lb: np.ndarray, ub: np.ndarray
+                     ) -> tuple[float, np.ndarray | None]:
+    """(a certified lower bound of cost.x over lo <= A x <= hi, lb <= x <= ub, the LP's point
+    or None) from a HiGHS instance `h` just run on that LP: the Lagrangian bound of its duals
+    (either sign); +inf when infeasible and its dual ray, checked, proves it (a Lagrangian
+    bound > 0 for the zero cost); -inf when neither is available."""
+    st = h.getModelStatus()
+    if st == hs.HighsModelStatus.kOptimal:
+        y = np.asarray(h.getSolution().row_dual, float)
+        b = max(lagrangian_bound(cost, A, lo, hi, lb, ub, y),
+                lagrangian_bound(cost, A, lo, hi, lb, ub, -y))
+        return b, np.asarray(h.getSolution().col_value, float)
+    if st == hs.HighsModelStatus.kInfeasible:
+        _, has, ray = h.getDualRay()
+        if has:
+            ray, zero = np.asarray(ray, float), np.zeros(A.shape[1])
+            if max(lagrangian_bound(zero, A, lo, hi, lb, ub, ray),
+                   lagrangian_bound(zero, A, lo, hi, lb, ub, -ray)) > 0:
+                return np.inf, None
+    return -np.inf, None
+
+
 class MilpModel:
     """The MILP of a Formulation in one HiGHS instance, and its relaxation in another.
 

@@ -27,8 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from rigidlcp.models.lattice import PLANE
+from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
-from .milp import MilpModel, lagrangian_bound
+from .milp import MilpModel, certified_result
 
 
 @dataclass
@@ -66,22 +67,9 @@ def case_bound(model: MilpModel, cost: np.ndarray, fix: dict[int, int]
     h.changeColsBounds(model.n, idx, lb, ub)
     h.changeColsCost(model.n, idx, cost)
     try:
-        h.run()
-        st = h.getModelStatus()
-        if st == hs.HighsModelStatus.kOptimal:
-            y = np.asarray(h.getSolution().row_dual, float)
-            b = max(lagrangian_bound(cost, model.A, f.lo, f.hi, lb, ub, y),
-                    lagrangian_bound(cost, model.A, f.lo, f.hi, lb, ub, -y))
-            return b, np.asarray(h.getSolution().col_value, float)
-        if st == hs.HighsModelStatus.kInfeasible:
-            _, has, ray = h.getDualRay()
-            if has:
-                ray = np.asarray(ray, float)
-                zero = np.zeros(model.n)
-                for y in (ray, -ray):
-                    if lagrangian_bound(zero, model.A, f.lo, f.hi, lb, ub, y) > 0:
-                        return np.inf, None
-        return -np.inf, None
+        with quiet_highs():
+            h.run()
+        return certified_result(h, hs, cost, model.A, f.lo, f.hi, lb, ub)
     finally:
         h.changeColsBounds(model.n, idx, f.lb, f.ub)
         h.clearSolver()
