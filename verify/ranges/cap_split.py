@@ -113,27 +113,36 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     for key, value in (("output_flag", False), ("primal_feasibility_tolerance", 1e-10),
                        ("dual_feasibility_tolerance", 1e-10)):
         h.setOptionValue(key, value)
+    n = beta.size
+    rows_a = mu[beta, None] * np.sign(b[beta])[:, None] * I2[beta] + I2[c + beta]  # (a)
+    rows_b = eps[:, None] * ra[disk]  # (b)
+    Ad = np.vstack([*base, rows_a, rows_b, np.zeros((1, 2 * c))])  # last: (c), per case
+    ia, ib, ic = Ad.shape[0] - 2 * n - 1, Ad.shape[0] - n - 1, Ad.shape[0] - 1
+    row_lo = np.r_[base_lo, np.zeros(n), -b[beta], -np.inf]
+    row_hi = np.r_[base_hi, np.zeros(n), -b[beta], np.inf]
+    _load(h, highspy, L, Ad, row_lo, row_hi, lb, ub)
+    free = np.full(n, np.inf)
     best, worst, cases, empty = np.inf, (), 0, 0
-    for z in product((False, True), repeat=beta.size):
+    for z in product((False, True), repeat=n):
         z = np.array(z)
-        rows, lo, hi = list(base), [base_lo], [base_hi]
-        for k in np.flatnonzero(~z):  # (a): S = -sgn(b) mu R
-            row = mu[beta[k]] * np.sign(b[beta[k]]) * I2[beta[k]] + I2[c + beta[k]]
-            rows.append(row[None, :])
-            lo.append([0.0])
-            hi.append([0.0])
-        for k in np.flatnonzero(z):  # (b): eps ra_i = -b
-            rows.append(eps[k] * ra[disk[k]][None, :])
-            lo.append([-b[beta[k]]])
-            hi.append([-b[beta[k]]])
-        if z.any():  # (c)
-            row = -(np.sign(b[beta[z]])[:, None] * I2[c + beta[z]]).sum(axis=0)
-            rows.append(row[None, :])
-            lo.append([M * float(np.sum(1.0 / D[np.unique(disk[z])]))])
-            hi.append([np.inf])
-        A = sp.csr_matrix(np.vstack(rows))
-        row_lo, row_hi = np.concatenate(lo), np.concatenate(hi)
-        bound = _solve(h, highspy, L, A, row_lo, row_hi, lb, ub)
+        row_lo[ia:ia + n] = np.where(z, -free, 0.0)
+        row_hi[ia:ia + n] = np.where(z, free, 0.0)
+        row_lo[ib:ib + n] = np.where(z, -b[beta], -free)
+        row_hi[ib:ib + n] = np.where(z, -b[beta], free)
+        Ad[ic, c + beta] = np.where(z, -np.sign(b[beta]), 0.0)
+        row_lo[ic] = M * float(np.sum(1.0 / D[np.unique(disk[z])])) if z.any() else -np.inf
+        idx = np.arange(ia, ic + 1, dtype=np.int32)
+        h.changeRowsBounds(idx.size, idx, row_lo[idx], row_hi[idx])
+        for k in range(n):
+            h.changeCoeff(ic, int(c + beta[k]), float(Ad[ic, c + beta[k]]))
+        with quiet_highs():
+            h.run()
+        if h.getModelStatus() not in (highspy.HighsModelStatus.kOptimal,
+                                      highspy.HighsModelStatus.kInfeasible):
+            h.clearSolver()  # warm start in trouble: once more from scratch
+            with quiet_highs():
+                h.run()
+        bound = certified_result(h, highspy, L, sp.csr_matrix(Ad), row_lo, row_hi, lb, ub)[0]
         cases += 1
         empty += bound == np.inf
         if bound < best:
@@ -141,7 +150,8 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     return CapSplitBound(float(best), worst, cases, empty, time.perf_counter() - t0)
 
 
-def _solve(h, hs, cost, A, row_lo, row_hi, lb, ub) -> float:
+def _load(h, hs, cost, A, row_lo, row_hi, lb, ub) -> None:
+    """Pass the LP min cost.x, row_lo <= A x <= row_hi, lb <= x <= ub to the instance h."""
     lp = hs.HighsLp()
     Ac = sp.csc_matrix(A)
     lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
@@ -150,8 +160,4 @@ def _solve(h, hs, cost, A, row_lo, row_hi, lb, ub) -> float:
     lp.a_matrix_.format_ = hs.MatrixFormat.kColwise
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
         Ac.indptr, Ac.indices, Ac.data)
-    h.clearModel()
     h.passModel(lp)
-    with quiet_highs():
-        h.run()
-    return certified_result(h, hs, cost, A, row_lo, row_hi, lb, ub)[0]
