@@ -31,7 +31,8 @@ def cell(e) -> str:
     if e.status == OPTIMAL:
         return f"{e.value:.7f}"
     if e.best is not None:
-        return f"TL (met {e.best:.7f})"
+        proved = "" if e.bound is None else f"; proved bound {e.bound:.7f}"
+        return f"TL (met {e.best:.7f}{proved})"
     return e.status
 
 

@@ -42,6 +42,7 @@ from rigidlcp.verify.certificates.uniqueness import quiet_highs
 from .bounds import rotation_cap
 from .milp import certified_result
 from .observables import alpha_rows
+from .result import OPTIMAL, TIME_LIMIT
 from .steady import Formulation, _equalities, velocity_box
 
 #: At most this many cap contacts (2^n linear programs).
@@ -161,3 +162,28 @@ def _load(h, hs, cost, A, row_lo, row_hi, lb, ub) -> None:
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
         Ac.indptr, Ac.indices, Ac.data)
     h.passModel(lp)
+
+
+def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray]) -> None:
+    """Give each end left at the time limit the proved bound of `cap_split_bound` (End.bound,
+    and a note), where it applies; an end whose best value met attains it is decided."""
+    for name, L in obs.items():
+        for side, sense in (("lo", 1.0), ("hi", -1.0)):
+            end = getattr(ranges[name], side)
+            if end.status != TIME_LIMIT:
+                continue
+            res = cap_split_bound(form, sense * L)
+            if res is None or not np.isfinite(res.bound):
+                continue
+            end.bound = sense * res.bound
+            end.seconds += res.seconds
+            how = (f"proved {'>=' if sense > 0 else '<='} {end.bound:.10g} by the case split on "
+                   f"the cap contacts with a_t = 0 ({res.cases} certified LPs, "
+                   f"{res.empty} empty)")
+            if end.best is not None and end.witness is not None and (
+                    sense * end.best <= res.bound + 1e-9 * max(1.0, abs(res.bound))):
+                end.status, end.value = OPTIMAL, end.best
+                end.note = f"{how}; attained by the witness"
+            else:
+                met = "" if end.best is None else f"; best met {end.best:.10g}"
+                end.note = f"{'min' if sense > 0 else 'max'} not decided: {how}{met}"

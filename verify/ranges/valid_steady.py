@@ -17,6 +17,7 @@ import numpy as np
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 
+from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
 from .observables import check_observable, steady_observables
@@ -75,6 +76,14 @@ class SteadyRanges:
                "status": {"mu_g": [mg.lo.status, mg.hi.status]},
                "scope": mg.scope, "force_bound": {"U": self.U, "proved": self.box_proved},
                "V": self.V_mode, "seconds": round(self.seconds, 3)}
+        bounds: dict[str, list] = {}
+        for name, r in self.ranges.items():  # [lower bound of min, upper bound of max]
+            pair = [num(e) if e.status == OPTIMAL else e.bound for e in (r.lo, r.hi)]
+            if name == "mu_g":
+                bounds["mu_g"] = pair
+            else:
+                bounds.setdefault(name.split("[")[0], []).append(pair)
+        out["bounds"] = bounds
         if "mu_g" in self.run_values:
             out["run"] = {"mu_g": self.run_values["mu_g"]}
         if "mu_g" in self.own:
@@ -137,14 +146,16 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None, kinematics: str = "lazy") -> SteadyRanges:
+                  V_mode: str | None = None, kinematics: str = "lazy", split: bool = True
+                  ) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
     also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
     box: the force box when no bound is proved. kinematics: "lazy" (velocities checked on
-    each optimum, verify.ranges.milp) or "big-M" (in the MILP). Raises NotSteady when no
-    valid steady state exists or the run is not steady."""
+    each optimum, verify.ranges.milp) or "big-M" (in the MILP). split: an end left at the
+    time limit gets a proved bound by verify.ranges.cap_split where it applies. Raises
+    NotSteady when no valid steady state exists or the run is not steady."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -185,6 +196,9 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                 if new.status == OPTIMAL:
                     new.seconds += old.seconds
                     setattr(ranges[name], side, new)
+    if split:  # a proved bound on each end still open (verify.ranges.cap_split)
+        bound_open_ends(form, ranges, obs)
+    for name, L in obs.items():
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
             ranges[name].selected = run_values[name]

@@ -104,3 +104,24 @@ def test_cap_split_bound_below_the_big_M_end(lattice, gamma):
     assert res is not None and res.cases == 2 ** len(cap_contacts(model.form)[0])
     assert res.bound <= lo + 1e-12
     assert np.isfinite(res.bound)
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS[:2])
+def test_open_ends_get_proved_bounds_around_the_big_M_ends(lattice, gamma):
+    """Ends left undecided (here made so) get bounds that contain the big-M MILP's ends; with
+    no witness they stay undecided, and the JSON's "bounds" carries them (null stays in
+    "mu_g")."""
+    from rigidlcp.verify.ranges import End, Range
+    from rigidlcp.verify.ranges.cap_split import bound_open_ends
+    from rigidlcp.verify.ranges.valid_steady import SteadyRanges
+
+    model, L, lo, hi = _ends(lattice, gamma)
+    form = model.form
+    rg = {"mu_g": Range("mu_g", End("time limit"), End("time limit"))}
+    bound_open_ends(form, rg, {"mu_g": mu_g_vector(form.system)})
+    e_lo, e_hi = rg["mu_g"].lo, rg["mu_g"].hi
+    assert e_lo.status == e_hi.status == "time limit"
+    assert e_lo.bound <= lo + 1e-12 and e_hi.bound >= hi - 1e-12
+    d = SteadyRanges(form.system, rg, form.U, form.box_proved, form.V_mode, 0.0).to_dict()
+    assert d["steady"]["mu_g"] == [None, None]
+    assert d["steady"]["bounds"]["mu_g"] == [e_lo.bound, e_hi.bound]
