@@ -30,7 +30,8 @@ from rigidlcp.verify.ranges import Range, SteadyRanges, steady_ranges
 from rigidlcp.verify.ranges.result import OPTIMAL, TIME_LIMIT
 
 #: Seconds per end of a band point (Fig. 11's 10x1: ~0.4 s per point) and of an experiment's
-#: steady set (the 10x4 arrays do not decide their ends in reasonable time: "time limit").
+#: steady set (the 10x4 and 10x2 arrays decide the upper end of mu_g, mu_plane, in < 1 s, not
+#: the lower end: "time limit" with the best value met, e.g. the rolling checkerboard's).
 BAND_TIME_LIMIT = 20.0
 SET_TIME_LIMIT = {False: 30.0, True: 2.0}
 

@@ -3,7 +3,8 @@ verify.ranges.steady (docs/mechanics.md, "Valid steady states and their ranges",
 bounds").
 
 Every valid steady state lies in the relaxation P = {x = [R; S]: a_n = 0, no translation,
-R >= 0, |S| <= mu R, S = 0 where mu = 0}. Linear programs over P give
+R >= 0, |S| <= mu R, S = 0 where mu = 0, |r alpha| <= M* where the rotation cap M* is
+proved}. Linear programs over P give
 
 * |S_a| <= S_abs[a] and the bounds of r alpha (linear in S): valid for *every* steady state;
 * R_a <= R_hi[a] for the contacts whose R is bounded over P.
@@ -24,6 +25,11 @@ linear programs: [dmin_a, dmax_a]),
 So for an observable of S (mu_g, alpha, S, and the bounded R) the extremes over all valid
 steady states equal those over the states with R <= R_hi: the bound is proved for it. An
 observable that weighs an R of a self-stress group is not covered (`free_R`).
+
+The angular accelerations obey a maximum principle (`rotation_cap`): |r alpha_i| <= max |b|
+over the one-disk frictional contacts (b = a_t at alpha = 0: gamma for the plane), proved for
+every valid steady state, not only over P; where it applies, the LPs for r alpha and a_t are
+not needed (their bounds follow from the cap).
 """
 
 from __future__ import annotations
@@ -63,7 +69,10 @@ class _P:
     """The relaxation P in one HiGHS instance; `extreme(L)` = (min, max) of L x over P (+-inf
     where unbounded), or None if P is empty or an LP fails."""
 
-    def __init__(self, system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray):
+    def __init__(self, system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray,
+                 ra_rows: np.ndarray | None = None, ra_cap: float = np.inf):
+        """ra_rows, ra_cap: also |ra_rows @ x| <= ra_cap (the rotation cap, valid on every
+        valid steady state: P then stays a relaxation of them)."""
         import highspy
 
         c, mu = system.c, system.mu
@@ -76,13 +85,17 @@ class _P:
                           sp.csr_matrix((np.r_[mu[fr], -np.ones(F)],
                                          (np.r_[np.arange(F), np.arange(F)], np.r_[fr, c + fr])),
                                         shape=(F, 2 * c))]).tocsc()
+        row_lo, row_hi = np.r_[e, np.zeros(2 * F)], np.r_[e, np.full(2 * F, np.inf)]
+        if ra_rows is not None and np.isfinite(ra_cap):
+            rows = sp.vstack([rows, sp.csr_matrix(ra_rows)]).tocsc()
+            row_lo = np.r_[row_lo, np.full(ra_rows.shape[0], -ra_cap)]
+            row_hi = np.r_[row_hi, np.full(ra_rows.shape[0], ra_cap)]
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = 2 * c, rows.shape[0]
         lp.col_cost_ = np.zeros(2 * c)
         lp.col_lower_ = np.r_[np.zeros(c), np.where(mu > 0, -np.inf, 0.0)]
         lp.col_upper_ = np.r_[np.full(c, np.inf), np.where(mu > 0, np.inf, 0.0)]
-        lp.row_lower_ = np.r_[e, np.zeros(2 * F)]
-        lp.row_upper_ = np.r_[e, np.full(2 * F, np.inf)]
+        lp.row_lower_, lp.row_upper_ = row_lo, row_hi
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
             rows.indptr, rows.indices, rows.data)
@@ -154,6 +167,48 @@ def _groups(ER: np.ndarray, free: np.ndarray) -> list[tuple[np.ndarray, np.ndarr
     return out
 
 
+def rotation_cap(system: System, dyn: Dynamics) -> float | None:
+    """M* with |r alpha_i| <= M* for every disk in every valid steady state (a discrete
+    maximum principle), or None when the contact geometry is not of the form it needs.
+
+    With no translation, a_t = T_u ra + b (ra = r alpha; b = u_obs'_t, gamma's part) and, by
+    the torque balance, ra = D T_u^T S with D = diag(r^2 / I) > 0 (verify.ranges.steady). It
+    needs: every frictional row of T_u has at most two nonzero entries, all of one sign
+    eps_beta (disk-disk -(u_i + u_j), plane -V - u_i, wall -u_i), and b_beta = 0 on the
+    two-disk rows; then M* = max |b_beta| over the one-disk frictional rows (gamma here).
+
+    Proof. Every valid steady state has S_beta a_t,beta <= 0 on every contact (sliding
+    S = -s mu R with s a_t >= 0; non-sliding a_t = 0; frictionless S = 0). Suppose
+    M = max_i |ra_i| > M*, K = {i: |ra_i| = M}, sigma_i = sgn ra_i. Then
+    Phi = sum_K sigma_i ra_i / D_i = sum_K M / D_i > 0, and also, from ra_i / D_i =
+    sum_beta T_beta,i S_beta, Phi = sum_K sigma_i sum_{beta at i} eps_beta S_beta. Per term:
+    a two-disk contact (i, j) with j in K and sigma_j = -sigma_i cancels (sigma_i + sigma_j
+    = 0); otherwise sgn(ra_i + ra_j) = sigma_i (|ra_j| < M or sigma_j = sigma_i), so
+    sgn a_t = eps_beta sigma_i and S a_t <= 0 gives sigma_i eps_beta S_beta <= 0; a one-disk
+    contact has |b| <= M* < M, so again sgn a_t = eps_beta sigma_i and the term is <= 0. So
+    Phi <= 0: a contradiction. Hence max |ra_i| <= M*.
+    """
+    c, p, r = system.c, system.p, system.lattice.radius
+    H = dyn.H.toarray()
+    if np.any(H[:c, 2 * p:] != 0):  # a normal row with rotation: not ra = D T_u^T S
+        return None
+    Tu = H[c:, 2 * p:] / r
+    b = np.asarray(dyn.u_obs_dot, float)[c:]
+    cap = 0.0
+    for beta in np.flatnonzero(system.mu > 0):
+        row = Tu[beta][Tu[beta] != 0]
+        if row.size == 0:
+            continue
+        if row.size > 2 or np.any(np.abs(row - row[0]) > 1e-12 * abs(row[0])):
+            return None  # unequal weights or signs: sgn(a_t) not fixed by the larger |ra|
+        if row.size == 2:
+            if b[beta] != 0:
+                return None
+        else:
+            cap = max(cap, abs(float(b[beta])))
+    return cap
+
+
 def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
                   ) -> ForceBounds | None:
     """The bounds of the module docstring, or None when they cannot be proved (an S or an
@@ -161,49 +216,58 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
     d_a unbounded). E x = e: a_n = 0 and no translation (verify.ranges.steady)."""
     c, p, mu = system.c, system.p, system.mu
     r = system.lattice.radius
-    P = _P(system, dyn, E, e)
+    HT = dyn.H.T.toarray()
+    Lra = (r * dyn.Minv[2 * p:])[:, None] * HT[2 * p:]
+    m_star = rotation_cap(system, dyn)
+    P = _P(system, dyn, E, e, Lra, np.inf if m_star is None else m_star * (1 + 1e-9) + 1e-15)
     S_abs, R_hi = np.zeros(c), np.full(c, np.inf)
     I2 = np.eye(2 * c)
     for a in range(c):
-        ext = P.extreme(I2[a])
-        if ext is None:
+        top = P._opt(-I2[a])  # max R_a (one LP: R >= 0 needs no lower bound)
+        if top is None:
             return None
-        if np.isfinite(ext[1]):
-            R_hi[a] = _pad(max(ext[1], 0.0))
+        if np.isfinite(top):
+            R_hi[a] = _pad(max(-top, 0.0))
         if mu[a] > 0:
             ext = P.extreme(I2[c + a])
             if ext is None or not np.all(np.isfinite(ext)):
                 return None
             S_abs[a] = _pad(max(abs(ext[0]), abs(ext[1])))
-    HT = dyn.H.T.toarray()
-    Lra = (r * dyn.Minv[2 * p:])[:, None] * HT[2 * p:]
-    ra_lo, ra_hi = np.zeros(p), np.zeros(p)
-    for i in range(p):
-        ext = P.extreme(Lra[i])
-        if ext is None or not np.all(np.isfinite(ext)):
-            return None
-        ra_lo[i], ra_hi[i] = -_pad(-ext[0]), _pad(ext[1])
-    # Power: nu'^T M nu' = nu'^T (H^T lambda + f) with no translation gives
-    # sum_i I_i alpha_i^2 = S . a_t - u_obs'^T lambda, and S . a_t <= 0 on every valid steady
-    # state (sliding: S = -s mu R, s a_t >= 0; non-sliding: a_t = 0; frictionless: S = 0), so
-    # I_i alpha_i^2 <= max over P of (-u_obs'^T lambda) =: Pmax (= gamma F_g at most).
-    ext = P.extreme(-np.asarray(dyn.u_obs_dot, float))
-    if ext is not None and np.isfinite(ext[1]):
-        I_rot = 1.0 / dyn.Minv[2 * p:]
-        cap = r * np.sqrt(_pad(max(ext[1], 0.0)) / I_rot)
-        ra_lo, ra_hi = np.maximum(ra_lo, -_pad(cap)), np.minimum(ra_hi, _pad(cap))
-    # a_t of each frictional contact: T_u r alpha + T_V gamma (verify.ranges.steady), one
-    # LP pair each (tighter than the sum of the r alpha intervals)
     Tu = dyn.H[c:].toarray()[:, 2 * p:] / r
     gam = dyn.u_obs(1.0)[c:] * system.gamma
     at_lo, at_hi = np.zeros(c), np.zeros(c)
-    for a in np.flatnonzero(mu > 0):
-        ext = P.extreme(Tu[a] @ Lra)
-        if ext is None or not np.all(np.isfinite(ext)):
-            return None
-        Tp, Tm = np.maximum(Tu[a], 0.0), np.minimum(Tu[a], 0.0)  # or from the r alpha box
-        at_lo[a] = gam[a] + max(-_pad(-ext[0]), Tp @ ra_lo + Tm @ ra_hi)
-        at_hi[a] = gam[a] + min(_pad(ext[1]), Tp @ ra_hi + Tm @ ra_lo)
+    if m_star is not None:  # the maximum principle: no LP needed for r alpha and a_t
+        ra_hi = np.full(p, m_star * (1 + 1e-9) + 1e-15)  # exact up to rounding
+        ra_lo = -ra_hi
+        for a in np.flatnonzero(mu > 0):
+            Tp, Tm = np.maximum(Tu[a], 0.0), np.minimum(Tu[a], 0.0)
+            at_lo[a] = gam[a] + Tp @ ra_lo + Tm @ ra_hi
+            at_hi[a] = gam[a] + Tp @ ra_hi + Tm @ ra_lo
+    else:
+        ra_lo, ra_hi = np.zeros(p), np.zeros(p)
+        for i in range(p):
+            ext = P.extreme(Lra[i])
+            if ext is None or not np.all(np.isfinite(ext)):
+                return None
+            ra_lo[i], ra_hi[i] = -_pad(-ext[0]), _pad(ext[1])
+        # Power: nu'^T M nu' = nu'^T (H^T lambda + f) with no translation gives
+        # sum_i I_i alpha_i^2 = S . a_t - u_obs'^T lambda, and S . a_t <= 0 on every valid
+        # steady state (sliding: S = -s mu R, s a_t >= 0; non-sliding: a_t = 0; frictionless:
+        # S = 0), so I_i alpha_i^2 <= max over P of (-u_obs'^T lambda) (= gamma F_g at most).
+        ext = P.extreme(-np.asarray(dyn.u_obs_dot, float))
+        if ext is not None and np.isfinite(ext[1]):
+            I_rot = 1.0 / dyn.Minv[2 * p:]
+            cap = r * np.sqrt(_pad(max(ext[1], 0.0)) / I_rot)
+            ra_lo, ra_hi = np.maximum(ra_lo, -_pad(cap)), np.minimum(ra_hi, _pad(cap))
+        # a_t of each frictional contact: T_u r alpha + T_V gamma (verify.ranges.steady),
+        # one LP pair each (tighter than the sum of the r alpha intervals)
+        for a in np.flatnonzero(mu > 0):
+            ext = P.extreme(Tu[a] @ Lra)
+            if ext is None or not np.all(np.isfinite(ext)):
+                return None
+            Tp, Tm = np.maximum(Tu[a], 0.0), np.minimum(Tu[a], 0.0)  # or the r alpha box
+            at_lo[a] = gam[a] + max(-_pad(-ext[0]), Tp @ ra_lo + Tm @ ra_hi)
+            at_hi[a] = gam[a] + min(_pad(ext[1]), Tp @ ra_hi + Tm @ ra_lo)
     free = np.flatnonzero(~np.isfinite(R_hi))
     groups = []
     if free.size:

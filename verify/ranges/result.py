@@ -22,7 +22,10 @@ class End:
     """One end of a range. value: the extreme (None unless status is "optimal"; +-inf when
     "unbounded"); witness: what attains it (a SteadyWitness, or an event's z); ray: the
     direction of unboundedness (checked); best: the best value met when the time limit
-    stopped the search (not a bound); residual: the witness's independent residual."""
+    stopped the search (not a bound); residual: the witness's independent residual; bound: for
+    an end not decided, a proved bound on it where one is known (a lower bound of a min, an
+    upper bound of a max: verify.ranges.cap_split), so the end lies in [bound, best] (min) or
+    [best, bound] (max)."""
 
     status: str
     value: float | None = None
@@ -32,6 +35,7 @@ class End:
     best: float | None = None
     seconds: float = 0.0
     note: str = ""
+    bound: float | None = None
 
     def __repr__(self) -> str:
         if self.status == OPTIMAL:
@@ -40,7 +44,8 @@ class End:
             return f"{self.value} (ray checked)"
         if self.status == TIME_LIMIT:
             best = "" if self.best is None else f", best met {self.best:.10g} (not a bound)"
-            return f"time limit{best}"
+            proved = "" if self.bound is None else f", proved bound {self.bound:.10g}"
+            return f"time limit{best}{proved}"
         return self.status
 
 

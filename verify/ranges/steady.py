@@ -106,6 +106,7 @@ class Formulation:
     notes: list[str] = field(default_factory=list)
     R_hi: np.ndarray | None = None  # per-contact force bounds (verify.ranges.bounds)
     free_R: np.ndarray | None = None  # contacts whose R bound holds for S-observables only
+    v_rows: tuple[int, int] = (0, 0)  # the rows of v_t's big-M constraints (start, stop)
 
     def proved_for(self, L: np.ndarray) -> bool:
         """Whether the force bounds are proved for the observable L (verify.ranges.bounds:
@@ -242,6 +243,7 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
     # v_t = T_u u + T_V V in [y+ - B y-, B y+ - y-]  (B = 2 OMEGA bounds |v_t| in the box)
     B = 2.0 * OMEGA
     TV = sp.csr_matrix(T_V[fric][:, None])
+    v_rows = (sum(b.shape[0] for b in rows), sum(b.shape[0] for b in rows) + 2 * F)
     add(cols({iu: Tf, iV: TV, yp: -sp.eye(F), ym: B * sp.eye(F)}, F), 0.0, np.inf)
     add(cols({iu: -Tf, iV: -TV, yp: B * sp.eye(F), ym: -sp.eye(F)}, F), 0.0, np.inf)
     add(cols({yp: sp.eye(F), ym: sp.eye(F)}, F), -np.inf, 1.0)  # y+ + y- <= 1
@@ -259,7 +261,7 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
     A = sp.vstack(rows).tocsr()
     return Formulation(system, dyn, A, np.concatenate(lo), np.concatenate(hi), lb, ub,
                        integrality, fric, U, proved, OMEGA, V_mode, [], R_hi,
-                       None if fb is None else fb.free_R)
+                       None if fb is None else fb.free_R, v_rows)
 
 
 def states_of(form: Formulation, y: np.ndarray) -> np.ndarray:

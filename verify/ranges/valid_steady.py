@@ -13,12 +13,13 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
+from .cap_split import bound_open_ends
+from .kinematics import realizable
+from .milp import MilpModel
 from .observables import check_observable, steady_observables
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
 from .steady import (
@@ -34,8 +35,8 @@ from .witness import make_witness, steady_check
 
 #: A witness is accepted when its independent residual is at most this.
 WITNESS_TOL = 1e-8
-#: Contact-state sets kept as seeds (verify.ranges.valid_steady._Model.add_seed).
-MAX_SEEDS = 6
+#: A witness attains a certified bound when within this (relative to max(1, |bound|)).
+ATTAIN_TOL = 1e-9
 
 
 @dataclass
@@ -75,6 +76,14 @@ class SteadyRanges:
                "status": {"mu_g": [mg.lo.status, mg.hi.status]},
                "scope": mg.scope, "force_bound": {"U": self.U, "proved": self.box_proved},
                "V": self.V_mode, "seconds": round(self.seconds, 3)}
+        bounds: dict[str, list] = {}
+        for name, r in self.ranges.items():  # [lower bound of min, upper bound of max]
+            pair = [num(e) if e.status == OPTIMAL else e.bound for e in (r.lo, r.hi)]
+            if name == "mu_g":
+                bounds["mu_g"] = pair
+            else:
+                bounds.setdefault(name.split("[")[0], []).append(pair)
+        out["bounds"] = bounds
         if "mu_g" in self.run_values:
             out["run"] = {"mu_g": self.run_values["mu_g"]}
         if "mu_g" in self.own:
@@ -110,7 +119,7 @@ class SteadyRanges:
                              f"{o.width:>11.4g}")
         for name, r in self.ranges.items():
             for e in (r.lo, r.hi):
-                if e.note:
+                if e.note and not e.note.startswith(("proved by", "optimal by")):
                     lines.append(f"note ({name}): {e.note}")
         return "\n".join(lines)
 
@@ -137,13 +146,16 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None) -> SteadyRanges:
+                  V_mode: str | None = None, kinematics: str = "lazy", split: bool = True
+                  ) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
     also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
-    box: the force box when no bound is proved. Raises NotSteady when no valid steady state
-    exists or the run is not steady."""
+    box: the force box when no bound is proved. kinematics: "lazy" (velocities checked on
+    each optimum, verify.ranges.milp) or "big-M" (in the MILP). split: an end left at the
+    time limit gets a proved bound by verify.ranges.cap_split where it applies. Raises
+    NotSteady when no valid steady state exists or the run is not steady."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -163,7 +175,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
     unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
-    model = _Model(form)
+    model = MilpModel(form, kinematics)
     if start is not None:
         model.starts.append(form.start(*start))
         model.add_seed(start[4])
@@ -174,6 +186,19 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         hi = _end(form, model, L, -1, time_limit)
         scope = "all valid steady states" if form.proved_for(L) else unproved
         ranges[name] = Range(name, lo, hi, scope)
+    # The ends left at their time limit, again against the states met since (a later end's
+    # witness may attain an earlier end's certified bound): no new search.
+    for name, L in obs.items():
+        for side, sense in (("lo", +1), ("hi", -1)):
+            old = getattr(ranges[name], side)
+            if old.status == TIME_LIMIT:
+                new = _end(form, model, L, sense, 0.0, seeds=False)
+                if new.status == OPTIMAL:
+                    new.seconds += old.seconds
+                    setattr(ranges[name], side, new)
+    if split:  # a proved bound on each end still open (verify.ranges.cap_split)
+        bound_open_ends(form, ranges, obs)
+    for name, L in obs.items():
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
             ranges[name].selected = run_values[name]
@@ -203,77 +228,36 @@ def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     return end
 
 
-class _Model:
-    """The MILP of a Formulation in one HiGHS instance, re-solved with new costs."""
-
-    def __init__(self, form: Formulation):
-        import highspy
-
-        A = sp.csc_matrix(form.A)
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-        lp.col_cost_ = np.zeros(A.shape[1])
-        lp.col_lower_, lp.col_upper_ = form.lb, form.ub
-        lp.row_lower_, lp.row_upper_ = form.lo, form.hi
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
-            A.indptr, A.indices, A.data)
-        lp.integrality_ = [highspy.HighsVarType.kInteger if v else
-                           highspy.HighsVarType.kContinuous for v in form.integrality]
-        with quiet_highs():
-            h = highspy.Highs()
-        for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
-                           ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
-                           ("primal_feasibility_tolerance", 1e-9)):
-            h.setOptionValue(key, value)
-        h.passModel(lp)
-        self.h, self.hs, self.n = h, highspy, A.shape[1]
-        self.starts: list[np.ndarray] = []
-        self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
-
-    def add_seed(self, s: np.ndarray) -> None:
-        """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
-        s = np.asarray(s, dtype=int)
-        self.seeds = [t for t in self.seeds if not np.array_equal(t, s)] + [s]
-        del self.seeds[:-MAX_SEEDS]
-
-    def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
-              ) -> tuple[str, np.ndarray | None]:
-        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
-        extra: MIP starts for this objective only."""
-        h, hs = self.h, self.hs
-        h.clearSolver()
-        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
-        h.setOptionValue("time_limit", float(time_limit))
-        starts = [*self.starts, *extra]
-        # the best valid state as the MIP start (a later setSolution replaces an earlier one)
-        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
-            sol = hs.HighsSolution()
-            sol.col_value = list(x)
-            sol.value_valid = True
-            h.setSolution(sol)
-        with quiet_highs():
-            h.run()
-        st = h.getModelStatus()
-        has_x = h.getInfo().primal_solution_status == 2
-        x = np.asarray(h.getSolution().col_value) if has_x else None
-        if st == hs.HighsModelStatus.kOptimal:
-            return OPTIMAL, x
-        if st == hs.HighsModelStatus.kInfeasible:
-            return INFEASIBLE, None
-        if st == hs.HighsModelStatus.kTimeLimit:
-            return TIME_LIMIT, x
-        return "failed", x
-
-
-def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit: float
-         ) -> End:
-    """min (sense +1) or max (sense -1) of L . x over the valid steady states."""
+def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_limit: float,
+         seeds: bool = True) -> End:
+    """min (sense +1) or max (sense -1) of L . x over the valid steady states; seeds: also
+    the seed states' extremes (linear programs) before the search."""
     t0 = time.perf_counter()
     c, p = form.system.c, form.system.p
     cost = np.zeros(model.n)
     cost[:2 * c] = sense * L
-    mstat, xm = model.solve(cost, time_limit, _seed_starts(form, model, L, sense))
+    # A checked valid steady state that attains the relaxation's certified bound is an
+    # extreme: no branching (verify.ranges.milp). First the states met so far, then the seeds.
+    bound = model.relaxation_bound(cost)
+    tol = ATTAIN_TOL * max(1.0, abs(bound)) if np.isfinite(bound) else 0.0
+    xm, mstat, how = None, None, ""
+    pools = [lambda: model.starts, lambda: _seed_starts(form, model, L, sense)]
+    found: list[np.ndarray] = []
+    for k, pool in enumerate(pools[:2 if seeds else 1]):
+        cands = pool()
+        if k:
+            found = cands
+        best = min(cands, key=lambda x: float(cost @ x), default=None)
+        if best is not None and float(cost @ best) <= bound + tol:
+            xm, mstat = best, OPTIMAL
+            how = (f"proved by the relaxation's certified bound {sense * bound:.12g} "
+                   "(no branching)")
+            break
+    if xm is None:
+        mstat, xm = (model.solve(cost, time_limit, found) if time_limit > 0
+                     else (TIME_LIMIT, None))
+        if xm is None and mstat == TIME_LIMIT:  # the best checked state met, not a bound
+            xm = min([*model.starts, *found], key=lambda x: float(cost @ x), default=None)
     if mstat == INFEASIBLE:
         raise NotSteady("no valid steady state: every contact-state set the kinematics admit "
                         "violates a law (MILP infeasible)")
@@ -283,14 +267,16 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
     s = states_of(form, xm)
     status, x, ray = state_extreme(form, s, L, sense)
     vel = state_velocities(form, s)
-    if vel is None:  # the LP disagrees with the MILP's kinematics: keep the MILP's velocities
+    if vel is None:  # the LP disagrees: the shortest-path velocities, else the MILP's
         r = form.system.lattice.radius
-        vel = (xm[2 * c + p:2 * c + 2 * p] / r, float(xm[2 * c + 2 * p]))
+        ok, xv = realizable(form, s)
+        xv = xv if ok else xm[2 * c + p:2 * c + 2 * p + 1]
+        vel = (np.asarray(xv[:p]) / r, float(xv[p]))
     if x is None:
         x = xm[:2 * c]
     wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
-              seconds=time.perf_counter() - t0)
+              seconds=time.perf_counter() - t0, note=how)
     if wit.residual > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
@@ -305,6 +291,11 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
         end.note = "the contact states of the MILP's point admit no force (rounding)"
     elif sense * (end.value - float(L @ xm[:2 * c])) < -1e-9 * max(1.0, abs(end.value)):
         end.note = "the extreme of these contact states lies beyond the force box"
+    elif not how and sense * end.value <= bound + tol:  # the search's optimum, certified too
+        end.note = (f"proved by the relaxation's certified bound {sense * bound:.12g} "
+                    "(attained by the search's witness)")
+    elif not how:
+        end.note = "optimal by HiGHS's branch and bound (gap closed; bound not re-checked)"
     if end.status == OPTIMAL:
         model.starts.append(form.start(wit.R, wit.S, wit.omega, wit.V, wit.s))
     if end.status in (OPTIMAL, TIME_LIMIT):
@@ -312,23 +303,62 @@ def _end(form: Formulation, model: _Model, L: np.ndarray, sense: int, time_limit
     return end
 
 
+def _two_colouring(system: System) -> np.ndarray | None:
+    """sigma = +-1 per disk with sigma_i = -sigma_j across every disk-disk contact, or None
+    (the contact graph is not bipartite)."""
+    lat, p = system.lattice, system.p
+    nbr: list[list[int]] = [[] for _ in range(p)]
+    for i, j in zip(lat.i, lat.j):
+        if 0 <= i < p and 0 <= j < p:
+            nbr[int(i)].append(int(j))
+            nbr[int(j)].append(int(i))
+    sigma = np.zeros(p)
+    for root in range(p):
+        if sigma[root]:
+            continue
+        sigma[root], stack = 1.0, [root]
+        while stack:
+            i = stack.pop()
+            for j in nbr[i]:
+                if not sigma[j]:
+                    sigma[j] = -sigma[i]
+                    stack.append(j)
+                elif sigma[j] == sigma[i]:
+                    return None
+    return sigma
+
+
 def seed_states(form: Formulation) -> list[np.ndarray]:
-    """Contact-state sets of simple velocities, tried at every end: no rotation (omega = 0)
-    with V = +1 and -1 (V free) or V of the run's sign: every disk-disk contact non-sliding,
-    every frictional contact with the plane sliding the same way (the locked array)."""
+    """Contact-state sets of simple velocities, tried at every end (each kept when its
+    velocities and some forces exist): V = +1 and -1 (V free) or V of the run's sign, with
+    no rotation (omega = 0: every disk-disk contact non-sliding, every frictional contact with
+    the plane sliding the same way: the locked array), and, where the disk-disk contacts
+    2-colour the disks, the rolling checkerboards r omega_i = +-sigma_i V (every disk-disk
+    contact non-sliding, the first-row disks of one colour rolling: Fig. 9's least mu_g
+    met, 0.1050919, is one)."""
     system, dyn = form.system, form.dyn
     Vs = {"free": (1.0, -1.0), "zero": (0.0,), "positive": (1.0,),
           "negative": (-1.0,)}[form.V_mode]
-    out = []
+    sigma = _two_colouring(system)
+    spins = [np.zeros(system.p)] + ([] if sigma is None else [sigma, -sigma])
+    out: list[np.ndarray] = []
+    zero = np.zeros(2 * system.c)
     for V in Vs:
-        vt = dyn.velocities(np.zeros(system.p), V)[system.c:]
-        s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
-        if state_velocities(form, s) is not None:
-            out.append(s)
+        for spin in spins:
+            u = spin * V
+            if V == 0 and np.any(u):
+                continue
+            vt = dyn.velocities(u / system.lattice.radius, V)[system.c:]
+            s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
+            if any(np.array_equal(s, t) for t in out):
+                continue
+            if (state_velocities(form, s) is not None
+                    and state_extreme(form, s, zero, 1)[0] == OPTIMAL):
+                out.append(s)
     return out
 
 
-def _seed_starts(form: Formulation, model: _Model, L: np.ndarray, sense: int
+def _seed_starts(form: Formulation, model: MilpModel, L: np.ndarray, sense: int
                  ) -> list[np.ndarray]:
     """MIP starts for one end: the extreme of L over each seed state set (a linear program),
     where it is finite and its witness passes steady_check."""

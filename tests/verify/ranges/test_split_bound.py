@@ -1,0 +1,127 @@
+"""verify.ranges.split (a certified lower bound by a case split on contact states, plane
+contacts first) against the big-M MILP's proved ends on small systems:
+
+* with the target at the proved end, every case closes and the bound equals the end (to the
+  rounding margin): never above it;
+* with the target above the end, the case holding the optimum never closes, and the bound
+  stays at or below the end (a bound, whatever the time limit);
+* the root case's bound (no state fixed) is below every end.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidlcp import models
+from rigidlcp.verify.ranges import steady_ranges
+from rigidlcp.verify.ranges.cap_split import cap_contacts, cap_split_bound
+from rigidlcp.verify.ranges.milp import MilpModel
+from rigidlcp.verify.ranges.observables import mu_g_vector
+from rigidlcp.verify.ranges.split import case_bound, split_bound
+from rigidlcp.verify.ranges.steady import formulate
+
+SYSTEMS = [(models.rectangular(3, 2), 0.16), (models.triangular(3, 2), 0.16),
+           (models.rectangular(2, 1), -0.1)]
+
+
+def _ends(lattice, gamma):
+    system = models.System(lattice, mu_pp=0.1, mu_plane=0.2, mu_wall=0.0, gamma=gamma)
+    r = steady_ranges(system, which="mu_g", time_limit=60, kinematics="big-M").mu_g
+    assert r.lo.status == r.hi.status == "optimal"
+    form = formulate(system)
+    model = MilpModel(form)
+    L = np.zeros(model.n)
+    L[:2 * system.c] = mu_g_vector(system)
+    return model, L, float(r.lo.value), float(r.hi.value)
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS)
+def test_split_bound_closes_at_the_big_M_end(lattice, gamma):
+    model, L, lo, hi = _ends(lattice, gamma)
+    for cost, end in ((L, lo), (-L, -hi)):
+        res = split_bound(model, cost, end, time_limit=60)
+        assert res.closed, res
+        assert res.bound <= end + 1e-12
+        assert res.bound >= end - 1e-8 * max(1.0, abs(end))
+        assert case_bound(model, cost, {})[0] <= end + 1e-12
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS)
+def test_split_bound_never_passes_the_end(lattice, gamma):
+    model, L, lo, hi = _ends(lattice, gamma)
+    for cost, end in ((L, lo), (-L, -hi)):
+        res = split_bound(model, cost, end + 0.05, time_limit=5)
+        assert not res.closed
+        assert res.bound <= end + 1e-12
+
+
+# --- verify.ranges.cap_split: the case split on the cap contacts with a_t = 0 ---------------
+
+def _witnesses(system):
+    r = steady_ranges(system, which="alpha", time_limit=60, kinematics="big-M")
+    return r, [e.witness for rg in r.ranges.values() for e in (rg.lo, rg.hi)
+               if e.witness is not None and e.witness.residual <= 1e-8]
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS)
+def test_cap_split_facts_hold_on_valid_steady_states(lattice, gamma):
+    """(a) and (c) of cap_split's docstring on every witness (checked valid steady states; the
+    alpha ends put disks at the cap, so (c) is met with Z nonempty), computed here from
+    models.Dynamics: a_t = H nu' + u_obs'."""
+    system = models.System(lattice, mu_pp=0.1, mu_plane=0.2, mu_wall=0.0, gamma=gamma)
+    form = formulate(system)
+    caps = cap_contacts(form)
+    assert caps is not None
+    beta, disk, eps, M = caps
+    assert M == pytest.approx(abs(gamma))
+    dyn, c, r = form.dyn, system.c, system.lattice.radius
+    _, wits = _witnesses(system)
+    met = 0
+    for w in wits:
+        lam = np.concatenate([w.R, w.S])
+        a_t = (dyn.H @ dyn.accelerations(lam) + dyn.u_obs_dot)[c:][beta]
+        b = np.asarray(dyn.u_obs_dot)[c:][beta]
+        z = np.abs(a_t) <= 1e-9
+        scale = max(1.0, float(np.max(np.abs(lam))))
+        # (a) off Z: sliding with s = sgn b
+        np.testing.assert_allclose(w.S[beta][~z], -np.sign(b[~z]) * 0.2 * w.R[beta][~z],
+                                   atol=1e-8 * scale)
+        if z.any():
+            met += 1
+            I = 1.0 / dyn.Minv[2 * system.p:]
+            lhs = -float(np.sum(np.sign(b[z]) * w.S[beta][z]))
+            rhs = M * float(np.sum(I[np.unique(disk[z])] / r ** 2))
+            assert lhs >= rhs - 1e-8 * scale
+    assert met > 0
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS)
+def test_cap_split_bound_below_the_big_M_end(lattice, gamma):
+    model, L, lo, hi = _ends(lattice, gamma)
+    system = model.form.system
+    res = cap_split_bound(model.form, mu_g_vector(system))
+    assert res is not None and res.cases == 2 ** len(cap_contacts(model.form)[0])
+    assert res.bound <= lo + 1e-12
+    assert np.isfinite(res.bound)
+
+
+@pytest.mark.parametrize("lattice, gamma", SYSTEMS[:2])
+def test_open_ends_get_proved_bounds_around_the_big_M_ends(lattice, gamma):
+    """Ends left undecided (here made so) get bounds that contain the big-M MILP's ends; with
+    no witness they stay undecided, and the JSON's "bounds" carries them (null stays in
+    "mu_g")."""
+    from rigidlcp.verify.ranges import End, Range
+    from rigidlcp.verify.ranges.cap_split import bound_open_ends
+    from rigidlcp.verify.ranges.valid_steady import SteadyRanges
+
+    model, L, lo, hi = _ends(lattice, gamma)
+    form = model.form
+    rg = {"mu_g": Range("mu_g", End("time limit"), End("time limit"))}
+    bound_open_ends(form, rg, {"mu_g": mu_g_vector(form.system)})
+    e_lo, e_hi = rg["mu_g"].lo, rg["mu_g"].hi
+    assert e_lo.status == e_hi.status == "time limit"
+    assert e_lo.bound <= lo + 1e-12 and e_hi.bound >= hi - 1e-12
+    d = SteadyRanges(form.system, rg, form.U, form.box_proved, form.V_mode, 0.0).to_dict()
+    assert d["steady"]["mu_g"] == [None, None]
+    assert d["steady"]["bounds"]["mu_g"] == [e_lo.bound, e_hi.bound]

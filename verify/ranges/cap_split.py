@@ -1,0 +1,189 @@
+"""A proved lower bound of an observable of S (mu_g) over the valid steady states, by a case
+split on which *cap contacts* have a_t = 0 (`cap_split_bound`).
+
+Setting (verify.ranges.bounds.rotation_cap): with no translation a_t = T_u ra + b (ra = r alpha),
+ra = D T_u^T S (D = r^2 / I), T_u's frictional rows of one or two entries +-1 of one sign,
+b = 0 on two-disk rows, and every valid steady state has |ra_i| <= M* = max |b| over the
+one-disk frictional contacts. Cap contacts: the one-disk frictional contacts beta with
+|b_beta| = M* (the plane, b = -gamma, on Fig. 9's system), eps_beta their T_u entry, i(beta)
+their disk. On every valid steady state, for Z = {cap contacts with a_t = 0}:
+
+(a) beta not in Z: a_t = eps ra_i + b != 0 has the sign of b (|eps ra_i| <= |b|), so the contact
+    slides with s = sgn b (a non-sliding one has a_t = 0; a sliding one s a_t >= 0):
+    S_beta = -sgn(b) mu R_beta.
+(b) beta in Z: ra_i = -b / eps (linear), so |ra_i| = M*: the disk attains the cap.
+(c) Z nonempty: with K = {i: |ra_i| = M*} (it holds the disks of Z) and sigma_i = sgn ra_i,
+    Phi = sum_K sigma_i ra_i / D_i = M* sum_K 1/D_i, and Phi = sum_K sigma_i (T_u^T S)_i is, as
+    in rotation_cap's proof, a sum of terms <= 0 (S a_t <= 0 on every contact of a valid steady
+    state, the larger |ra| deciding sgn a_t) except those of the contacts of Z, whose term is
+    sigma_i eps_beta S_beta = -sgn(b_beta) S_beta (a cap contact of a disk of K not in Z has
+    a_t = 2 eps sigma_i M*: its term is <= 0). Hence
+        -sum_{beta in Z} sgn(b_beta) S_beta >= M* sum_{i in disks(Z)} 1 / D_i.
+
+Each Z gives a linear program: the relaxation P of verify.ranges.bounds (a_n = 0, no
+translation, R >= 0, |S| <= mu R, S = 0 where mu = 0, |ra| <= M*) with (a), (b), (c), over the
+proved force box (R <= R_hi, |S| <= S_abs: valid for observables of S). Its minimum is bounded
+by the certified Lagrangian bound (verify.ranges.milp.certified_result), an empty case is
+closed only by a checked Farkas ray, and the least bound over all 2^|cap| cases (they cover
+every valid steady state) is a lower bound over every valid steady state.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from itertools import product
+
+import numpy as np
+import scipy.sparse as sp
+
+from rigidlcp.verify.certificates.uniqueness import quiet_highs
+
+from .bounds import rotation_cap
+from .milp import certified_result
+from .observables import alpha_rows
+from .result import OPTIMAL, TIME_LIMIT
+from .steady import Formulation, _equalities, velocity_box
+
+#: At most this many cap contacts (2^n linear programs).
+MAX_CAP = 16
+
+
+@dataclass
+class CapSplitBound:
+    """bound: proved lower bound of L . x over every valid steady state; worst: the Z (cap
+    contact indices) whose case gives it; cases, empty: the cases solved, those proved empty."""
+
+    bound: float
+    worst: tuple[int, ...]
+    cases: int
+    empty: int
+    seconds: float
+
+
+def cap_contacts(form: Formulation) -> tuple[np.ndarray, np.ndarray, np.ndarray, float] | None:
+    """(cap contacts beta, their disks i, their eps, M*) or None when the rotation cap does not
+    apply or no cap contact exists (module docstring)."""
+    system, dyn = form.system, form.dyn
+    M = rotation_cap(system, dyn)
+    if M is None or M <= 0:
+        return None
+    T_u, _, _ = velocity_box(dyn)
+    b = np.asarray(dyn.u_obs_dot, float)[system.c:]
+    beta, disk, eps = [], [], []
+    for a in np.flatnonzero(system.mu > 0):
+        nz = np.flatnonzero(T_u[a])
+        if nz.size == 1 and abs(abs(b[a]) - M) <= 1e-12 * M:
+            beta.append(a)
+            disk.append(int(nz[0]))
+            eps.append(float(T_u[a, nz[0]]))
+    if not beta:
+        return None
+    return np.array(beta), np.array(disk), np.array(eps), float(M)
+
+
+def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
+    """min over the cases Z of the certified bound of min L . x (module docstring); None when
+    it does not apply (no proved force box, no rotation cap, no cap contact, more than
+    MAX_CAP cap contacts, or L weighs an R whose bound is not proved)."""
+    import highspy
+
+    t0 = time.perf_counter()
+    system, dyn = form.system, form.dyn
+    c, p, mu, r = system.c, system.p, system.mu, system.lattice.radius
+    L = np.asarray(L, float)
+    caps = cap_contacts(form)
+    if caps is None or form.R_hi is None or not form.proved_for(L):
+        return None
+    beta, disk, eps, M = caps
+    if beta.size > MAX_CAP:
+        return None
+    b = np.asarray(dyn.u_obs_dot, float)[c:]
+    D = r * r * dyn.Minv[2 * p:]
+    ra = r * alpha_rows(system, dyn)  # r alpha = ra @ x
+    E, e = _equalities(dyn)
+    fr = np.flatnonzero(mu > 0)
+    I2 = np.eye(2 * c)
+    base = [E, mu[fr, None] * I2[fr] - I2[c + fr], mu[fr, None] * I2[fr] + I2[c + fr], ra]
+    base_lo = np.r_[e, np.zeros(2 * fr.size), np.full(p, -M)]
+    base_hi = np.r_[e, np.full(2 * fr.size, np.inf), np.full(p, M)]
+    lb = form.lb[:2 * c].copy()
+    ub = form.ub[:2 * c].copy()
+    with quiet_highs():
+        h = highspy.Highs()
+    for key, value in (("output_flag", False), ("primal_feasibility_tolerance", 1e-10),
+                       ("dual_feasibility_tolerance", 1e-10)):
+        h.setOptionValue(key, value)
+    n = beta.size
+    rows_a = mu[beta, None] * np.sign(b[beta])[:, None] * I2[beta] + I2[c + beta]  # (a)
+    rows_b = eps[:, None] * ra[disk]  # (b)
+    Ad = np.vstack([*base, rows_a, rows_b, np.zeros((1, 2 * c))])  # last: (c), per case
+    ia, ib, ic = Ad.shape[0] - 2 * n - 1, Ad.shape[0] - n - 1, Ad.shape[0] - 1
+    row_lo = np.r_[base_lo, np.zeros(n), -b[beta], -np.inf]
+    row_hi = np.r_[base_hi, np.zeros(n), -b[beta], np.inf]
+    _load(h, highspy, L, Ad, row_lo, row_hi, lb, ub)
+    free = np.full(n, np.inf)
+    best, worst, cases, empty = np.inf, (), 0, 0
+    for z in product((False, True), repeat=n):
+        z = np.array(z)
+        row_lo[ia:ia + n] = np.where(z, -free, 0.0)
+        row_hi[ia:ia + n] = np.where(z, free, 0.0)
+        row_lo[ib:ib + n] = np.where(z, -b[beta], -free)
+        row_hi[ib:ib + n] = np.where(z, -b[beta], free)
+        Ad[ic, c + beta] = np.where(z, -np.sign(b[beta]), 0.0)
+        row_lo[ic] = M * float(np.sum(1.0 / D[np.unique(disk[z])])) if z.any() else -np.inf
+        idx = np.arange(ia, ic + 1, dtype=np.int32)
+        h.changeRowsBounds(idx.size, idx, row_lo[idx], row_hi[idx])
+        for k in range(n):
+            h.changeCoeff(ic, int(c + beta[k]), float(Ad[ic, c + beta[k]]))
+        with quiet_highs():
+            h.run()
+        if h.getModelStatus() not in (highspy.HighsModelStatus.kOptimal,
+                                      highspy.HighsModelStatus.kInfeasible):
+            h.clearSolver()  # warm start in trouble: once more from scratch
+            with quiet_highs():
+                h.run()
+        bound = certified_result(h, highspy, L, sp.csr_matrix(Ad), row_lo, row_hi, lb, ub)[0]
+        cases += 1
+        empty += bound == np.inf
+        if bound < best:
+            best, worst = bound, tuple(int(beta[k]) for k in np.flatnonzero(z))
+    return CapSplitBound(float(best), worst, cases, empty, time.perf_counter() - t0)
+
+
+def _load(h, hs, cost, A, row_lo, row_hi, lb, ub) -> None:
+    """Pass the LP min cost.x, row_lo <= A x <= row_hi, lb <= x <= ub to the instance h."""
+    lp = hs.HighsLp()
+    Ac = sp.csc_matrix(A)
+    lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
+    lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, lb, ub
+    lp.row_lower_, lp.row_upper_ = row_lo, row_hi
+    lp.a_matrix_.format_ = hs.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+        Ac.indptr, Ac.indices, Ac.data)
+    h.passModel(lp)
+
+
+def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray]) -> None:
+    """Give each end left at the time limit the proved bound of `cap_split_bound` (End.bound,
+    and a note), where it applies; an end whose best value met attains it is decided."""
+    for name, L in obs.items():
+        for side, sense in (("lo", 1.0), ("hi", -1.0)):
+            end = getattr(ranges[name], side)
+            if end.status != TIME_LIMIT:
+                continue
+            res = cap_split_bound(form, sense * L)
+            if res is None or not np.isfinite(res.bound):
+                continue
+            end.bound = sense * res.bound
+            end.seconds += res.seconds
+            how = (f"proved {'>=' if sense > 0 else '<='} {end.bound:.10g} by the case split on "
+                   f"the cap contacts with a_t = 0 ({res.cases} certified LPs, "
+                   f"{res.empty} empty)")
+            if end.best is not None and end.witness is not None and (
+                    sense * end.best <= res.bound + 1e-9 * max(1.0, abs(res.bound))):
+                end.status, end.value = OPTIMAL, end.best
+                end.note = f"{how}; attained by the witness"
+            else:
+                met = "" if end.best is None else f"; best met {end.best:.10g}"
+                end.note = f"{'min' if sense > 0 else 'max'} not decided: {how}{met}"

@@ -1,0 +1,216 @@
+"""The MILP of verify.ranges.steady in HiGHS, re-solved with new costs, and its linear
+relaxation with a *certified* lower bound (used by verify.ranges.valid_steady to decide an end
+without branching when a checked valid steady state attains the relaxation's bound).
+
+Certificate. The MILP is min c.x over lo <= A x <= hi, lb <= x <= ub, binaries. For any row
+multipliers y (here HiGHS's duals of the relaxation, either sign convention), weak duality of
+the Lagrangian gives, for every x of the box with lo <= A x <= hi (so for every point of the
+MILP),
+
+    c.x = (c - A^T y).x + y.(A x) >= sum_j min(d_j lb_j, d_j ub_j) + sum_i min(y_i lo_i, y_i hi_i),
+
+d = c - A^T y, each term taken on the finite side (a multiplier whose side is infinite is set
+to 0 first, which keeps the inequality). Every column of the formulation is boxed (forces by
+the proved bounds, r alpha by the rotation cap, velocities by the velocity box, binaries in
+[0, 1]), so the bound is finite; it is evaluated here in numpy, independently of HiGHS's claim
+of optimality, and lowered by a rounding margin.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from rigidlcp.verify.certificates.uniqueness import quiet_highs
+
+from .kinematics import realizable
+from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
+from .steady import Formulation, states_of
+
+#: Contact-state sets kept as seeds (MilpModel.add_seed).
+MAX_SEEDS = 10
+
+
+def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,
+                     lb: np.ndarray, ub: np.ndarray, y: np.ndarray) -> float:
+    """The certified lower bound of the module docstring for the multipliers y (-inf if a
+    needed column bound is infinite)."""
+    y = np.where(((y > 0) & ~np.isfinite(lo)) | ((y < 0) & ~np.isfinite(hi)), 0.0, y)
+    row = np.where(y > 0, y * np.where(np.isfinite(lo), lo, 0.0),
+                   y * np.where(np.isfinite(hi), hi, 0.0))
+    d = c - A.T @ y
+    need = np.where(d > 0, lb, ub)
+    if np.any((d != 0) & ~np.isfinite(need)):
+        return -np.inf
+    col = np.where(d != 0, d * np.where(np.isfinite(need), need, 0.0), 0.0)
+    total = float(np.sum(row) + np.sum(col))
+    margin = 1e-12 * float(np.sum(np.abs(row)) + np.sum(np.abs(col))) + 1e-15
+    return total - margin
+
+
+def certified_result(h, hs, cost: np.ndarray, A: sp.csr_matrix, lo: np.ndarray,
+                     hi: np.ndarray, lb: np.ndarray, ub: np.ndarray
+                     ) -> tuple[float, np.ndarray | None]:
+    """(a certified lower bound of cost.x over lo <= A x <= hi, lb <= x <= ub, the LP's point
+    or None) from a HiGHS instance `h` just run on that LP: the Lagrangian bound of its duals
+    (either sign); +inf when infeasible and its dual ray, checked, proves it (a Lagrangian
+    bound > 0 for the zero cost); -inf when neither is available."""
+    st = h.getModelStatus()
+    if st == hs.HighsModelStatus.kOptimal:
+        y = np.asarray(h.getSolution().row_dual, float)
+        b = max(lagrangian_bound(cost, A, lo, hi, lb, ub, y),
+                lagrangian_bound(cost, A, lo, hi, lb, ub, -y))
+        return b, np.asarray(h.getSolution().col_value, float)
+    if st == hs.HighsModelStatus.kInfeasible:
+        _, has, ray = h.getDualRay()
+        if has:
+            ray, zero = np.asarray(ray, float), np.zeros(A.shape[1])
+            if max(lagrangian_bound(zero, A, lo, hi, lb, ub, ray),
+                   lagrangian_bound(zero, A, lo, hi, lb, ub, -ray)) > 0:
+                return np.inf, None
+    return -np.inf, None
+
+
+class MilpModel:
+    """The MILP of a Formulation in one HiGHS instance, and its relaxation in another.
+
+    kinematics "lazy" (default): the MILP drops the velocities' big-M rows (a relaxation) and
+    each optimum's contact states are checked by verify.ranges.kinematics; a set the
+    velocities do not admit is cut off (the states of its negative cycle cannot all hold) and
+    the MILP solved again, until the optimum's states are admitted: then it is the optimum
+    over every valid steady state. "big-M": the velocity rows stay (module steady)."""
+
+    def __init__(self, form: Formulation, kinematics: str = "lazy"):
+        import highspy
+
+        if kinematics not in ("lazy", "big-M"):
+            raise ValueError(f"kinematics must be 'lazy' or 'big-M', got {kinematics!r}")
+        A = sp.csc_matrix(form.A)
+        self.A, self.form, self.lazy = sp.csr_matrix(form.A), form, kinematics == "lazy"
+        self.hs, self.n = highspy, A.shape[1]
+        self.cuts = 0
+        F = form.fric.size
+        self.base = 2 * form.system.c + 2 * form.system.p + 1  # y+ at base + k, y- base + F + k
+        self.fpos = {int(a): k for k, a in enumerate(form.fric)}
+        self.F = F
+
+        def model(integer: bool):
+            lp = highspy.HighsLp()
+            lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
+            lp.col_cost_ = np.zeros(A.shape[1])
+            lp.col_lower_, lp.col_upper_ = form.lb, form.ub
+            lo = np.array(form.lo, float)
+            if integer and self.lazy:
+                lo[form.v_rows[0]:form.v_rows[1]] = -np.inf
+            lp.row_lower_, lp.row_upper_ = lo, form.hi
+            lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+            lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+                A.indptr, A.indices, A.data)
+            if integer:
+                lp.integrality_ = [highspy.HighsVarType.kInteger if v else
+                                   highspy.HighsVarType.kContinuous for v in form.integrality]
+            with quiet_highs():
+                h = highspy.Highs()
+            for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
+                               ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
+                               ("primal_feasibility_tolerance", 1e-9),
+                               ("dual_feasibility_tolerance", 1e-9)):
+                h.setOptionValue(key, value)
+            h.passModel(lp)
+            return h
+
+        self.h, self.lp = model(True), model(False)
+        self.starts: list[np.ndarray] = []
+        self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
+
+    def add_seed(self, s: np.ndarray) -> None:
+        """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
+        s = np.asarray(s, dtype=int)
+        self.seeds = [t for t in self.seeds if not np.array_equal(t, s)] + [s]
+        del self.seeds[:-MAX_SEEDS]
+
+    def relaxation_bound(self, cost: np.ndarray) -> float:
+        """A certified lower bound of cost.x over the MILP (module docstring); -inf if the
+        relaxation fails."""
+        h, hs = self.lp, self.hs
+        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        with quiet_highs():
+            h.run()
+        if h.getModelStatus() != hs.HighsModelStatus.kOptimal:
+            h.clearSolver()
+            with quiet_highs():
+                h.run()
+            if h.getModelStatus() != hs.HighsModelStatus.kOptimal:
+                return -np.inf
+        y = np.asarray(h.getSolution().row_dual, float)
+        f = self.form
+        return max(lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, y),
+                   lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, -y))
+
+    def cut(self, s: np.ndarray, contacts: list[int]) -> None:
+        """Forbid the states s on `contacts` together: sum of their indicators <= |C| - 1
+        (indicator of +1: y+, of -1: y-, of 0: 1 - y+ - y-)."""
+        idx, val, rhs = [], [], len(contacts) - 1.0
+        for a in contacts:
+            k = self.fpos[int(a)]
+            if s[a] > 0:
+                idx, val = idx + [self.base + k], val + [1.0]
+            elif s[a] < 0:
+                idx, val = idx + [self.base + self.F + k], val + [1.0]
+            else:
+                idx, val = idx + [self.base + k, self.base + self.F + k], val + [-1.0, -1.0]
+                rhs -= 1.0
+        self.h.addRow(-np.inf, rhs, len(idx), np.array(idx, dtype=np.int32),
+                      np.array(val, float))
+        self.cuts += 1
+
+    def solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
+              ) -> tuple[str, np.ndarray | None]:
+        """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
+        extra: MIP starts for this objective only. Lazy: the point's contact states are
+        admitted by the velocities (else it is None)."""
+        if not self.lazy:
+            return self._solve(cost, time_limit, extra)
+        t0 = time.perf_counter()
+        while True:
+            left = time_limit - (time.perf_counter() - t0)
+            if left <= 0:
+                return TIME_LIMIT, None
+            st, x = self._solve(cost, left, extra)
+            if x is None:
+                return st, None
+            s = states_of(self.form, x)
+            ok, info = realizable(self.form, s)
+            if ok:
+                return st, x
+            self.cut(s, info)
+            if st != OPTIMAL:
+                return st, None
+
+    def _solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
+               ) -> tuple[str, np.ndarray | None]:
+        h, hs = self.h, self.hs
+        h.clearSolver()
+        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        h.setOptionValue("time_limit", float(time_limit))
+        starts = [*self.starts, *extra]
+        # the best valid state as the MIP start (a later setSolution replaces an earlier one)
+        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
+            sol = hs.HighsSolution()
+            sol.col_value = list(x)
+            sol.value_valid = True
+            h.setSolution(sol)
+        with quiet_highs():
+            h.run()
+        st = h.getModelStatus()
+        has_x = h.getInfo().primal_solution_status == 2
+        x = np.asarray(h.getSolution().col_value) if has_x else None
+        if st == hs.HighsModelStatus.kOptimal:
+            return OPTIMAL, x
+        if st == hs.HighsModelStatus.kInfeasible:
+            return INFEASIBLE, None
+        if st == hs.HighsModelStatus.kTimeLimit:
+            return TIME_LIMIT, x
+        return "failed", x
