@@ -2,12 +2,11 @@
 
 `analyse(system)` answers, each answer checked in code:
 
-* exists: a lambda in P (checked against P), or a Farkas certificate that P is empty: virtual
-  velocities y of the disks whose relative velocities H y lie in the dual cone of every
-  contact ({a_n >= mu |a_t|}) while gravity does positive work, -b . y > 0. For any lambda in P,
-  -b . y = -lambda . H y <= max(v) sum R (v: the violations of the dual cone, checked in floating
-  point), so no admissible lambda has sum R < radius = (-b . y) / max(v); the certificate is
-  accepted when radius exceeds 1e9 times the packing's weight.
+* exists: a lambda in P (checked against P), or a Farkas certificate that P is empty (virtual
+  velocities under which every contact opens or slides within its cone while gravity does
+  work), checked in floating point with a radius or in exact rational arithmetic
+  (verify.statics.farkas); when neither passes, exists is None (undecided, with the reason),
+  never a guess.
 * dimension: of P itself, i.e. of its affine hull. An inequality of P that holds with equality
   on all of P (an implicit equality: R = 0, S = mu R or S = -mu R on the whole set) is found
   by linear programs maximizing slacks t_k in [0, scale] of the undecided rows (a row whose
@@ -38,10 +37,9 @@ from scipy.optimize import linprog
 
 from rigidlcp import models
 
+from .farkas import farkas
 from .model import LP_TOL, ForceLP, StaticProblem, interior_point
 
-#: A Farkas certificate must exclude every equilibrium with sum R below this many weights.
-RADIUS_WEIGHTS = 1e9
 #: A slack or a force below this times the largest disk weight is zero.
 ZERO = 1e-9
 #: Largest number of unknowns whose rank is computed (dense SVD).
@@ -54,7 +52,7 @@ class ForceSet:
     implicit[alpha]: "R=0", "S=+muR", "S=-muR" or "" (no implicit equality); sliding (c,)."""
 
     system: models.System
-    exists: bool
+    exists: bool | None  # None: undecided (`undecided` says why)
     solution: np.ndarray | None = None
     certificate: np.ndarray | None = None
     radius: float | None = None
@@ -67,6 +65,8 @@ class ForceSet:
     unchecked: int = 0  # LP optima that failed the check against P (none expected)
     residuals: tuple[float, float] = (0.0, 0.0)  # of `solution`: balance, laws (force units)
     lps: int = 0
+    exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
+    undecided: str = ""
 
     @property
     def c(self) -> int:
@@ -98,7 +98,10 @@ class ForceSet:
                                           "plane": self.system.mu_plane,
                                           "wall": self.system.mu_wall}}
         if not self.exists:
-            out["farkas_radius"] = self.radius
+            out["farkas_radius"] = None if self.radius == np.inf else self.radius
+            out["farkas_exact"] = self.exact
+            if self.exists is None:
+                out["undecided"] = self.undecided
             out["contacts"] = [{"i": int(i), "j": int(j), "R": None, "S": None}
                                for i, j in zip(lat.i, lat.j)]
             return out
@@ -140,11 +143,13 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
         lp = ForceLP(prob)
         status, lam = lp.solve(np.zeros(prob.n))
         if status != "optimal" or not prob.admissible(lam):
-            y, radius = farkas(prob)
-            if y is None:
-                raise RuntimeError(f"equilibrium LP {status} and no Farkas certificate found "
-                                   "(please report)")
-            return ForceSet(system, False, certificate=y, radius=radius, lps=3)
+            cert = farkas(prob)
+            if not cert.proves:  # neither a checked solution nor a checked certificate
+                return ForceSet(system, None, radius=cert.radius, lps=3,
+                                undecided=f"equilibrium LP {status}; Farkas certificate "
+                                f"not proved (radius {cert.radius:.3g} weights' units)")
+            return ForceSet(system, False, certificate=cert.y, radius=cert.radius, lps=3,
+                            exact=cert.exact)
     witness = lam
     if interior and max(prob.residuals(lam)) > 1e-12 * prob.scale:
         # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
@@ -160,27 +165,6 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     if ranges:
         _ranges(prob, lp or ForceLP(prob), fs, progress)
     return fs
-
-
-def farkas(prob: StaticProblem) -> tuple[np.ndarray | None, float | None]:
-    """y (3p) with H y in the dual cone and b . y < 0, checked (module docstring), or None."""
-    c, mu = prob.c, prob.mu
-    H = sp.csr_matrix(prob.A.T)
-    Hn, Ht = H[:c], H[c:]
-    fr = mu > 0
-    rows = [-Hn + sp.diags(mu) @ Ht, (-Hn - sp.diags(mu) @ Ht)[fr]]
-    res = linprog(prob.b, A_ub=sp.vstack(rows, format="csr"),
-                  b_ub=np.zeros(c + int(fr.sum())), bounds=(-1, 1), method="highs")
-    if res.status != 0 or res.fun >= 0:
-        return None, None
-    y = res.x
-    g = H @ y
-    v = np.where(fr, mu * np.abs(g[c:]) - g[:c], -g[:c])
-    gap = -float(prob.b @ y)
-    worst = float(np.max(v, initial=0.0))
-    radius = np.inf if worst <= 0 else gap / worst
-    weight = float(np.sum(prob.system.masses)) * prob.system.g
-    return (y, radius) if gap > 0 and radius >= RADIUS_WEIGHTS * weight else (None, None)
 
 
 def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> list[str]:

@@ -218,3 +218,51 @@ def test_ranges_and_sliding_against_linprog_on_the_rows_form(seed, mu):
                 res = opt(e, A_eq, np.r_[prob.b, 0.0])
                 can |= res.status == 3 or (res.status == 0 and res.x[a] > 1e-9 * prob.scale)
         assert bool(fs.sliding[a]) == can, a
+
+
+# Piles on which HiGHS found P empty but the Farkas y it returned failed the floating-point
+# check (cone rows violated at its tolerance, ~2e-11, capping the radius near 1e10 weights):
+# `analyse` raised. Found by a scan of 40-disk piles and by the deep hypothesis profile.
+NEAR_MISSES = [(40, 2, (0.8, 1.2), 10.0, 0.3), (7, 1737, (1.0, 1.0894363145159462), 6.0, 0.4)]
+
+
+@pytest.mark.parametrize("n, seed, radii, width, mu", NEAR_MISSES)
+def test_farkas_certificate_where_the_lp_y_fails_the_float_check(n, seed, radii, width, mu):
+    """Both the polished float certificate (what `analyse` returns) and the exact rational
+    one from the LP's raw y prove P empty; scipy's linprog on the rows form agrees."""
+    from rigidlcp.verify.statics.farkas import check, cone_rows, exact_certificate
+
+    system = models.System(deposit(n, seed=seed, radii=radii, width=width), mu_pp=mu,
+                           mu_plane=mu, mu_wall=mu)
+    fs = analyse(system)
+    assert fs.exists is False and fs.radius >= 1e9 * float(np.sum(system.masses))
+    prob = StaticProblem(system)
+    g = prob.A.T @ fs.certificate  # H y: every contact opens or stays inside its cone
+    c = prob.c
+    v = np.where(prob.mu > 0, prob.mu * np.abs(g[c:]) - g[:c], -g[:c])
+    assert prob.b @ fs.certificate < 0 and np.max(v) <= 1e-13
+    C = cone_rows(prob)
+    raw = linprog(prob.b, A_ub=C, b_ub=np.zeros(C.shape[0]), bounds=(-1, 1), method="highs")
+    assert not check(prob, raw.x).proves  # the raw y alone: the float check says no
+    exact = exact_certificate(prob, raw.x)
+    assert exact is not None and exact.exact and exact.radius == np.inf and exact.gap > 0
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+    rows = linprog(np.zeros(prob.n), A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
+                   b_eq=prob.b, bounds=bounds, method="highs")
+    assert rows.status == 2  # infeasible
+    assert json.loads(json.dumps(fs.to_dict(), allow_nan=False))["exists"] is False
+
+
+def test_exact_farkas_check_refuses_a_pile_with_an_equilibrium():
+    """On a pile with a checked equilibrium no y passes the exact check (it would prove P
+    empty): random virtual velocities and the corner disk's."""
+    from rigidlcp.verify.statics.farkas import exact_certificate
+
+    system = models.System(deposit(12, seed=1, radii=(0.8, 1.2), width=6.0), mu_pp=0.5,
+                           mu_plane=0.5, mu_wall=0.5)
+    assert analyse(system, ranges=False).exists
+    prob = StaticProblem(system)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        assert exact_certificate(prob, rng.standard_normal(3 * prob.p)) is None
