@@ -170,7 +170,7 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
 def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> list[str]:
     """Per contact: "R=0", "S=+muR", "S=-muR" or "" (module docstring). x: a point of P
     near its relative interior, if one is known (else one is computed)."""
-    c, k = prob.c, prob.fric.size
+    c = prob.c
     # inequality rows: -R <= 0 (c), then S - mu R <= 0 and -S - mu R <= 0 (k each)
     Gi = sp.vstack([-sp.eye(c, prob.n), prob.G], format="csr")
     m = Gi.shape[0]
@@ -202,6 +202,14 @@ def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> lis
         if not new.any():
             break
         undecided &= ~new
+    return labels(prob, undecided)
+
+
+def labels(prob: StaticProblem, undecided: np.ndarray) -> list[str]:
+    """Per contact, the strongest implicit equality among the rows left `undecided` (no slack
+    found: -R <= 0 for the c contacts, then S - mu R <= 0 and -S - mu R <= 0 for the k
+    frictional ones): "R=0" (implies S = +-mu R = 0), "S=+muR", "S=-muR" or ""."""
+    c, k = prob.c, prob.fric.size
     out = [""] * c
     for a in range(c):
         if undecided[a]:
@@ -209,11 +217,29 @@ def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> lis
     for n, a in enumerate(prob.fric):
         if out[a]:
             continue
-        if undecided[c + n]:
-            out[a] = "S=+muR"
-        elif undecided[c + k + n]:
-            out[a] = "S=-muR"
+        plus, minus = undecided[c + n], undecided[c + k + n]
+        # S = mu R and S = -mu R both on all of P give 2 mu R = 0: R = 0 (which implies both)
+        if (plus and minus) or ((plus or minus) and not _positive_R(prob, a)):
+            out[a] = "R=0"
+        elif plus or minus:
+            out[a] = "S=+muR" if plus else "S=-muR"
     return out
+
+
+def _positive_R(prob: StaticProblem, a: int) -> bool:
+    """Is R_a > 0 somewhere on P? One LP, max R_a, its optimum checked against P. The slack
+    LPs decide R_a >= 0 from points within the LP's tolerance of P, where R_a ~ 1e-9 can be
+    rounding on a set with R_a = 0 throughout (a 2-disk pile at mu 0.988 was labelled
+    "S=+muR" so); a contact labelled S = +-mu R must have a checked witness of R > 0."""
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+    cost = np.zeros(prob.n)
+    cost[a] = -1.0
+    res = linprog(cost, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A, b_eq=prob.b,
+                  bounds=bounds, method="highs")
+    if res.status == 3:  # unbounded: R_a takes every large value on P
+        return True
+    return bool(res.status == 0 and prob.admissible(res.x) and res.x[a] > ZERO * prob.scale)
 
 
 def reduced_balance(prob: StaticProblem, implicit: list[str]) -> sp.csc_matrix:

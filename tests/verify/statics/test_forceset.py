@@ -266,3 +266,37 @@ def test_exact_farkas_check_refuses_a_pile_with_an_equilibrium():
     rng = np.random.default_rng(0)
     for _ in range(5):
         assert exact_certificate(prob, rng.standard_normal(3 * prob.p)) is None
+
+
+@pytest.mark.parametrize("mu_wall", [0.5, 0.9, 0.988, 0.999])
+def test_corner_contact_without_force_is_labelled_R_zero(mu_wall):
+    """Case 1 below mu_wall = 1: R_w = S_w = 0 on all of P, so S_w = +mu R_w and S_w = -mu R_w
+    hold there too; the label must be the strongest, R = 0 (it implies the others), and the
+    dimension counts both unknowns as fixed (0 here)."""
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=mu_wall))
+    wall = int(np.flatnonzero(fs.system.lattice.j == LEFT_WALL)[0])
+    assert fs.implicit[wall] == "R=0" and fs.dimension == 0
+    _close(_range(fs, LEFT_WALL), (0, 0))
+    _close(_range(fs, LEFT_WALL, what="S"), (0, 0))
+
+
+def test_one_implicit_cone_row_with_R_zero_is_labelled_R_zero():
+    """The slack LPs decide rows from points within the LP's tolerance of P, where R ~ 1e-9 is
+    rounding: the deep hypothesis profile's 2-disk pile at mu 0.988 had R = 0 on all of P but
+    its R >= 0 row and one cone row decided so, and came out "S=+muR". The labels now ask a
+    checked optimum for R > 0 before saying S = +-mu R. Forced here on the corner disk (R_w = 0
+    on P): whichever single cone row is left undecided, the label is R = 0; at the plane
+    (R_p = 1 on P), an undecided cone row stays S = +-mu R."""
+    from rigidlcp.verify.statics.forceset import labels
+
+    prob = StaticProblem(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=0.9))
+    lat = prob.system.lattice
+    wall = int(np.flatnonzero(lat.j == LEFT_WALL)[0])
+    plane = int(np.flatnonzero(lat.j == PLANE)[0])
+    c, k = prob.c, prob.fric.size
+    for a, want in ((wall, "R=0"), (plane, None)):
+        n = int(np.flatnonzero(prob.fric == a)[0])
+        for row, kind in ((c + n, "S=+muR"), (c + k + n, "S=-muR")):
+            undecided = np.zeros(c + 2 * k, dtype=bool)
+            undecided[row] = True
+            assert labels(prob, undecided)[a] == (want or kind)
