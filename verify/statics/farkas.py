@@ -87,9 +87,11 @@ def farkas(prob: StaticProblem) -> Certificate:
     """A checked certificate that P is empty, or one with y None (no claim) carrying the best
     radius found (module docstring)."""
     C = cone_rows(prob)
-    res = linprog(prob.b, A_ub=C, b_ub=np.zeros(C.shape[0]), bounds=(-1, 1), method="highs",
-                  options={"primal_feasibility_tolerance": 1e-10,
-                           "dual_feasibility_tolerance": 1e-10})
+    # HiGHS's IPM with crossover (a vertex, as the polishing wants): 14x faster than its dual
+    # simplex on a 3000-disk pile (docs/packings.md, Scale)
+    res = linprog(prob.b, A_ub=C, b_ub=np.zeros(C.shape[0]), bounds=(-1, 1),
+                  method="highs-ipm", options={"primal_feasibility_tolerance": 1e-10,
+                                               "dual_feasibility_tolerance": 1e-10})
     if res.status != 0 or res.x is None or res.fun >= 0:
         return Certificate(None, 0.0, 0.0)
     best = check(prob, res.x)

@@ -136,14 +136,19 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     progress(done, total, stage): called as the LPs of the ranges are solved."""
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
-    lam = interior_point(prob, 1e3 * weight)  # fast, and a relative-interior witness
-    interior = lam is not None and prob.admissible(lam)
-    lp = None
+    # the IPM is fast, and its point a relative-interior witness; when it finds no point in
+    # its box, a Farkas certificate (one LP) usually settles existence before any simplex
+    status, lam = interior_point(prob, 1e3 * weight)
+    interior = status == "optimal" and prob.admissible(lam)
+    lp = cert = None
     if not interior:
-        lp = ForceLP(prob)
-        status, lam = lp.solve(np.zeros(prob.n))
-        if status != "optimal" or not prob.admissible(lam):
+        if status == "infeasible":
             cert = farkas(prob)
+        if cert is None or not cert.proves:
+            lp = ForceLP(prob)
+            status, lam = lp.solve(np.zeros(prob.n))
+        if cert is not None and cert.proves or status != "optimal" or not prob.admissible(lam):
+            cert = cert if cert is not None else farkas(prob)
             if not cert.proves:  # neither a checked solution nor a checked certificate
                 return ForceSet(system, None, radius=cert.radius, lps=3,
                                 undecided=f"equilibrium LP {status}; Farkas certificate "
@@ -179,7 +184,7 @@ def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> lis
     # One interior point settles most rows at once: a row with a clear positive slack at a
     # point of P is not an implicit equality; the slack LPs then decide only the rest.
     if x is None:
-        x = interior_point(prob, 1e3 * float(np.sum(prob.system.masses)) * prob.system.g)
+        x = interior_point(prob, 1e3 * float(np.sum(prob.system.masses)) * prob.system.g)[1]
     if x is not None:
         weight = float(np.sum(prob.system.masses)) * prob.system.g
         eq, viol = prob.residuals(x)
