@@ -287,7 +287,7 @@ def test_one_implicit_cone_row_with_R_zero_is_labelled_R_zero():
     checked optimum for R > 0 before saying S = +-mu R. Forced here on the corner disk (R_w = 0
     on P): whichever single cone row is left undecided, the label is R = 0; at the plane
     (R_p = 1 on P), an undecided cone row stays S = +-mu R."""
-    from rigidlcp.verify.statics.forceset import labels
+    from rigidlcp.verify.statics.hull import labels
 
     prob = StaticProblem(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=0.9))
     lat = prob.system.lattice
