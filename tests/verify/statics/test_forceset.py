@@ -173,7 +173,12 @@ def test_properties_on_deposited_packings(n, seed, mu, spread):
     for a, kind in enumerate(fs.implicit):  # R = 0 on all of P iff its range is {0}
         assert (kind == "R=0") == (fs.hi[a] <= 1e-9 * prob.scale), a
     rng = np.random.default_rng(seed)
-    assert _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng) == fs.dimension
+    rank = _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng)
+    if rank < fs.dimension:  # a lower bound: on an unbounded P most random vertices are the
+        # box's, and thin directions (widths ~1e-2 against a box of ~1e2) need more draws
+        # (the deep profile's 7-disk pile, seed 1737, mu 0.4375: 6 with 27 draws, 7 with 200)
+        rank = _affine_dimension(prob, fs, 30 * (fs.dimension + 2), rng)
+    assert rank == fs.dimension
 
 
 @pytest.mark.parametrize("seed, mu", [(1, 0.3), (3, 0.5), (5, 1.0), (2, 0.05)])
