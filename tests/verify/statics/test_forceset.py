@@ -135,13 +135,16 @@ def test_pyramid_without_walls_has_a_farkas_certificate():
 
 
 def _affine_dimension(prob: StaticProblem, fs, draws: int, rng) -> int:
-    """Rank of the differences of LP vertices of P inside a large box, for random costs: an
-    independent lower bound on dim P that reaches it for enough generic costs."""
+    """Rank of the differences of LP vertices of P inside a large box, for +-each coordinate
+    and `draws` random costs: an independent lower bound on dim P that reaches it for enough
+    generic costs."""
     big = 10.0 * (np.abs(fs.solution).max() + prob.scale * prob.p)
     bounds = [(max(lo, -big), min(hi, big)) for lo, hi in zip(prob.lb, prob.ub)]
     pts = []
-    for _ in range(draws):
-        res = linprog(rng.standard_normal(prob.n), A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]),
+    # the ends of every coordinate's range (in the box), then random costs
+    costs = [s * e for e in np.eye(prob.n) for s in (1.0, -1.0)]
+    for cost in costs + [rng.standard_normal(prob.n) for _ in range(draws)]:
+        res = linprog(cost, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]),
                       A_eq=prob.A, b_eq=prob.b, bounds=bounds, method="highs")
         assert res.status == 0
         pts.append(res.x)
@@ -173,12 +176,10 @@ def test_properties_on_deposited_packings(n, seed, mu, spread):
     for a, kind in enumerate(fs.implicit):  # R = 0 on all of P iff its range is {0}
         assert (kind == "R=0") == (fs.hi[a] <= 1e-9 * prob.scale), a
     rng = np.random.default_rng(seed)
-    rank = _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng)
-    if rank < fs.dimension:  # a lower bound: on an unbounded P most random vertices are the
-        # box's, and thin directions (widths ~1e-2 against a box of ~1e2) need more draws
-        # (the deep profile's 7-disk pile, seed 1737, mu 0.4375: 6 with 27 draws, 7 with 200)
-        rank = _affine_dimension(prob, fs, 30 * (fs.dimension + 2), rng)
-    assert rank == fs.dimension
+    # a lower bound: on an unbounded P many random vertices are the box's, and thin directions
+    # (widths ~1e-2 against a box of ~1e2) were missed by 3 (dim + 2) random costs alone (the
+    # deep profile's 7-disk pile, seed 1737, mu 0.4375: 6 with 27 draws, 7 with 200)
+    assert _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng) == fs.dimension
 
 
 @pytest.mark.parametrize("seed, mu", [(1, 0.3), (3, 0.5), (5, 1.0), (2, 0.05)])
