@@ -306,3 +306,16 @@ def test_one_implicit_cone_row_with_R_zero_is_labelled_R_zero():
             undecided = np.zeros(c + 2 * k, dtype=bool)
             undecided[row] = True
             assert labels(prob, undecided)[a] == (want or kind)
+
+
+def test_undecided_existence_is_reported_as_null_with_its_reason():
+    """When neither a checked point nor a checked certificate is found, the JSON says
+    "exists": null and why (no case of it is known; the contract is checked directly)."""
+    from rigidlcp.verify.statics.forceset import ForceSet
+
+    system = _system([[1.0, 1.0]], left=0.0)
+    fs = ForceSet(system, None, radius=12.5, undecided="equilibrium LP failed; Farkas "
+                  "certificate not proved (radius 12.5 weights' units)")
+    d = json.loads(json.dumps(fs.to_dict(), allow_nan=False))
+    assert d["exists"] is None and "not proved" in d["undecided"]
+    assert d["farkas_radius"] == 12.5 and d["contacts"][0]["R"] is None
