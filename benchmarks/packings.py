@@ -56,6 +56,8 @@ def main() -> int:
             system = models.System(pile, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
             fs, wall, cpu = _timed(lambda s=system, f=full: analyse(s, ranges=f))
             result = (f"exists, dim {fs.dimension}" if fs.exists else
+                      f"undecided ({fs.undecided})" if fs.exists is None else
+                      "no equilibrium (Farkas, exact)" if fs.exact else
                       f"no equilibrium (Farkas, radius {fs.radius:.2g})")
             if full and fs.exists:
                 result += f", {fs.lps} LPs, {int(fs.sliding.sum())} can slide"

@@ -65,8 +65,9 @@ def existence_table(lines: list[str]) -> None:
         yes = no = und = 0
         for s in seeds:
             fs = safe_analyse(system(deposit(n, seed=s, radii=RADII, width=w), mu))
-            yes, no, und = (yes + 1, no, und) if fs and fs.exists else (
-                (yes, no + 1, und) if fs else (yes, no, und + 1))
+            exists = None if fs is None else fs.exists  # None: undecided (no claim)
+            yes, no, und = (yes + (exists is True), no + (exists is False),
+                            und + (exists is None))
         lines.append(f"| {mu:g} | {yes} | {no} | {und} |")
     lines.append("")
 

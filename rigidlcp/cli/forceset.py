@@ -134,9 +134,13 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
     print(f"{lat.title()}: {lat.c} contacts ({report(lat).text()}); mu_pp = {args.mu_pp:g}, "
           f"mu_plane = {args.mu_plane:g}, mu_wall = {args.mu_wall:g}", file=sys.stdout)
     print(_box_line(lat, disks, left, right))
+    if fs.exists is None:
+        print(f"existence undecided: {fs.undecided}")
+        return 0
     if not fs.exists:
-        print(f"no equilibrium: Farkas certificate checked (no admissible forces with "
-              f"sum R < {fs.radius:.3g})")
+        print("no equilibrium: Farkas certificate checked " + (
+            "in exact rational arithmetic" if fs.exact else
+            f"(no admissible forces with sum R < {fs.radius:.3g})"))
         return 0
     print(f"equilibrium exists (checked: balance residual {fs.residuals[0]:.2e}, laws "
           f"{fs.residuals[1]:.2e}); dimension of the admissible set: {fs.dimension}"

@@ -5,9 +5,9 @@
 P is sampled on its affine hull, where it is full-dimensional (a sampler in the 2c unknowns
 would see a flat set and stall). `forceset.analyse` gives the implicit equalities (R = 0,
 S = +-mu R on the whole of P) and a point of P; substituting them leaves unknowns z with
-lambda = E z, the balance B z = b (B = H^T E, `forceset.reduced_balance`) and the remaining
+lambda = E z, the balance B z = b (B = H^T E, `hull.reduced_balance`) and the remaining
 inequalities. With an orthonormal basis N of ker B (dense SVD, rank rule of
-`forceset.dimension`) and a point z0 of P, z = z0 + N y, and P is the polytope
+`hull.dimension`) and a point z0 of P, z = z0 + N y, and P is the polytope
 {y : G (z0 + N y) <= 0} in dim P coordinates; uniform samples of y are uniform samples of P
 (the map is an isometry onto the affine hull).
 
@@ -29,7 +29,8 @@ import scipy.sparse as sp
 
 from rigidlcp import models
 
-from .forceset import ForceSet, analyse, reduced_balance
+from .forceset import ForceSet, analyse
+from .hull import reduced_balance
 from .model import ForceLP, StaticProblem
 
 

@@ -2,12 +2,11 @@
 
 `analyse(system)` answers, each answer checked in code:
 
-* exists: a lambda in P (checked against P), or a Farkas certificate that P is empty: virtual
-  velocities y of the disks whose relative velocities H y lie in the dual cone of every
-  contact ({a_n >= mu |a_t|}) while gravity does positive work, -b . y > 0. For any lambda in P,
-  -b . y = -lambda . H y <= max(v) sum R (v: the violations of the dual cone, checked in floating
-  point), so no admissible lambda has sum R < radius = (-b . y) / max(v); the certificate is
-  accepted when radius exceeds 1e9 times the packing's weight.
+* exists: a lambda in P (checked against P), or a Farkas certificate that P is empty (virtual
+  velocities under which every contact opens or slides within its cone while gravity does
+  work), checked in floating point with a radius or in exact rational arithmetic
+  (verify.statics.farkas); when neither passes, exists is None (undecided, with the reason),
+  never a guess.
 * dimension: of P itself, i.e. of its affine hull. An inequality of P that holds with equality
   on all of P (an implicit equality: R = 0, S = mu R or S = -mu R on the whole set) is found
   by linear programs maximizing slacks t_k in [0, scale] of the undecided rows (a row whose
@@ -33,19 +32,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.optimize import linprog
 
 from rigidlcp import models
 
-from .model import LP_TOL, ForceLP, StaticProblem, interior_point
-
-#: A Farkas certificate must exclude every equilibrium with sum R below this many weights.
-RADIUS_WEIGHTS = 1e9
-#: A slack or a force below this times the largest disk weight is zero.
-ZERO = 1e-9
-#: Largest number of unknowns whose rank is computed (dense SVD).
-DENSE_RANK_LIMIT = 8000
+from .farkas import farkas
+from .hull import ZERO, dimension, implicit_equalities
+from .model import ForceLP, StaticProblem, interior_point
 
 
 @dataclass
@@ -54,7 +46,7 @@ class ForceSet:
     implicit[alpha]: "R=0", "S=+muR", "S=-muR" or "" (no implicit equality); sliding (c,)."""
 
     system: models.System
-    exists: bool
+    exists: bool | None  # None: undecided (`undecided` says why)
     solution: np.ndarray | None = None
     certificate: np.ndarray | None = None
     radius: float | None = None
@@ -67,6 +59,8 @@ class ForceSet:
     unchecked: int = 0  # LP optima that failed the check against P (none expected)
     residuals: tuple[float, float] = (0.0, 0.0)  # of `solution`: balance, laws (force units)
     lps: int = 0
+    exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
+    undecided: str = ""
 
     @property
     def c(self) -> int:
@@ -98,7 +92,10 @@ class ForceSet:
                                           "plane": self.system.mu_plane,
                                           "wall": self.system.mu_wall}}
         if not self.exists:
-            out["farkas_radius"] = self.radius
+            out["farkas_radius"] = None if self.radius == np.inf else self.radius
+            out["farkas_exact"] = self.exact
+            if self.exists is None:
+                out["undecided"] = self.undecided
             out["contacts"] = [{"i": int(i), "j": int(j), "R": None, "S": None}
                                for i, j in zip(lat.i, lat.j)]
             return out
@@ -133,18 +130,26 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     progress(done, total, stage): called as the LPs of the ranges are solved."""
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
-    lam = interior_point(prob, 1e3 * weight)  # fast, and a relative-interior witness
-    interior = lam is not None and prob.admissible(lam)
-    lp = None
+    # the IPM is fast, and its point a relative-interior witness; when it finds no point in
+    # its box, a Farkas certificate (one LP, IPM) usually settles existence before any
+    # simplex (27 CPU s for the equilibrium LP of a 3000-disk pile without equilibrium)
+    status, lam = interior_point(prob, 1e3 * weight)
+    interior = status == "optimal" and prob.admissible(lam)
+    lp = cert = None
     if not interior:
-        lp = ForceLP(prob)
-        status, lam = lp.solve(np.zeros(prob.n))
-        if status != "optimal" or not prob.admissible(lam):
-            y, radius = farkas(prob)
-            if y is None:
-                raise RuntimeError(f"equilibrium LP {status} and no Farkas certificate found "
-                                   "(please report)")
-            return ForceSet(system, False, certificate=y, radius=radius, lps=3)
+        if status != "optimal":  # HiGHS's IPM says "infeasible" or stops undecided
+            cert = farkas(prob)
+        if cert is None or not cert.proves:
+            lp = ForceLP(prob)
+            status, lam = lp.solve(np.zeros(prob.n))
+        if cert is not None and cert.proves or status != "optimal" or not prob.admissible(lam):
+            cert = cert if cert is not None else farkas(prob)
+            if not cert.proves:  # neither a checked solution nor a checked certificate
+                return ForceSet(system, None, radius=cert.radius, lps=3,
+                                undecided=f"equilibrium LP {status}; Farkas certificate "
+                                f"not proved (radius {cert.radius:.3g} weights' units)")
+            return ForceSet(system, False, certificate=cert.y, radius=cert.radius, lps=3,
+                            exact=cert.exact)
     witness = lam
     if interior and max(prob.residuals(lam)) > 1e-12 * prob.scale:
         # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
@@ -160,147 +165,6 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     if ranges:
         _ranges(prob, lp or ForceLP(prob), fs, progress)
     return fs
-
-
-def farkas(prob: StaticProblem) -> tuple[np.ndarray | None, float | None]:
-    """y (3p) with H y in the dual cone and b . y < 0, checked (module docstring), or None."""
-    c, mu = prob.c, prob.mu
-    H = sp.csr_matrix(prob.A.T)
-    Hn, Ht = H[:c], H[c:]
-    fr = mu > 0
-    rows = [-Hn + sp.diags(mu) @ Ht, (-Hn - sp.diags(mu) @ Ht)[fr]]
-    res = linprog(prob.b, A_ub=sp.vstack(rows, format="csr"),
-                  b_ub=np.zeros(c + int(fr.sum())), bounds=(-1, 1), method="highs")
-    if res.status != 0 or res.fun >= 0:
-        return None, None
-    y = res.x
-    g = H @ y
-    v = np.where(fr, mu * np.abs(g[c:]) - g[:c], -g[:c])
-    gap = -float(prob.b @ y)
-    worst = float(np.max(v, initial=0.0))
-    radius = np.inf if worst <= 0 else gap / worst
-    weight = float(np.sum(prob.system.masses)) * prob.system.g
-    return (y, radius) if gap > 0 and radius >= RADIUS_WEIGHTS * weight else (None, None)
-
-
-def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> list[str]:
-    """Per contact: "R=0", "S=+muR", "S=-muR" or "" (module docstring). x: a point of P
-    near its relative interior, if one is known (else one is computed)."""
-    c, k = prob.c, prob.fric.size
-    # inequality rows: -R <= 0 (c), then S - mu R <= 0 and -S - mu R <= 0 (k each)
-    Gi = sp.vstack([-sp.eye(c, prob.n), prob.G], format="csr")
-    m = Gi.shape[0]
-    T = prob.scale
-    undecided = np.ones(m, dtype=bool)
-    # One interior point settles most rows at once: a row with a clear positive slack at a
-    # point of P is not an implicit equality; the slack LPs then decide only the rest.
-    if x is None:
-        x = interior_point(prob, 1e3 * float(np.sum(prob.system.masses)) * prob.system.g)
-    if x is not None:
-        weight = float(np.sum(prob.system.masses)) * prob.system.g
-        eq, viol = prob.residuals(x)
-        if eq <= 1e-9 * weight and viol <= 1e-9 * weight:
-            undecided &= ~(-(Gi @ x) > 1e-6 * T)
-    while undecided.any():
-        cost = np.r_[np.zeros(prob.n), -undecided.astype(float)]
-        A_ub = sp.hstack([Gi, sp.eye(m)], format="csr")
-        A_eq = sp.hstack([prob.A, sp.csr_matrix((prob.A.shape[0], m))], format="csr")
-        bounds = list(zip(prob.lb, prob.ub)) + [(0, T if u else 0) for u in undecided]
-        bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
-                  for lo, hi in bounds]
-        res = linprog(cost, A_ub=A_ub, b_ub=np.zeros(m), A_eq=A_eq, b_eq=prob.b,
-                      bounds=bounds, method="highs",
-                      options={"primal_feasibility_tolerance": LP_TOL})
-        if res.status != 0:
-            raise RuntimeError(f"slack LP failed: {res.message}")
-        t = np.maximum(res.x[prob.n:], -(Gi @ res.x[:prob.n]))  # the rows' actual slacks
-        new = undecided & (t > ZERO * T)
-        if not new.any():
-            break
-        undecided &= ~new
-    out = [""] * c
-    for a in range(c):
-        if undecided[a]:
-            out[a] = "R=0"
-    for n, a in enumerate(prob.fric):
-        if out[a]:
-            continue
-        if undecided[c + n]:
-            out[a] = "S=+muR"
-        elif undecided[c + k + n]:
-            out[a] = "S=-muR"
-    return out
-
-
-def reduced_balance(prob: StaticProblem, implicit: list[str]) -> sp.csc_matrix:
-    """The balance matrix on the unknowns left once the implicit equalities are substituted:
-    per contact none (R = 0), one column A_R +- mu A_S (S = +-mu R; or A_R when mu = 0), or
-    two (A_R, A_S)."""
-    A = sp.csc_matrix(prob.A)
-    c, mu = prob.c, prob.mu
-    cols = []
-    for a in range(c):
-        kind = implicit[a]
-        if kind == "R=0":
-            continue
-        if mu[a] == 0:
-            cols.append(A[:, a])
-        elif kind:
-            cols.append(A[:, a] + (mu[a] if kind == "S=+muR" else -mu[a]) * A[:, c + a])
-        else:
-            cols += [A[:, a], A[:, c + a]]
-    return sp.hstack(cols, format="csc") if cols else sp.csc_matrix((A.shape[0], 0))
-
-
-def dimension(prob: StaticProblem, implicit: list[str]
-              ) -> tuple[int | None, tuple[float | None, float | None]]:
-    """(dim P, (smallest singular value kept, largest dropped)); None when the rank is not
-    settled (rank deficient above the dense limit)."""
-    B = reduced_balance(prob, implicit)
-    B = B[np.flatnonzero(np.diff(B.tocsr().indptr))]  # rows that are exactly zero: rank 0
-    if B.shape[1] == 0 or B.shape[0] == 0:
-        return B.shape[1], (None, None)
-    full = _full_row_rank(B)
-    if full is not None:
-        return B.shape[1] - B.shape[0], (full, None)
-    if B.shape[1] > DENSE_RANK_LIMIT:
-        return None, (None, None)
-    w = np.linalg.svd(B.toarray(), compute_uv=False)
-    tol = max(B.shape) * np.finfo(float).eps * float(w[0])
-    rank = int(np.sum(w > tol))
-    kept = float(w[rank - 1]) if rank else None
-    dropped = float(w[rank]) if rank < w.size else None
-    return B.shape[1] - rank, (kept, dropped)
-
-
-def _full_row_rank(B: sp.csr_matrix) -> float | None:
-    """sigma_min(B) when B (rows <= columns) has full row rank beyond doubt, else None.
-
-    The extreme eigenvalues of B B^T (sparse: shift-invert at 0 for the smallest) give
-    sigma_min and sigma_max; rank = rows by the SVD's own rule (sigma_min > max(shape) eps
-    sigma_max) is accepted only with a wide margin, sigma_min > 1e-6 sigma_max, since the
-    eigenvalues of B B^T carry an absolute error ~ eps sigma_max^2 (else the dense SVD, or
-    None, decides)."""
-    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, eigsh
-
-    rows, cols = B.shape
-    if rows > cols:
-        return None
-    C = (B @ B.T).tocsc()
-    if rows < 3:
-        ev = np.linalg.eigvalsh(C.toarray())
-        lo, hi = float(ev[0]), float(ev[-1])
-    else:
-        try:
-            hi = float(eigsh(C, k=1, which="LA", return_eigenvectors=False, tol=1e-6)[0])
-            lo = float(eigsh(C, k=1, sigma=0.0, which="LM", return_eigenvectors=False,
-                             tol=1e-6)[0])
-        except (ArpackError, ArpackNoConvergence, RuntimeError, ValueError):
-            return None  # e.g. C exactly singular: the factorization at sigma = 0 fails
-    if hi <= 0 or lo <= 0:
-        return None
-    smin, smax = np.sqrt(lo), np.sqrt(hi)
-    return float(smin) if smin > 1e-6 * smax else None
 
 
 def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:

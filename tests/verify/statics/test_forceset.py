@@ -135,13 +135,16 @@ def test_pyramid_without_walls_has_a_farkas_certificate():
 
 
 def _affine_dimension(prob: StaticProblem, fs, draws: int, rng) -> int:
-    """Rank of the differences of LP vertices of P inside a large box, for random costs: an
-    independent lower bound on dim P that reaches it for enough generic costs."""
+    """Rank of the differences of LP vertices of P inside a large box, for +-each coordinate
+    and `draws` random costs: an independent lower bound on dim P that reaches it for enough
+    generic costs."""
     big = 10.0 * (np.abs(fs.solution).max() + prob.scale * prob.p)
     bounds = [(max(lo, -big), min(hi, big)) for lo, hi in zip(prob.lb, prob.ub)]
     pts = []
-    for _ in range(draws):
-        res = linprog(rng.standard_normal(prob.n), A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]),
+    # the ends of every coordinate's range (in the box), then random costs
+    costs = [s * e for e in np.eye(prob.n) for s in (1.0, -1.0)]
+    for cost in costs + [rng.standard_normal(prob.n) for _ in range(draws)]:
+        res = linprog(cost, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]),
                       A_eq=prob.A, b_eq=prob.b, bounds=bounds, method="highs")
         assert res.status == 0
         pts.append(res.x)
@@ -173,6 +176,9 @@ def test_properties_on_deposited_packings(n, seed, mu, spread):
     for a, kind in enumerate(fs.implicit):  # R = 0 on all of P iff its range is {0}
         assert (kind == "R=0") == (fs.hi[a] <= 1e-9 * prob.scale), a
     rng = np.random.default_rng(seed)
+    # a lower bound: on an unbounded P many random vertices are the box's, and thin directions
+    # (widths ~1e-2 against a box of ~1e2) were missed by 3 (dim + 2) random costs alone (the
+    # deep profile's 7-disk pile, seed 1737, mu 0.4375: 6 with 27 draws, 7 with 200)
     assert _affine_dimension(prob, fs, 3 * (fs.dimension + 2), rng) == fs.dimension
 
 
@@ -218,3 +224,98 @@ def test_ranges_and_sliding_against_linprog_on_the_rows_form(seed, mu):
                 res = opt(e, A_eq, np.r_[prob.b, 0.0])
                 can |= res.status == 3 or (res.status == 0 and res.x[a] > 1e-9 * prob.scale)
         assert bool(fs.sliding[a]) == can, a
+
+
+# Piles on which HiGHS found P empty but the Farkas y it returned failed the floating-point
+# check (cone rows violated at its tolerance, ~2e-11, capping the radius near 1e10 weights):
+# `analyse` raised. Found by a scan of 40-disk piles and by the deep hypothesis profile.
+NEAR_MISSES = [(40, 2, (0.8, 1.2), 10.0, 0.3), (7, 1737, (1.0, 1.0894363145159462), 6.0, 0.4)]
+
+
+@pytest.mark.parametrize("n, seed, radii, width, mu", NEAR_MISSES)
+def test_farkas_certificate_where_the_lp_y_fails_the_float_check(n, seed, radii, width, mu):
+    """Both the polished float certificate (what `analyse` returns) and the exact rational
+    one from the LP's raw y prove P empty; scipy's linprog on the rows form agrees."""
+    from rigidlcp.verify.statics.farkas import check, cone_rows, exact_certificate
+
+    system = models.System(deposit(n, seed=seed, radii=radii, width=width), mu_pp=mu,
+                           mu_plane=mu, mu_wall=mu)
+    fs = analyse(system)
+    assert fs.exists is False and fs.radius >= 1e9 * float(np.sum(system.masses))
+    prob = StaticProblem(system)
+    g = prob.A.T @ fs.certificate  # H y: every contact opens or stays inside its cone
+    c = prob.c
+    v = np.where(prob.mu > 0, prob.mu * np.abs(g[c:]) - g[:c], -g[:c])
+    assert prob.b @ fs.certificate < 0 and np.max(v) <= 1e-13
+    C = cone_rows(prob)
+    raw = linprog(prob.b, A_ub=C, b_ub=np.zeros(C.shape[0]), bounds=(-1, 1), method="highs")
+    assert not check(prob, raw.x).proves  # the raw y alone: the float check says no
+    exact = exact_certificate(prob, raw.x)
+    assert exact is not None and exact.exact and exact.radius == np.inf and exact.gap > 0
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+    rows = linprog(np.zeros(prob.n), A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
+                   b_eq=prob.b, bounds=bounds, method="highs")
+    assert rows.status == 2  # infeasible
+    assert json.loads(json.dumps(fs.to_dict(), allow_nan=False))["exists"] is False
+
+
+def test_exact_farkas_check_refuses_a_pile_with_an_equilibrium():
+    """On a pile with a checked equilibrium no y passes the exact check (it would prove P
+    empty): random virtual velocities and the corner disk's."""
+    from rigidlcp.verify.statics.farkas import exact_certificate
+
+    system = models.System(deposit(12, seed=1, radii=(0.8, 1.2), width=6.0), mu_pp=0.5,
+                           mu_plane=0.5, mu_wall=0.5)
+    assert analyse(system, ranges=False).exists
+    prob = StaticProblem(system)
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        assert exact_certificate(prob, rng.standard_normal(3 * prob.p)) is None
+
+
+@pytest.mark.parametrize("mu_wall", [0.5, 0.9, 0.988, 0.999])
+def test_corner_contact_without_force_is_labelled_R_zero(mu_wall):
+    """Case 1 below mu_wall = 1: R_w = S_w = 0 on all of P, so S_w = +mu R_w and S_w = -mu R_w
+    hold there too; the label must be the strongest, R = 0 (it implies the others), and the
+    dimension counts both unknowns as fixed (0 here)."""
+    fs = analyse(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=mu_wall))
+    wall = int(np.flatnonzero(fs.system.lattice.j == LEFT_WALL)[0])
+    assert fs.implicit[wall] == "R=0" and fs.dimension == 0
+    _close(_range(fs, LEFT_WALL), (0, 0))
+    _close(_range(fs, LEFT_WALL, what="S"), (0, 0))
+
+
+def test_one_implicit_cone_row_with_R_zero_is_labelled_R_zero():
+    """The slack LPs decide rows from points within the LP's tolerance of P, where R ~ 1e-9 is
+    rounding: the deep hypothesis profile's 2-disk pile at mu 0.988 had R = 0 on all of P but
+    its R >= 0 row and one cone row decided so, and came out "S=+muR". The labels now ask a
+    checked optimum for R > 0 before saying S = +-mu R. Forced here on the corner disk (R_w = 0
+    on P): whichever single cone row is left undecided, the label is R = 0; at the plane
+    (R_p = 1 on P), an undecided cone row stays S = +-mu R."""
+    from rigidlcp.verify.statics.hull import labels
+
+    prob = StaticProblem(_system([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=0.9))
+    lat = prob.system.lattice
+    wall = int(np.flatnonzero(lat.j == LEFT_WALL)[0])
+    plane = int(np.flatnonzero(lat.j == PLANE)[0])
+    c, k = prob.c, prob.fric.size
+    for a, want in ((wall, "R=0"), (plane, None)):
+        n = int(np.flatnonzero(prob.fric == a)[0])
+        for row, kind in ((c + n, "S=+muR"), (c + k + n, "S=-muR")):
+            undecided = np.zeros(c + 2 * k, dtype=bool)
+            undecided[row] = True
+            assert labels(prob, undecided)[a] == (want or kind)
+
+
+def test_undecided_existence_is_reported_as_null_with_its_reason():
+    """When neither a checked point nor a checked certificate is found, the JSON says
+    "exists": null and why (no case of it is known; the contract is checked directly)."""
+    from rigidlcp.verify.statics.forceset import ForceSet
+
+    system = _system([[1.0, 1.0]], left=0.0)
+    fs = ForceSet(system, None, radius=12.5, undecided="equilibrium LP failed; Farkas "
+                  "certificate not proved (radius 12.5 weights' units)")
+    d = json.loads(json.dumps(fs.to_dict(), allow_nan=False))
+    assert d["exists"] is None and "not proved" in d["undecided"]
+    assert d["farkas_radius"] == 12.5 and d["contacts"][0]["R"] is None

@@ -1,0 +1,205 @@
+"""Certificates that a packing has no equilibrium: P (verify.statics.model) is empty.
+
+Farkas's lemma for P = {lambda : H^T lambda = b, R >= 0, |S| <= mu R}: P is empty iff some
+virtual velocities y of the disks (3p) have relative velocities g = H y in the dual cone of
+every contact, g_n >= mu |g_t| (g_n >= 0 and g_t free where mu = 0), while gravity does
+positive work, b . y < 0. (For lambda in P, b . y = lambda . H y = sum R g_n + S g_t
+>= sum R (g_n - mu |g_t|) >= 0.) In rows: C y <= 0 with C = [-H_n + mu H_t; -H_n - mu H_t]
+(the second block at frictional contacts only).
+
+y comes from one LP (min b . y, C y <= 0, |y| <= 1) and is checked, never taken on the LP's
+word, in one of two ways:
+
+* floating point: with v the violations of the cone rows, every lambda in P has
+  sum R >= radius = (-b . y) / max(v); the certificate is accepted when radius exceeds
+  RADIUS_WEIGHTS times the packing's weight. HiGHS leaves C y <= 0 to its feasibility
+  tolerance (~1e-11 here), which caps that radius near 1e10 weights; so y is first projected
+  onto the cone rows it makes (nearly) active (`_polish`: least squares, twice), which
+  leaves rounding-size violations.
+* exact: the rows y nearly makes active are made exactly active by a rational y (python-flint's
+  row reduction, free unknowns at y's values as small fractions) and C y <= 0, b . y < 0 are
+  checked in rational arithmetic on the float data as stored (each double is a rational; mu
+  too; the rows of C are formed exactly from H), as lcp.acceptance.farkas does for LCPs. Such
+  a y proves P empty for the stored data: no tolerance and no radius (radius = inf).
+
+When neither check passes, no claim is made: `analyse` reports the existence as undecided
+(with the LP's statuses and the best radius) rather than "no".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.optimize import linprog
+
+from .model import StaticProblem
+
+#: A floating-point certificate must exclude every equilibrium with sum R below this many
+#: weights.
+RADIUS_WEIGHTS = 1e9
+#: Largest number of disks for the exact re-check (dense rational row reduction).
+EXACT_MAX_P = 150
+
+
+@dataclass
+class Certificate:
+    """y (3p) with H y in the dual cone and b . y < 0. radius: no lambda in P has sum R below
+    it (inf when exact); gap: -b . y with |y|_inf = 1; exact: checked in rational arithmetic."""
+
+    y: np.ndarray | None
+    radius: float
+    gap: float
+    exact: bool = False
+
+    @property
+    def proves(self) -> bool:
+        return self.y is not None
+
+
+def cone_rows(prob: StaticProblem) -> sp.csr_matrix:
+    """C: C y <= 0 iff H y is in the dual cone of every contact (module docstring)."""
+    c, mu = prob.c, prob.mu
+    H = sp.csr_matrix(prob.A.T)
+    Hn, Ht = H[:c], H[c:]
+    fr = mu > 0
+    return sp.vstack([-Hn + sp.diags(mu) @ Ht, (-Hn - sp.diags(mu) @ Ht)[fr]], format="csr")
+
+
+def check(prob: StaticProblem, y: np.ndarray) -> Certificate:
+    """The floating-point check of y (module docstring); y is None in the answer when the
+    radius is too small or gravity does no work."""
+    c, mu = prob.c, prob.mu
+    g = prob.A.T @ y  # H y
+    v = np.where(mu > 0, mu * np.abs(g[c:]) - g[:c], -g[:c])
+    top = float(np.max(np.abs(y), initial=0.0))
+    gap = -float(prob.b @ y) / top if top > 0 else 0.0
+    worst = float(np.max(v, initial=0.0)) / top if top > 0 else 0.0
+    radius = np.inf if worst <= 0 else gap / worst
+    weight = float(np.sum(prob.system.masses)) * prob.system.g
+    ok = gap > 0 and radius >= RADIUS_WEIGHTS * weight
+    return Certificate(y / top if ok else None, float(radius) if gap > 0 else 0.0, gap)
+
+
+def farkas(prob: StaticProblem) -> Certificate:
+    """A checked certificate that P is empty, or one with y None (no claim) carrying the best
+    radius found (module docstring)."""
+    C = cone_rows(prob)
+    # HiGHS's IPM with crossover (a vertex, as the polishing wants): 14x faster than its dual
+    # simplex on a 3000-disk pile (docs/packings.md, Scale)
+    res = linprog(prob.b, A_ub=C, b_ub=np.zeros(C.shape[0]), bounds=(-1, 1),
+                  method="highs-ipm", options={"primal_feasibility_tolerance": 1e-10,
+                                               "dual_feasibility_tolerance": 1e-10})
+    if res.status != 0 or res.x is None or res.fun >= 0:
+        return Certificate(None, 0.0, 0.0)
+    best = check(prob, res.x)
+    if best.proves:
+        return best
+    polished = _polish(C, res.x)
+    cert = check(prob, polished)
+    if cert.proves:
+        return cert
+    best = max(best, cert, key=lambda k: k.radius)
+    if prob.p <= EXACT_MAX_P:
+        for cand in (polished, res.x):
+            exact = exact_certificate(prob, cand)
+            if exact is not None:
+                return exact
+    return best
+
+
+def _polish(C: sp.csr_matrix, y: np.ndarray) -> np.ndarray:
+    """Project y onto the cone rows J it makes nearly active, {C_J y = 0} (least squares,
+    twice): the LP's tolerance-size violations become rounding."""
+    from scipy.sparse.linalg import lsqr
+
+    y = np.asarray(y, dtype=float).copy()
+    scale = float(np.max(np.abs(y), initial=1.0))
+    for _ in range(2):
+        g = C @ y
+        J = np.flatnonzero(g > -1e-8 * scale)
+        if J.size == 0:
+            break
+        CJ = C[J]
+        step = lsqr(CJ, CJ @ y, atol=1e-15, btol=1e-15, iter_lim=10 * C.shape[1])[0]
+        y -= step
+    return y
+
+
+def _q(x: float):
+    from flint import fmpq  # a dependency (pyproject); imported on first use
+
+    f = Fraction(float(x))
+    return fmpq(f.numerator, f.denominator)
+
+
+def _small(x: float):
+    from flint import fmpq
+
+    f = Fraction(float(x)).limit_denominator(10**6)
+    return fmpq(f.numerator, f.denominator)
+
+
+def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e-9
+                      ) -> Certificate | None:
+    """A rational y near the float y with the nearly active cone rows exactly active, checked
+    exactly: C y <= 0 and b . y < 0 for the stored (float) H, b, mu (module docstring)."""
+    from flint import fmpq, fmpq_mat
+
+    c, mu, m = prob.c, prob.mu, prob.A.shape[0]
+    H = sp.coo_matrix(prob.A.T)
+    Hq = [[fmpq(0)] * m for _ in range(2 * c)]
+    for i, j, v in zip(H.row, H.col, H.data):
+        Hq[int(i)][int(j)] = _q(v)
+    rows = []  # C exactly: -H_n + mu H_t, then -H_n - mu H_t where mu > 0
+    for a in range(c):
+        mq = _q(mu[a])
+        rows.append([-hn + mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
+    for a in np.flatnonzero(mu > 0):
+        mq = _q(mu[a])
+        rows.append([-hn - mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
+    bq = [_q(v) for v in prob.b]
+    y = np.asarray(y, dtype=float) / float(np.max(np.abs(y)))
+    g = cone_rows(prob) @ y
+    J = np.flatnonzero(g > -active_tol)
+    start = [_small(v) for v in y]
+    cands = [start]
+    if J.size:
+        A = fmpq_mat(len(J), m, [v for j in J for v in rows[int(j)]])
+        cands.insert(0, _solve_homogeneous(A, start))
+    for cand in cands:
+        if cand is None:
+            continue
+        work = sum((bi * yi for bi, yi in zip(bq, cand)), fmpq(0))
+        if work >= 0:
+            continue
+        if all(sum((r * yi for r, yi in zip(row, cand)), fmpq(0)) <= 0 for row in rows):
+            yf = np.array([int(v.p) / int(v.q) for v in cand])
+            top = float(np.max(np.abs(yf)))
+            return Certificate(yf / top, np.inf, -(int(work.p) / int(work.q)) / top,
+                               exact=True)
+    return None
+
+
+def _solve_homogeneous(A, start: list) -> list | None:
+    """The rational y with A y = 0, free unknowns (non-pivots of A's reduced row echelon
+    form) at `start`; None if that makes y = 0."""
+    from flint import fmpq
+
+    n = A.ncols()
+    R, rank = A.rref()
+    pivots, col = [], 0
+    for r in range(rank):
+        while R[r, col] == 0:
+            col += 1
+        pivots.append(col)
+        col += 1
+    free = [k for k in range(n) if k not in set(pivots)]
+    y = [fmpq(0)] * n
+    for k in free:
+        y[k] = start[k]
+    for r, k in enumerate(pivots):
+        y[k] = -sum((R[r, f] * y[f] for f in free), fmpq(0))
+    return None if all(v == 0 for v in y) else y
