@@ -86,16 +86,19 @@ def read_packing(path: str | os.PathLike, left: float | None | str = None,
     return packing(d.x, d.r, d.m, d.I, left=lo, right=hi, gap_tol=gap_tol)
 
 
-def _number(path: Path, line: int, field: str, text: str, positive: bool = False) -> float:
+def _number(path: Path, line: int | str, field: str, text: str,
+            positive: bool = False) -> float:
+    """A number of a text file's `line` (an int), or of an .npz array at `line` (a text such
+    as "entry 3": an archive has no lines)."""
+    where = f"line {line}, field {field!r}" if isinstance(line, int) else f"array {field!r}, {line}"
     try:
         v = float(text)
     except ValueError:
-        raise InvalidFile(f"{path} line {line}, field {field!r}: {text.strip()!r} is not a "
-                          "number") from None
+        raise InvalidFile(f"{path} {where}: {text.strip()!r} is not a number") from None
     if not math.isfinite(v):
-        raise InvalidFile(f"{path} line {line}, field {field!r}: {text.strip()!r} is not finite")
+        raise InvalidFile(f"{path} {where}: {text.strip()!r} is not finite")
     if positive and v <= 0:
-        raise InvalidFile(f"{path} line {line}, field {field!r}: must be > 0, got {v!r}")
+        raise InvalidFile(f"{path} {where}: must be > 0, got {v!r}")
     return v
 
 
@@ -156,6 +159,9 @@ def _box_comment(path: Path, k: int, text: str) -> dict:
 def _read_npz(path: Path) -> Disks:
     with open_npz(path, "a packing (.npz with arrays x, y, r)") as data:
         files = set(data.files)
+        if "__meta__" in files:  # models.runio's marker
+            raise InvalidFile(f"{path} is a run saved by `rigidlcp simulate`, not a packing "
+                              "(.npz with arrays x, y, r)")
         missing = [c for c in REQUIRED if c not in files]
         if missing:
             raise InvalidFile(f"{path}: array {missing[0]!r} missing (a packing .npz holds x, "
@@ -169,7 +175,7 @@ def _read_npz(path: Path) -> Disks:
             raise InvalidFile(f"{path}: array {c!r} must be {p} numbers (like x), got shape "
                               f"{a.shape} of {a.dtype}")
         for k, v in enumerate(a.astype(float)):
-            _number(path, k, c, repr(float(v)), positive=c in ("r", "m", "I"))
+            _number(path, f"entry {k}", c, repr(float(v)), positive=c in ("r", "m", "I"))
         cols[c] = a.astype(float).tolist()
     box = {k: ("none" if math.isnan(v) else v) for k, v in walls.items()}
     return _finish(path, cols, **box)

@@ -111,3 +111,24 @@ def test_bad_npz_and_binary(tmp_path):
         read_disks(g)
     with pytest.raises(FileNotFoundError):
         read_disks(tmp_path / "missing.csv")
+
+
+def test_npz_errors_name_the_array_entry_and_a_run_is_named(tmp_path):
+    """user25: an .npz with NaN said 'line 1' (an archive has no lines); a run file said
+    "array 'x' missing" instead of naming what it is."""
+    import numpy as np
+    import pytest
+
+    from rigidlcp import models
+    from rigidlcp.lcp.errors import InvalidFile
+    from rigidlcp.models.packing_io import read_packing
+    from rigidlcp.models.runio import save_run
+
+    f = tmp_path / "pn.npz"
+    np.savez(f, x=[1.0, 3.0], y=[1.0, np.nan], r=[1.0, 1.0])
+    with pytest.raises(InvalidFile, match=r"array 'y', entry 1: 'nan' is not finite"):
+        read_packing(f)
+    run = models.simulate(models.System(models.rectangular(2, 1)), seed=1)
+    save_run(run, tmp_path / "run.npz")
+    with pytest.raises(InvalidFile, match="is a run saved by `rigidlcp simulate`, not a packing"):
+        read_packing(tmp_path / "run.npz")
