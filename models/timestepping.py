@@ -179,6 +179,7 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
         rec, settled = k.record(got)
         k.quiet = k.quiet + 1 if settled else 0
         opening = np.flatnonzero(got.u[:c] > 1e-9 * got.u_scale)
+        moving = _translating(got, system, h)
         changed = not np.array_equal(rec.s, k.s_prev)
         if step == 0:  # the run's records start at its initial state (plots, dissipated
             # energy from t = state.t): the first step's forces, from the initial velocities
@@ -186,11 +187,11 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
                                        vt=k.ut_prev.copy(),
                                        dissipation=dissipation_rate(rec.S, k.ut_prev)))
         k.advance(got, rec)
-        last = (opening.size or k.quiet >= opts.steady_steps or k.t >= opts.t_max
+        last = (opening.size or moving.size or k.quiet >= opts.steady_steps or k.t >= opts.t_max
                 or step + 1 == opts.max_steps)
         if changed or last or (opts.record_every and (step + 1) % opts.record_every == 0):
             run.records.append(rec)
-        stop = _stop(k, opening, opts, step)
+        stop = _stop(k, opening, moving, opts, step)
         if stop:
             run.status, run.message = stop
             if opening.size:
@@ -336,12 +337,30 @@ def _failure(got: _Step, opts: StepOptions) -> tuple[str, str] | None:
     return None
 
 
-def _stop(k: _Stepper, opening: np.ndarray, opts: StepOptions, step: int
+#: A disk translates when its mean translational acceleration over a step exceeds this
+#: fraction of max(g, |gamma|) (as models.engine.loop's check: the arrays block every
+#: translation, to rounding).
+TRANSLATION_TOL = 1e-7
+
+
+def _translating(got: _Step, system, h: float) -> np.ndarray:
+    """The disks that the step's impulses would translate (dnu's translational part != 0) with
+    every contact closed: a mechanism of a packing (e.g. a disk pushed along the plane with no
+    wall), which the no-displacement regime excludes; the paper's arrays never have one."""
+    p = system.p
+    size = np.hypot(got.dnu[:p], got.dnu[p:2 * p]) / h
+    return np.flatnonzero(size > TRANSLATION_TOL * max(system.g, abs(system.gamma), 1e-12))
+
+
+def _stop(k: _Stepper, opening: np.ndarray, moving: np.ndarray, opts: StepOptions, step: int
           ) -> tuple[str, str] | None:
     """(status, message) when the run stops after this step, else None."""
     if opening.size:
         return ("detachment", f"t = {k.t:.6g}: contact(s) would open (u_n > 0), the "
                 f"no-displacement regime ends: {opening[:5].tolist()}")
+    if moving.size:
+        return ("detachment", f"t = {k.t:.6g}: disk(s) would translate with every contact "
+                f"closed, the no-displacement regime ends: disks {moving[:5].tolist()}")
     if k.quiet >= opts.steady_steps:
         return "steady", f"steady state at t = {k.t:.6g} (step {step + 1})"
     if k.t >= opts.t_max:

@@ -101,3 +101,19 @@ def test_bad_options_raise_typed_errors(options):
         info.value)
     with pytest.raises(ValueError):
         StepOptions(**options)
+
+
+def test_a_disk_pushed_along_the_plane_with_no_wall_is_a_detachment():
+    """A lone disk on the driven plane, walls far away: nothing balances the plane's friction
+    horizontally, so the disk would translate (the paper's regime ends). The time-stepper ran
+    it to 'steady' with mu_g 0; the event engine stops it as a detachment (models.engine.loop);
+    so must the time-stepper, at its first step, naming the disk."""
+    from rigidlcp.models.packing import packing
+
+    lone = packing(np.array([[5.0, 1.0]]), np.array([1.0]), left=0.0, right=20.0)
+    system = models.System(lone, gamma=0.5)
+    run = moreau_jean(system, seed=1, h=1e-3)
+    assert run.status == "detachment" and "would translate" in run.message
+    assert "disks [0]" in run.message and len(run.records) <= 2
+    events = models.simulate(system, seed=1)
+    assert events.status == "detachment" and "would translate" in events.message
