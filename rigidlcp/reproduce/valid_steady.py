@@ -135,17 +135,20 @@ def end_families(points: list[BandPoint], m_g: float, g: float = 1.0
 
 
 def fmt_range(r: Range | None) -> str:
-    """"[lo, hi]" with an undecided end as "time limit (best met x, not a bound)"."""
+    """"[lo, hi]" with an undecided end as "time limit (best met x, not a bound)" and its
+    proved bound where one is known (End.bound, verify.ranges.cap_split)."""
     if r is None:
         return "not computed"
 
     def end(e) -> str:
         if e.status == OPTIMAL:
             return f"{e.value:.7g}"
+        proved = ("" if e.bound is None else
+                  f"; proved {'>=' if e is r.lo else '<='} {e.bound:.7g}")
         if e.status == TIME_LIMIT and e.best is not None:
-            return f"unknown (time limit; best met {e.best:.7g}, not a bound)"
+            return f"unknown (time limit; best met {e.best:.7g}, not a bound{proved})"
         if e.status == TIME_LIMIT:
-            return "unknown (time limit; no value met)"
+            return f"unknown (time limit; no value met{proved})"
         return e.status
     return f"[{end(r.lo)}, {end(r.hi)}]"
 

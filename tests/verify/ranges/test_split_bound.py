@@ -125,3 +125,31 @@ def test_open_ends_get_proved_bounds_around_the_big_M_ends(lattice, gamma):
     d = SteadyRanges(form.system, rg, form.U, form.box_proved, form.V_mode, 0.0).to_dict()
     assert d["steady"]["mu_g"] == [None, None]
     assert d["steady"]["bounds"]["mu_g"] == [e_lo.bound, e_hi.bound]
+
+
+@pytest.mark.slow
+def test_cap_split_on_fig9_below_a_checked_witness():
+    """Fig. 9's system: the cap split's bound is positive and below the least mu_g of the
+    rolling-checkerboard seeds (each checked by steady_check here); every plane contact is a
+    cap contact (b = -gamma)."""
+    from rigidlcp.models.lattice import PLANE
+    from rigidlcp.verify.ranges.steady import state_extreme, state_velocities
+    from rigidlcp.verify.ranges.valid_steady import seed_states
+    from rigidlcp.verify.ranges.witness import steady_check
+
+    system = models.System(models.rectangular(10, 4), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.16)
+    form = formulate(system)
+    beta, _, _, M = cap_contacts(form)
+    assert set(beta) == set(np.flatnonzero(system.lattice.j == PLANE)) and M == 0.16
+    L = mu_g_vector(system)
+    res = cap_split_bound(form, L)
+    assert res.bound > 0
+    c, met = system.c, []
+    for s in seed_states(form):
+        status, x, _ = state_extreme(form, s, L, 1)
+        vel = state_velocities(form, s)
+        if status == "optimal" and vel is not None:
+            if steady_check(system, vel[0], vel[1], x[:c], x[c:], form.dyn)[0] <= 1e-8:
+                met.append(float(L @ x))
+    assert met and res.bound <= min(met)
