@@ -88,3 +88,25 @@ class Range:
     def __repr__(self) -> str:
         sel = "" if self.selected is None else f", selected {self.selected:.10g}"
         return f"{self.name}: [{self.lo!r}, {self.hi!r}]{sel}"
+
+
+def end_cell(e: End, side: int) -> str:
+    """An end in the table: its value; an open end as the interval it is known to lie in
+    (proved bound and best value met) or its status."""
+    if e.status == OPTIMAL:
+        return f"{e.value:.10g}"
+    if e.status == TIME_LIMIT and e.best is not None and e.bound is not None:
+        lo, hi = (e.bound, e.best) if side < 0 else (e.best, e.bound)
+        return f"in [{lo:.4g}, {hi:.4g}]"
+    return e.status
+
+
+def width_text(r: Range) -> str:
+    """hi - lo, "-" while an end is open; a rounding-level negative width (lo above hi by
+    1e-12 of their size, two LPs' optima of one point) shows as 0."""
+    if not r.decided:
+        return "-"
+    w = r.width
+    if -1e-12 * max(1.0, abs(float(r.lo.value)), abs(float(r.hi.value))) <= w < 0:
+        w = 0.0
+    return f"{w:.4g}"

@@ -17,6 +17,7 @@ import numpy as np
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 
+from . import result
 from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
@@ -107,16 +108,15 @@ class SteadyRanges:
                  f"{'(proved)' if self.box_proved else '(a box: not proved)'}; "
                  f"{self.seconds:.2f} s",
                  f"{'observable':<12} {'min':>16} {'max':>16} {'width':>11} {'run':>13}"]
+        cell, width = result.end_cell, result.width_text
         for name, r in self.ranges.items():
-            def cell(e: End) -> str:
-                return f"{e.value:.10g}" if e.status == OPTIMAL else e.status
             run = self.run_values.get(name)
-            lines.append(f"{name:<12} {cell(r.lo):>16} {cell(r.hi):>16} {r.width:>11.4g} "
-                         f"{'' if run is None else f'{run:.8g}':>13}")
+            lines.append(f"{name:<12} {cell(r.lo, -1):>16} {cell(r.hi, 1):>16} "
+                         f"{width(r):>11} {'' if run is None else f'{run:.8g}':>13}")
             if name in self.own:
                 o = self.own[name]
-                lines.append(f"{'  own states':<12} {cell(o.lo):>16} {cell(o.hi):>16} "
-                             f"{o.width:>11.4g}")
+                lines.append(f"{'  own states':<12} {cell(o.lo, -1):>16} {cell(o.hi, 1):>16} "
+                             f"{width(o):>11}")
         for name, r in self.ranges.items():
             for e in (r.lo, r.hi):
                 if e.note and not e.note.startswith(("proved by", "optimal by")):
@@ -398,3 +398,4 @@ def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
     end.status, end.value, end.ray = UNBOUNDED, -sense * np.inf, ray
     end.note = f"ray checked: x + {t:.3g} d is a valid steady state"
     return end
+
