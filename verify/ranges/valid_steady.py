@@ -17,12 +17,11 @@ import numpy as np
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 
-from . import result
 from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
 from .observables import check_observable, steady_observables
-from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
+from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range, end_cell, width_text
 from .steady import (
     Formulation,
     NotSteady,
@@ -108,7 +107,7 @@ class SteadyRanges:
                  f"{'(proved)' if self.box_proved else '(a box: not proved)'}; "
                  f"{self.seconds:.2f} s",
                  f"{'observable':<12} {'min':>16} {'max':>16} {'width':>11} {'run':>13}"]
-        cell, width = result.end_cell, result.width_text
+        cell, width = end_cell, width_text
         for name, r in self.ranges.items():
             run = self.run_values.get(name)
             lines.append(f"{name:<12} {cell(r.lo, -1):>16} {cell(r.hi, 1):>16} "
