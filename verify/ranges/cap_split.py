@@ -132,8 +132,8 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
         row_hi[ib:ib + n] = np.where(z, -b[beta], free)
         Ad[ic, c + beta] = np.where(z, -np.sign(b[beta]), 0.0)
         row_lo[ic] = M * float(np.sum(1.0 / D[np.unique(disk[z])])) if z.any() else -np.inf
-        idx = np.arange(ia, ic + 1, dtype=np.int32)
-        h.changeRowsBounds(idx.size, idx, row_lo[idx], row_hi[idx])
+        for i in range(ia, ic + 1):  # one by one: highspy 1.10 has no changeRowsBounds
+            h.changeRowBounds(i, float(row_lo[i]), float(row_hi[i]))
         for k in range(n):
             h.changeCoeff(ic, int(c + beta[k]), float(Ad[ic, c + beta[k]]))
         with quiet_highs():
