@@ -319,3 +319,31 @@ def test_undecided_existence_is_reported_as_null_with_its_reason():
     d = json.loads(json.dumps(fs.to_dict(), allow_nan=False))
     assert d["exists"] is None and "not proved" in d["undecided"]
     assert d["farkas_radius"] == 12.5 and d["contacts"][0]["R"] is None
+
+
+@pytest.mark.parametrize("n, seed, radii, width, mu, empty",
+                         [case + (True,) for case in NEAR_MISSES]
+                         + [(12, 1, (0.8, 1.2), 6.0, 0.5, False)])
+def test_farkas_lp_without_crossover_gives_the_verdict_with_crossover(n, seed, radii, width,
+                                                                      mu, empty):
+    """The Farkas LP's interior optimum (IPM, no crossover: the path taken first, and the only
+    one on large piles) proves P empty exactly where the vertex (with crossover) does: on the
+    near-miss piles (no equilibrium, see above) both settle to a checked certificate; on a
+    pile with a checked equilibrium neither gives a y with b . y < 0 that passes."""
+    from rigidlcp.verify.statics.farkas import _settle, cone_rows, farkas_lp
+
+    system = models.System(deposit(n, seed=seed, radii=radii, width=width), mu_pp=mu,
+                           mu_plane=mu, mu_wall=mu)
+    assert analyse(system, ranges=False).exists is (not empty)
+    prob = StaticProblem(system)
+    C = cone_rows(prob)
+    verdicts = []
+    for crossover in (False, True):
+        y = farkas_lp(prob, C, crossover)
+        cert = None if y is None else _settle(prob, C, y)
+        verdicts.append(cert is not None and cert.proves)
+        if cert is not None and cert.proves:
+            g = prob.A.T @ cert.y
+            v = np.where(prob.mu > 0, prob.mu * np.abs(g[prob.c:]) - g[:prob.c], -g[:prob.c])
+            assert prob.b @ cert.y < 0 and (cert.exact or np.max(v) <= 1e-13)
+    assert verdicts == [empty, empty]
