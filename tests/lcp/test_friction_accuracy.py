@@ -23,8 +23,10 @@ from rigidlcp.lcp.acceptance.friction_accuracy import (
     states_of,
 )
 
-#: Siconos's FC2D files (read-only, beside the checkout) when present; else the copies here.
-SICONOS = next((d / "shared" / "data" / "siconos" / "fc2d" for d in Path(__file__).parents
+#: Siconos's FC2D files (read-only, beside the checkout, or this machine's /work/shared for a
+#: clone elsewhere, as tests/lcp/test_accuracy.py) when present; else the copies here.
+SICONOS = next((d / "shared" / "data" / "siconos" / "fc2d"
+                for d in (*Path(__file__).parents, Path("/work"))
                 if (d / "shared" / "data" / "siconos" / "fc2d").is_dir()), Path("/nonexistent"))
 LOCAL = Path(__file__).resolve().parents[1] / "data" / "siconos"
 METHODS = ("states", "nsgs", "lemke", "pivoting", "newton-fb")
@@ -204,7 +206,7 @@ def test_siconos_fc2d_answers_carry_both_errors_and_the_bounds_hold(path):
 
 
 @pytest.mark.slow
-@pytest.mark.skipif(not SICONOS.is_dir(), reason="../shared/data/siconos/fc2d is absent")
+@pytest.mark.skipif(not SICONOS.is_dir(), reason="shared/data/siconos/fc2d is absent")
 @pytest.mark.parametrize("name", ["fc2d_granularflowonwall_00667_00000.dat",
                                   "fc2d_granularflowonwall_02020_00213.dat"])
 def test_siconos_granular_files_solved_by_states_with_both_errors(name):
