@@ -35,9 +35,10 @@ def quiet_stdout() -> Iterator[None]:
         os.close(saved)
 
 
-def new_highs():
-    """A `highspy.Highs` with output_flag off; the first one of the process is built with
-    descriptor 1 silenced, so that HiGHS's banner is not printed."""
+def new_highs(**options):
+    """A `highspy.Highs` with output_flag off and each of `options` set (HiGHS option names,
+    e.g. presolve="off"); the first one of the process is built with descriptor 1 silenced, so
+    that HiGHS's banner is not printed."""
     global _HIGHS_GREETED
     import highspy
 
@@ -48,4 +49,6 @@ def new_highs():
             h = highspy.Highs()
         _HIGHS_GREETED = True
     h.setOptionValue("output_flag", False)
+    for key, value in options.items():
+        h.setOptionValue(key, value)
     return h

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .uniqueness import quiet_highs
+from rigidlcp.lcp.quiet import new_highs
 
 #: HiGHS tolerances for the face LPs (its defaults are 1e-7).
 _TOL = 1e-10
@@ -107,12 +107,8 @@ class FaceLP:
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
             K.indptr, K.indices, K.data)
-        with quiet_highs():  # the banner HiGHS prints on fd 1 when first constructed
-            h = highspy.Highs()
-        for key, value in (("output_flag", False), ("presolve", "off"),
-                           ("primal_feasibility_tolerance", _TOL),
-                           ("dual_feasibility_tolerance", _TOL)):
-            h.setOptionValue(key, value)
+        h = new_highs(presolve="off", primal_feasibility_tolerance=_TOL,
+                      dual_feasibility_tolerance=_TOL)
         h.passModel(lp)
         self._h, self._hs, self.n = h, highspy, n
 

@@ -40,6 +40,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import null_space
 
+from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.system import System
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
@@ -99,11 +100,7 @@ class _P:
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
             rows.indptr, rows.indices, rows.data)
-        with quiet_highs():
-            h = highspy.Highs()
-        for key, value in (("output_flag", False), ("primal_feasibility_tolerance", 1e-10),
-                           ("dual_feasibility_tolerance", 1e-10)):
-            h.setOptionValue(key, value)
+        h = new_highs(primal_feasibility_tolerance=1e-10, dual_feasibility_tolerance=1e-10)
         h.passModel(lp)
         self.h, self.hs, self.n, self.count = h, highspy, 2 * c, 0
 

@@ -37,6 +37,7 @@ from itertools import product
 import numpy as np
 import scipy.sparse as sp
 
+from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .bounds import rotation_cap
@@ -109,11 +110,7 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     base_hi = np.r_[e, np.full(2 * fr.size, np.inf), np.full(p, M)]
     lb = form.lb[:2 * c].copy()
     ub = form.ub[:2 * c].copy()
-    with quiet_highs():
-        h = highspy.Highs()
-    for key, value in (("output_flag", False), ("primal_feasibility_tolerance", 1e-10),
-                       ("dual_feasibility_tolerance", 1e-10)):
-        h.setOptionValue(key, value)
+    h = new_highs(primal_feasibility_tolerance=1e-10, dual_feasibility_tolerance=1e-10)
     n = beta.size
     rows_a = mu[beta, None] * np.sign(b[beta])[:, None] * I2[beta] + I2[c + beta]  # (a)
     rows_b = eps[:, None] * ra[disk]  # (b)

@@ -23,6 +23,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .kinematics import realizable
@@ -111,13 +112,8 @@ class MilpModel:
             if integer:
                 lp.integrality_ = [highspy.HighsVarType.kInteger if v else
                                    highspy.HighsVarType.kContinuous for v in form.integrality]
-            with quiet_highs():
-                h = highspy.Highs()
-            for key, value in (("output_flag", False), ("mip_rel_gap", 0.0),
-                               ("mip_abs_gap", 1e-13), ("mip_feasibility_tolerance", 1e-9),
-                               ("primal_feasibility_tolerance", 1e-9),
-                               ("dual_feasibility_tolerance", 1e-9)):
-                h.setOptionValue(key, value)
+            h = new_highs(mip_rel_gap=0.0, mip_abs_gap=1e-13, mip_feasibility_tolerance=1e-9,
+                          primal_feasibility_tolerance=1e-9, dual_feasibility_tolerance=1e-9)
             h.passModel(lp)
             return h
 

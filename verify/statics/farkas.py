@@ -34,7 +34,7 @@ from fractions import Fraction
 import numpy as np
 import scipy.sparse as sp
 
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
+from rigidlcp.lcp.quiet import new_highs
 
 from .model import StaticProblem
 
@@ -123,13 +123,8 @@ def farkas_lp(prob: StaticProblem, C: sp.csr_matrix, crossover: bool) -> np.ndar
     lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
         Cc.indptr, Cc.indices, Cc.data)
-    with quiet_highs():
-        h = highspy.Highs()
-    for key, value in (("output_flag", False), ("solver", "ipm"),
-                       ("run_crossover", "on" if crossover else "off"),
-                       ("primal_feasibility_tolerance", 1e-10),
-                       ("dual_feasibility_tolerance", 1e-10)):
-        h.setOptionValue(key, value)
+    h = new_highs(solver="ipm", run_crossover="on" if crossover else "off",
+                  primal_feasibility_tolerance=1e-10, dual_feasibility_tolerance=1e-10)
     h.passModel(lp)
     h.run()
     if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:

@@ -22,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidlcp import models
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
+from rigidlcp.lcp.quiet import new_highs
 
 #: HiGHS's primal and dual feasibility tolerances (relative to O(1) data: rows are scaled).
 LP_TOL = 1e-10
@@ -95,14 +95,10 @@ class ForceLP:
         lp, self.T, k = cone_lp(prob)
         nw = lp.num_col_
         self.u_col, self.v_col = np.arange(k), k + np.arange(k)
-        with quiet_highs():
-            h = highspy.Highs()
         # primal simplex: a new objective leaves the last basis primal feasible, so each
         # range LP restarts from the previous optimum (3.5x faster than the default here)
-        for key, value in (("output_flag", False), ("presolve", "off"),
-                           ("simplex_strategy", 4), ("primal_feasibility_tolerance", LP_TOL),
-                           ("dual_feasibility_tolerance", LP_TOL)):
-            h.setOptionValue(key, value)
+        h = new_highs(presolve="off", simplex_strategy=4, primal_feasibility_tolerance=LP_TOL,
+                      dual_feasibility_tolerance=LP_TOL)
         h.passModel(lp)
         self.h, self.nw = h, nw
         self.cols = np.arange(nw, dtype=np.int32)
@@ -168,11 +164,7 @@ def interior_point(prob: StaticProblem, bound: float) -> tuple[str, np.ndarray |
 
     lp, T, _ = cone_lp(prob)
     lp.col_upper_ = np.full(lp.num_col_, bound)
-    with quiet_highs():
-        h = highspy.Highs()
-    for key, value in (("output_flag", False), ("solver", "ipm"), ("run_crossover", "off"),
-                       ("presolve", "off")):
-        h.setOptionValue(key, value)
+    h = new_highs(solver="ipm", run_crossover="off", presolve="off")
     h.passModel(lp)
     h.run()
     status = h.getModelStatus()
