@@ -67,7 +67,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     import numpy as np
 
     from rigidlcp import models
-    from rigidlcp.cli.simulate import DENSE_ONLY, refuse_too_large_for_dense
+    from rigidlcp.cli.simulate import DENSE_ONLY, refuse_array_options, refuse_too_large_for_dense
     from rigidlcp.models.engine.simulate import check_dense_memory
     from rigidlcp.verify.nullspace.contact import (
         null_space,
@@ -77,9 +77,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     )
 
     if args.packing:
-        if (args.lattice, args.lx, args.ly) != ("rect", 4, 3):  # else silently ignored
-            raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
-                             "--ly describe an array, give one or the other")
+        refuse_array_options(args, ("rect", 4, 3))  # nullspace's own defaults
         lattice = packing_lattice(args.packing)
         check_dense_memory(lattice.c, f"the dense contact matrix of {args.packing} "
                            f"({lattice.c} contacts)", instead=DENSE_ONLY)

@@ -47,9 +47,7 @@ def system_from_args(args):
     from rigidlcp.models.system import make_system
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
-        if (args.lattice, args.lx, args.ly) != ARRAY_DEFAULTS:  # else silently ignored
-            raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
-                             "--ly describe an array, give one or the other")
+        refuse_array_options(args)
         from rigidlcp.models.system import System
 
         return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
@@ -61,6 +59,14 @@ def system_from_args(args):
 #: The advice of the commands that have no sparse path.
 DENSE_ONLY = ("this command is dense only: use a smaller array (the event-driven evolution of "
               "large arrays: rigidlcp simulate --method sparse-pivoting --select none)")
+
+
+def refuse_array_options(args, defaults: tuple = ARRAY_DEFAULTS) -> None:
+    """--packing with --lattice/--lx/--ly changed from their `defaults`: refused (they would
+    be silently ignored)."""
+    if (args.lattice, args.lx, args.ly) != defaults:
+        raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
+                         "--ly describe an array, give one or the other")
 
 
 def packing_of(args):

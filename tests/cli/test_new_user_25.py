@@ -179,3 +179,15 @@ def test_no_progress_bar_when_there_is_nothing_to_range(tmp_path, capsys):
     assert main(["forceset", str(f)]) == 0  # default friction: a Farkas certificate
     cap = capsys.readouterr()
     assert "no equilibrium" in cap.out and cap.err == ""
+
+
+@pytest.mark.parametrize("array", [["--lx", "5"], ["--ly", "4"]])
+def test_nullspace_packing_with_array_options_is_refused(tmp_path, capsys, array):
+    """nullspace's own array defaults (rect 4 x 3) differ from simulate's: a changed --lx/--ly
+    beside --packing is refused there too, while --packing alone runs."""
+    f = tmp_path / "three.csv"
+    f.write_text(THREE)
+    assert main(["nullspace", "--packing", str(f), *array]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "--packing takes its disks from the file" in err and "\n" not in err
+    assert main(["nullspace", "--packing", str(f)]) == 0
