@@ -216,13 +216,14 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
         total = sum(1 if isinstance(p, Unreadable) else len(methods)
                     for problems in sets.values() for p in problems)
         count = [len(done)]
+        mw = max([len(m) for m in methods] + [14])  # the method column, aligned
 
         def progress(r) -> None:
             append_csv(r, csv_path)
             count[0] += 1
-            if not args.quiet:
-                print(f"[{count[0]}/{total}] {r.problem:<40} {r.method:<14} {r.outcome:<14} "
-                      f"{1e3 * r.time:10.2f} ms", flush=True)
+            if not args.quiet:  # progress on stderr: stdout is the result
+                print(f"[{count[0]}/{total}] {r.problem:<40} {r.method:<{mw}} {r.outcome:<14} "
+                      f"{1e3 * r.time:10.2f} ms", file=sys.stderr, flush=True)
 
         warmups: dict = {}
         skip = {(r.set, r.problem, r.method) for r in done}
@@ -267,10 +268,26 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     report = write_report(results, out, time_limit=args.time_limit, tol=args.tol,
                           set_info=set_info, header=header, notes=notes, environment=env,
                           rerun=rerun, warmups=warmups)
+    _print_summary(results, args.time_limit)
     print(f"wrote {csv_path} and {report}")
     for line in notes:
         print(f"note: {line}")
     return 0
+
+
+def _print_summary(results, time_limit: float) -> None:
+    """The result on stdout: per method over all sets, certified answers / problems given,
+    refusals, failures and the SGM time (report.md has the full tables)."""
+    from rigidlcp.bench.report import _fmt_time, summarize
+
+    rows = summarize(results, time_limit)
+    width = max([len(s.method) for s in rows] + [6])
+    print(f"{'method':<{width}}  {'certified':>11}  {'refused':>7}  {'SGM time':>9}  failures")
+    for s in rows:
+        ran = s.problems - s.refused
+        fails = ", ".join(f"{k} {v}" for k, v in sorted(s.failures.items())) or "-"
+        print(f"{s.method:<{width}}  {f'{s.successes}/{s.problems}':>11}  {s.refused:>7}  "
+              f"{_fmt_time(s.sgm_time) if ran else '-':>9}  {fails}")
 
 
 def _slug(name: str) -> str:

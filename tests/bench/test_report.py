@@ -200,8 +200,13 @@ def test_resume_keeps_the_rows_done_and_runs_the_rest(tmp_path, capsys):
         writer.writerow(rows[0])
     capsys.readouterr()
     assert cli_main(args + ["--resume"]) == 0
-    printed = [line for line in capsys.readouterr().out.splitlines() if line.startswith("[")]
-    assert len(printed) == 3  # only the three missing pairs ran
+    captured = capsys.readouterr()
+    printed = [line for line in captured.err.splitlines() if line.startswith("[")]
+    assert len(printed) == 3  # only the three missing pairs ran (progress: on stderr)
+    assert not [line for line in captured.out.splitlines() if line.startswith("[")]
+    table = captured.out.splitlines()  # stdout is the result: one row per method
+    assert table[0].split()[:2] == ["method", "certified"]
+    assert [line.split()[:2] for line in table[1:3]] == [["lemke", "2/2"], ["pivoting", "2/2"]]
     back = read_csv(path)
     assert sorted((r.problem, r.method) for r in back) == \
         sorted((r["problem"], r["method"]) for r in rows)
