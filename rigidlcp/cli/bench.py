@@ -288,6 +288,9 @@ def _print_summary(results, time_limit: float) -> None:
         fails = ", ".join(f"{k} {v}" for k, v in sorted(s.failures.items())) or "-"
         print(f"{s.method:<{width}}  {f'{s.successes}/{s.problems}':>11}  {s.refused:>7}  "
               f"{_fmt_time(s.sgm_time) if ran else '-':>9}  {fails}")
+    for r in results:
+        if r.method == "-":  # an unreadable file: one row, no method ran on it
+            print(f"unreadable: {r.problem}: {r.message}")
 
 
 def _slug(name: str) -> str:

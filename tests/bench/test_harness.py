@@ -269,3 +269,19 @@ def test_batched_lemke_answers_as_single_solves():
         in_batch = a.method == "lemke" and (a.set, a.n) in shared
         assert a.message.startswith("batch of ") == in_batch
         assert not b.message.startswith("batch of ")
+
+
+def test_bench_stdout_names_an_unreadable_file(tmp_path, capsys):
+    """stdout is the result: the per-method table and a line per unreadable file (a new
+    user otherwise sees "15 problems" for 16 files and no reason); progress on stderr."""
+    folder = tmp_path / "f"
+    folder.mkdir()
+    get_set("random-p", sizes=(3,), per_size=1)[0].save(folder / "good.npz")
+    (folder / "broken.dat").write_text("2\n0\n2\n2\n2\t2\n1 2\n")
+    assert cli_main(["bench", "--set", str(folder), "--methods", "lemke", "--out",
+                     str(tmp_path / "o"), "--no-siconos", "--no-isolation"]) == 0
+    captured = capsys.readouterr()
+    out = captured.out.splitlines()
+    assert out[1].split()[:2] == ["lemke", "1/1"]
+    assert any(line.startswith("unreadable: f/broken: ") and "line 6" in line for line in out)
+    assert "[1/2]" in captured.err and "[1/2]" not in captured.out
