@@ -95,6 +95,10 @@ def run_case(case: Case, method: str, done: tuple | None = None) -> dict:
     return res
 
 
+#: seconds between the one-line progress counts on stderr (unless --no-progress)
+PROGRESS_SECONDS = 10.0
+
+
 def run_fuzz(count: int, seed: int = 0, out: str | Path | None = None,
              classes: tuple[str, ...] = CLASSES, methods: tuple[str, ...] | None = None,
              progress=None) -> dict:
@@ -150,7 +154,10 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated classes")
     ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
     ap.add_argument("--progress", type=int, default=0, metavar="K",
-                    help="print the table so far to stderr every K problems (default: never)")
+                    help="print the table so far to stderr every K problems (default: never; "
+                    f"a one-line count goes to stderr every {PROGRESS_SECONDS:g} s anyway)")
+    ap.add_argument("--no-progress", action="store_true",
+                    help="no progress lines on stderr")
     ap.add_argument("--files", nargs="+", default=None, help="judge the methods on these LCP "
                     "and MLCP files (Siconos's text formats or .npz) instead of generated "
                     "problems")
@@ -183,14 +190,25 @@ def run_from_args(args: argparse.Namespace) -> int:
         what = f"{len(args.files)} files"
     else:
         every = max(1, args.progress)
+        last = [t0]
 
         def progress(k: int, partial: dict) -> None:
-            if k % every == 0 and k < args.count:
-                print(f"[{k} of {args.count} problems, {time.perf_counter() - t0:.0f} s]\n"
+            now = time.perf_counter()
+            if k >= args.count:
+                return
+            if args.progress and k % every == 0:
+                print(f"[{k} of {args.count} problems, {now - t0:.0f} s]\n"
                       + format_table(partial), file=sys.stderr, flush=True)
+            elif now - last[0] >= PROGRESS_SECONDS:
+                bad = sum(c["WRONG"] + c["crash"] for c in partial["table"].values())
+                print(f"fuzz: {k} of {args.count} problems, {now - t0:.0f} s, {bad} "
+                      "silent-wrong or crashing so far", file=sys.stderr, flush=True)
+            else:
+                return
+            last[0] = now
 
         result = run_fuzz(args.count, args.seed, args.out, classes, methods,
-                          progress=progress if args.progress else None)
+                          progress=None if args.no_progress else progress)
         what = f"{args.count} problems, seed {args.seed}"
     print(format_table(result))
     wrong = sum(c["WRONG"] + c["crash"] for c in result["table"].values())

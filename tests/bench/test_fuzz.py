@@ -121,3 +121,22 @@ def test_batched_lemke_judged_as_one_by_one(monkeypatch):
              for k, cell in batched["table"].items()}
     assert strip == {k: {o: v for o, v in cell.items() if o != "seconds"}
                      for k, cell in single["table"].items()}
+
+
+def test_progress_by_default_on_stderr_and_none_with_no_progress(monkeypatch, capsys):
+    """Without --progress K, a one-line count goes to stderr every PROGRESS_SECONDS (here 0:
+    after every problem but the last); --no-progress silences it; stdout is the table."""
+    from rigidlcp.bench import fuzz
+    from rigidlcp.cli.main import main as cli
+
+    monkeypatch.setattr(fuzz, "PROGRESS_SECONDS", 0.0)
+    args = ["fuzz", "--count", "3", "--seed", "5", "--methods", "lemke"]
+    assert cli(args) == 0
+    captured = capsys.readouterr()
+    lines = captured.err.splitlines()
+    assert [line.split(",")[0] for line in lines] == ["fuzz: 1 of 3 problems",
+                                                     "fuzz: 2 of 3 problems"]
+    assert "0 silent-wrong or crashing so far" in lines[0]
+    assert "fuzz:" not in captured.out and "| P | lemke |" in captured.out
+    assert cli(args + ["--no-progress"]) == 0
+    assert capsys.readouterr().err == ""
