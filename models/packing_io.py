@@ -7,7 +7,13 @@
 * .npz: arrays x, y, r [, m, I] and optional scalars left, right (NaN: no such wall).
 * LAMMPS dump (text, `dump ... custom`): the first snapshot's `ITEM: ATOMS` columns x, y and
   radius (mass optional); atoms in the file's order. Recognized by its first line
-  `ITEM: TIMESTEP`.
+  `ITEM: TIMESTEP`. Its `ITEM: BOX BOUNDS` give the walls from the x line and its boundary
+  flag (one letter per side: lo, hi): "f" (fixed; also a line without flags) a wall at xlo /
+  xhi; "s", "m" (shrink-wrapped: the box follows the atoms' centres) no stated wall (the tight
+  box, as without BOX BOUNDS); "p" (periodic) and a tilted box (triclinic, xy != 0) are refused
+  unless the caller gives that wall (left= / right=: a position or "none"), since neither is a
+  vertical wall and contacts across a periodic boundary are not modelled. The y and z lines are
+  not used: the plane is y = 0 and the frame is not moved.
 
 Missing m: m = r^2; missing I: I = m r^2 / 2 (uniform disks; the units of the arrays, where a
 disk of radius 1 has mass 1). Walls not given by the file or the caller: the tight box
@@ -19,7 +25,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -45,17 +51,24 @@ class Disks:
     I: np.ndarray  # noqa: E741 (the paper's I)
     left: float | None | str = None
     right: float | None | str = None
+    #: {"left" | "right": why the file's bound on that side is not a wall} (a LAMMPS dump's
+    #: periodic or tilted box): refused unless the caller gives that wall
+    unusable: dict = field(default_factory=dict)
 
     def box(self, left=None, right=None) -> tuple[float | None, float | None]:
         """The walls: the caller's, else the file's, else the tight box; "none": no wall."""
-        def pick(given, stated, tight):
+        def pick(name, given, stated, tight):
+            if given is None and name in self.unusable:
+                raise InvalidFile(f"{self.unusable[name]}: give the {name} wall ({name}=X or "
+                                  f"'none'; `rigidlcp forceset --{name}`), or write the disks "
+                                  "as a CSV with a '# box: left=.. right=..' comment")
             v = given if given is not None else stated
             if v is None:
                 return tight
             return None if v == "none" else float(v)
 
-        return (pick(left, self.left, float(np.min(self.x[:, 0] - self.r))),
-                pick(right, self.right, float(np.max(self.x[:, 0] + self.r))))
+        return (pick("left", left, self.left, float(np.min(self.x[:, 0] - self.r))),
+                pick("right", right, self.right, float(np.max(self.x[:, 0] + self.r))))
 
 
 def read_disks(path: str | os.PathLike) -> Disks:
@@ -208,7 +221,40 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
         for c, name in need.items():
             cols[c].append(_number(path, k, name, fields[names.index(name)],
                                    positive=c in ("r", "m")))
-    return _finish(path, cols)
+    disks = _finish(path, cols)
+    _lammps_box(path, lines[:start], disks)
+    return disks
+
+
+def _lammps_box(path: Path, head: list[str], disks: Disks) -> None:
+    """The walls of a dump's `ITEM: BOX BOUNDS` (module docstring) into disks."""
+    at = next((k for k, line in enumerate(head) if line.startswith("ITEM: BOX BOUNDS")), None)
+    if at is None:
+        return  # no box: the tight box
+    words = head[at].split()[3:]
+    tilted = words[:3] == ["xy", "xz", "yz"]
+    flags = words[3:] if tilted else words
+    flag = flags[0] if flags else "ff"  # old dumps state no flags: the box is fixed
+    if len(flag) != 2 or any(f not in "fsmp" for f in flag):
+        raise InvalidFile(f"{path} line {at + 1}: x boundary flag {flag!r} (expected two of "
+                          "f, s, m, p)")
+    if at + 1 >= len(head):
+        raise InvalidFile(f"{path} line {at + 2}: the x bounds are missing")
+    fields = head[at + 1].split()
+    if len(fields) != (3 if tilted else 2):
+        raise InvalidFile(f"{path} line {at + 2}: {len(fields)} fields, the x bounds need "
+                          f"{3 if tilted else 2}")
+    lo, hi = (_number(path, at + 2, name, v) for name, v in zip(("xlo", "xhi"), fields))
+    tilt = _number(path, at + 2, "xy", fields[2]) if tilted else 0.0
+    for name, f, x in (("left", flag[0], lo), ("right", flag[1], hi)):
+        if tilt != 0.0:
+            disks.unusable[name] = (f"{path} line {at + 2}: the box is tilted (xy = {tilt:g}), "
+                                    "its x faces are not vertical walls")
+        elif f == "p":
+            disks.unusable[name] = (f"{path} line {at + 1}: the x boundary is periodic; "
+                                    "contacts across it are not modelled")
+        elif f == "f":
+            setattr(disks, name, x)
 
 
 def write_packing(path: str | os.PathLike, lattice: Lattice, m: np.ndarray | None = None,

@@ -9,6 +9,7 @@ import pytest
 from rigidlcp import models
 from rigidlcp.lcp.errors import InvalidFile, OutputExists
 from rigidlcp.models.deposition import deposit
+from rigidlcp.models.packing import Overlap
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, event_problem, initial_state
 from rigidlcp.models.packing_io import read_disks, read_packing, write_packing
@@ -61,7 +62,7 @@ LAMMPS = """ITEM: TIMESTEP
 0
 ITEM: NUMBER OF ATOMS
 2
-ITEM: BOX BOUNDS pp ff pp
+ITEM: BOX BOUNDS ff ff pp
 0 4
 0 10
 -0.5 0.5
@@ -81,6 +82,56 @@ def test_lammps_dump(tmp_path):
     f.write_text(LAMMPS.replace("2 1 3.0 1.0 0 1.0", "2 1 3.0 1.0 0 abc"))
     with pytest.raises(InvalidFile, match=r"line 11, field 'radius': 'abc' is not a number"):
         read_disks(f)
+
+
+def _dump(tmp_path, box: str | None):
+    """LAMMPS with its BOX BOUNDS header and x line replaced (None: no BOX BOUNDS at all)."""
+    lines = LAMMPS.splitlines()
+    if box is None:
+        del lines[4:8]
+    else:
+        lines[4:6] = box.splitlines()
+    f = tmp_path / "dump.atoms"
+    f.write_text("\n".join(lines) + "\n")
+    return f
+
+
+def test_lammps_box_bounds_are_the_walls(tmp_path):
+    """x's fixed bounds are the walls (here 0 and 6: the right disk does not touch x = 6);
+    without BOX BOUNDS or with shrink-wrapped bounds, the tight box (0 and 4)."""
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS ff ff pp\n0 6"))
+    assert (lat.left, lat.right, lat.c) == (0.0, 6.0, 4)  # plane x2, left wall, the pair
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS\n0.0 6.0"))  # old dumps: no flags
+    assert (lat.left, lat.right) == (0.0, 6.0)
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS fs ff pp\n-1 7"))
+    assert (lat.left, lat.right, lat.c) == (-1.0, 4.0, 4)  # shrink-wrapped right: tight
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS xy xz yz ff ff pp\n0 6 0"))
+    assert (lat.left, lat.right) == (0.0, 6.0)  # triclinic without tilt
+    lat = read_packing(_dump(tmp_path, None))
+    assert (lat.left, lat.right, lat.c) == (0.0, 4.0, 5)  # no BOX BOUNDS: the tight box
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS ff ff pp\n0 6"), right="none")
+    assert lat.right is None  # the caller's wall wins
+
+
+@pytest.mark.parametrize("box, message", [
+    ("ITEM: BOX BOUNDS pp ff pp\n0 4", r"line 5: the x boundary is periodic.*forceset --left"),
+    ("ITEM: BOX BOUNDS xy xz yz ff ff pp\n0 4 0.5", r"tilted \(xy = 0.5\)"),
+    ("ITEM: BOX BOUNDS qq ff pp\n0 4", r"line 5: x boundary flag 'qq'"),
+    ("ITEM: BOX BOUNDS ff ff pp\n0 four", r"line 6, field 'xhi': 'four' is not a number"),
+    ("ITEM: BOX BOUNDS ff ff pp\n0 4 1", r"line 6: 3 fields, the x bounds need 2"),
+    ("ITEM: BOX BOUNDS ff ff pp\n0.5 4", r"disk 0 overlaps the left wall"),
+])
+def test_lammps_box_bounds_refused_naming_the_line(tmp_path, box, message):
+    """A periodic or tilted x is not a wall (refused unless the caller gives the walls), a
+    bad flag or bound names its line, a wall through a disk is an overlap."""
+    with pytest.raises(Overlap if "overlaps" in message else InvalidFile, match=message):
+        read_packing(_dump(tmp_path, box))
+
+
+def test_lammps_periodic_x_with_the_callers_walls(tmp_path):
+    lat = read_packing(_dump(tmp_path, "ITEM: BOX BOUNDS pp ff pp\n0 4"), left="none",
+                       right="none")
+    assert (lat.left, lat.right, lat.c) == (None, None, 3)
 
 
 @pytest.mark.parametrize("text, message", [
