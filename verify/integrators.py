@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.models.engine.records import EventRecord, Run
 from rigidlcp.models.event import State, acceleration_tol, event_problem
 from rigidlcp.models.modes import row_modes
@@ -146,7 +147,7 @@ def omega_at(run: Run, T: float) -> np.ndarray:
     t = run.array("t")
     k = int(np.searchsorted(t, T, side="right")) - 1
     if k < 0:
-        raise ValueError(f"T = {T} is before the run's first event")
+        raise InvalidInput(f"T = {T} is before the run's first event")
     rec = run.records[k]
     return rec.omega + rec.omega_dot * (T - rec.t)
 
@@ -174,9 +175,9 @@ def compare_integrators(system: models.System, seed: int | None = 1,
     depends on that phase; averaging over phases shows the first order cleanly.
     """
     if not (isinstance(phases, int) and phases >= 1):
-        raise ValueError(f"phases must be an integer >= 1, got {phases!r}")
+        raise InvalidInput(f"phases must be an integer >= 1, got {phases!r}")
     if len(hs) < 2 or any(not (h > 0) for h in hs):
-        raise ValueError(f"hs must hold at least two step sizes > 0, got {hs!r}")
+        raise InvalidInput(f"hs must hold at least two step sizes > 0, got {hs!r}")
     ed = models.simulate(system, seed=seed, t_max=t_max, **(event_options or {}))
     if not ed.records:
         raise ValueError(f"the event-driven run has no event ({ed.status}: {ed.message})")

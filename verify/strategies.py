@@ -30,6 +30,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from rigidlcp.lcp import LCP, MLCP
+from rigidlcp.lcp.errors import InvalidInput
 
 __all__ = [
     "P_KINDS", "p_matrices", "symmetric_psd", "lcps", "degenerate_lcps", "mlcps",
@@ -54,7 +55,7 @@ LY = st.integers(1, 6)
 def _size(draw, n: SizeLike, least: int = 1) -> int:
     value = draw(n) if isinstance(n, st.SearchStrategy) else n
     if not isinstance(value, (int, np.integer)) or value < least:
-        raise ValueError(f"sizes must be integers >= {least}, got {value!r}")
+        raise InvalidInput(f"sizes must be integers >= {least}, got {value!r}")
     return int(value)
 
 
@@ -99,7 +100,7 @@ def p_matrices(draw, n: SizeLike = SMALL, *, kind: str | None = None) -> np.ndar
     size = _size(draw, n)
     kind = kind if kind is not None else draw(st.sampled_from(P_KINDS))
     if kind not in P_KINDS:
-        raise ValueError(f"kind must be one of {P_KINDS} or None, got {kind!r}")
+        raise InvalidInput(f"kind must be one of {P_KINDS} or None, got {kind!r}")
     if kind == "positive-definite":
         B = _matrix(draw, size, size)
         K = _matrix(draw, size, size) * draw(_unit(0.0, 2.0))
@@ -136,12 +137,12 @@ def symmetric_psd(
     if singular:
         r = _size(draw, rank) if rank is not None else draw(st.integers(0, size - 1))
         if r >= size:
-            raise ValueError(f"a singular matrix needs rank < n = {size}, got {r}")
+            raise InvalidInput(f"a singular matrix needs rank < n = {size}, got {r}")
         B = _matrix(draw, size, r) if r else np.zeros((size, 0))
         M = B @ B.T
     else:
         if rank is not None:
-            raise ValueError("rank applies only with singular=True")
+            raise InvalidInput("rank applies only with singular=True")
         B = _matrix(draw, size, size)
         M = B @ B.T + draw(_unit(0.1, 1.0)) * np.eye(size)
     return 0.5 * (M + M.T)
@@ -209,7 +210,7 @@ def degenerate_lcps(
     elif base == "psd":
         M0 = draw(symmetric_psd(n0, singular=n0 > 1 and draw(st.booleans())))
     else:
-        raise ValueError(f"base must be 'p', 'psd' or None, got {base!r}")
+        raise InvalidInput(f"base must be 'p', 'psd' or None, got {base!r}")
     z0, w0, q0 = draw(planted_solution(M0))
     if zeros:
         Mz = M0 @ z0

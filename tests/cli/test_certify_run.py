@@ -10,6 +10,7 @@ import pytest
 
 from rigidlcp import models
 from rigidlcp.cli import main
+from rigidlcp.lcp.errors import InvalidInput, OutputExists
 from rigidlcp.models.runio import save_run
 from rigidlcp.verify.certificates.run import FIGURE, LINES, SUMMARY, certify_run
 
@@ -65,13 +66,13 @@ def test_never_overwrites_and_checks_options(run_file, tmp_path):
     path, _ = run_file
     out = tmp_path / "cert"
     certify_run(path, out, events=[0])
-    with pytest.raises(ValueError, match="--resume"):
+    with pytest.raises(OutputExists, match="--resume"):
         certify_run(path, out, events=[0])
-    with pytest.raises(ValueError, match="other options"):
+    with pytest.raises(InvalidInput, match="other options"):
         certify_run(path, out, resume=True, time_limit=3.0)
     res = certify_run(path, out, events=[0, 1], force=True)
     assert res.skipped == 0 and res.ran == 2
-    with pytest.raises(ValueError, match="out of range"):
+    with pytest.raises(InvalidInput, match="out of range"):
         certify_run(path, tmp_path / "other", events=[99])
 
 

@@ -30,6 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint
 
+from rigidlcp.lcp.errors import InvalidInput
+
 from .uniqueness import confirmed_milp, scaled_residual
 
 _HIGHS = {"mip_feasibility_tolerance": 1e-9, "primal_feasibility_tolerance": 1e-9}
@@ -54,7 +56,7 @@ def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float
     q = np.asarray(q, dtype=float)
     n = q.size
     if not S > 0:
-        raise ValueError(f"S must be positive, got {S}")
+        raise InvalidInput(f"S must be positive, got {S}")
     wmax = np.maximum(np.max(M, axis=1) + np.maximum(q, 0.0) / S, 0.0)
     # columns: zeta (n) | theta | y (n)
     N = 2 * n + 1

@@ -11,6 +11,7 @@ import numpy as np
 from rigidlcp import lcp
 from rigidlcp.lcp import Solution
 from rigidlcp.lcp.acceptance.friction_accuracy import FCAccuracy, assess_fc2d
+from rigidlcp.lcp.errors import InvalidInput
 
 #: Friction contact: uniqueness is asked on the dense Glocker LCP up to this many contacts.
 FC_UNIQUENESS_MAX_C = 200
@@ -44,7 +45,7 @@ def friction_certificate(fc: lcp.FrictionContact2D, solution, tol: float, unique
     r = np.asarray(solution.z if isinstance(solution, Solution) else solution, dtype=float)
     r = r.reshape(-1)
     if r.size != fc.n:
-        raise ValueError(f"the solution has {r.size} entries, the problem {fc.n} unknowns")
+        raise InvalidInput(f"the solution has {r.size} entries, the problem {fc.n} unknowns")
     res = lcp.natural_residual(fc, r)
     acc = fc_accuracy(fc, r)
     note = (f"friction contact: relative natural-map residual {res:.3e}, backward error "

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidlcp.lcp.errors import InvalidInput, OutputExists
 from rigidlcp.models.engine.records import Run
 from rigidlcp.models.event import event_problem
 from rigidlcp.models.observables import global_friction
@@ -151,7 +152,7 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
                                                                          events))
     bad = [k for k in todo_all if not 0 <= k < run.n_events]
     if bad:
-        raise ValueError(f"events {bad[:5]} out of range (the run has {run.n_events} events)")
+        raise InvalidInput(f"events {bad[:5]} out of range (the run has {run.n_events} events)")
     done: dict[int, dict] = {}
     lines = None
     notes: list[str] = []
@@ -197,9 +198,9 @@ def _prepare(out: Path, options: dict, resume: bool, force: bool, notes: list[st
     ours = [out / name for name in (LINES, SUMMARY, FIGURE, OPTIONS)]
     exists = out.exists() and any(out.iterdir()) if out.is_dir() else out.exists()
     if out.exists() and not out.is_dir():
-        raise ValueError(f"{out} exists and is not a directory")
+        raise InvalidInput(f"{out} exists and is not a directory")
     if exists and not (resume or force):
-        raise ValueError(f"{out} exists: pass --resume to continue it or --force to start "
+        raise OutputExists(f"{out} exists: pass --resume to continue it or --force to start "
                          "afresh")
     if exists and force:
         for path in ours:
@@ -210,7 +211,7 @@ def _prepare(out: Path, options: dict, resume: bool, force: bool, notes: list[st
     if resume and saved.exists():
         previous = json.loads(saved.read_text())
         if previous != options:
-            raise ValueError(f"{out} was certified with other options {previous}; pass "
+            raise InvalidInput(f"{out} was certified with other options {previous}; pass "
                              "--force to start afresh")
         lines = ResultsFile(out / LINES)
         for line in (lines.path.read_text().splitlines() if lines.path.exists() else []):

@@ -33,6 +33,7 @@ import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint, milp
 
 from rigidlcp.lcp.acceptance.residual import scaled_residual, scales
+from rigidlcp.lcp.errors import InvalidInput
 
 from .highs import HIGHS_MILP, quiet_highs
 from .pmatrix import P_MINORS_MAX_N, RCOND, PMatrixTest, p_matrix_test
@@ -134,11 +135,11 @@ def milp_search(
     q = np.asarray(q, dtype=float)
     z_star = np.asarray(z_star, dtype=float)
     if target not in ("pattern", "values"):
-        raise ValueError(f"target must be 'pattern' or 'values', got {target!r}")
+        raise InvalidInput(f"target must be 'pattern' or 'values', got {target!r}")
     if target == "values" and L is None:
-        raise ValueError("target 'values' needs the matrix L")
+        raise InvalidInput("target 'values' needs the matrix L")
     if objective not in ("none", "min-sum"):
-        raise ValueError(f"objective must be 'min-sum' or 'none', got {objective!r}")
+        raise InvalidInput(f"objective must be 'min-sum' or 'none', got {objective!r}")
     zs, ws = scales(M, q, z_star)
     U = float(bound) if bound is not None else BOUND_FACTOR * zs
     # HiGHS accepts y within 1e-9 of an integer, so z_i <= 1e-9 U "vanishes": a margin below

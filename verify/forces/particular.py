@@ -44,6 +44,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint, milp
 
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .polyhedra import (
@@ -125,7 +126,7 @@ def min_norm_solution(poly: Polyhedron, solver: str = "CLARABEL") -> Particular:
     """
     solver = solver.upper()
     if solver not in ("CLARABEL", "OSQP"):
-        raise ValueError(f"solver must be 'CLARABEL' or 'OSQP', got {solver!r}")
+        raise InvalidInput(f"solver must be 'CLARABEL' or 'OSQP', got {solver!r}")
     A, b = _independent_rows(poly.A_eq, poly.b_eq)
     x = cp.Variable(poly.n)
     cons = [A @ x == b]
@@ -214,7 +215,7 @@ def paper_solution(poly: Polyhedron, method: str = "milp", time_limit: float = 1
             raise EmptyPolyhedron(f"no admissible forces ({poly.description}): {r.message}")
         return _particular(poly, r.x, "paper (L1 heuristic: min sum R)")
     if method != "milp":
-        raise ValueError(f"method must be 'milp' or 'l1', got {method!r}")
+        raise InvalidInput(f"method must be 'milp' or 'l1', got {method!r}")
     c, n = poly.c, poly.n
     ranges = ranges or force_ranges(poly, variables=np.arange(c))
     Rmax = ranges.hi[:c].copy()

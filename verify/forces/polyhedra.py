@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import linprog
 
-from rigidlcp.lcp.errors import RigidLCPError
+from rigidlcp.lcp.errors import InvalidInput, RigidLCPError
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import EventProblem, acceleration_tol, contact_matrix
 from rigidlcp.models.lattice import PLANE
@@ -97,7 +97,7 @@ def state_polyhedron(system: System, normal: np.ndarray, tangential: np.ndarray,
     normal = np.asarray(normal, dtype=bool).reshape(-1)
     tang = np.array(tangential, dtype=int).reshape(-1)
     if normal.size != c or tang.size != c:
-        raise ValueError(f"one state per contact expected ({c})")
+        raise InvalidInput(f"one state per contact expected ({c})")
     tang[mu == 0] = 1  # frictionless: the row S + 1 * 0 * R = 0
     A_eq, b_eq = contact_matrix(system, normal, tang, dyn)
     rows, rhs = [], []

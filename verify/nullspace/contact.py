@@ -34,6 +34,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidFile, InvalidInput
 
 from .loops import LoopBasis, closed_form_loops, rotation_loops, rotation_matrix
 from .sparse import (
@@ -70,11 +71,11 @@ def paper_states(
     if kind == "normal":
         tangential = np.ones(c, dtype=int) if signs is None else np.asarray(signs, dtype=int)
         if tangential.shape != (c,) or not np.all(np.isin(tangential, (-1, 1))):
-            raise ValueError(f"signs must hold -1 or +1 for each of the {c} contacts")
+            raise InvalidInput(f"signs must hold -1 or +1 for each of the {c} contacts")
     elif kind == "tangential":
         tangential = np.where(system.mu > 0, 0, 1)
     else:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+        raise InvalidInput(f"kind must be one of {KINDS}, got {kind!r}")
     return normal, tangential
 
 @dataclass
@@ -174,7 +175,6 @@ def read_states(path: str, lattice: models.Lattice) -> tuple[np.ndarray, np.ndar
     import json
     from pathlib import Path
 
-    from rigidlcp.lcp.errors import InvalidFile
     from rigidlcp.lcp.io.files import open_npz
 
     path = Path(path)
@@ -200,21 +200,21 @@ def read_states(path: str, lattice: models.Lattice) -> tuple[np.ndarray, np.ndar
               ("ly", lambda v: int(v) == lattice.ly, lattice.ly))
     for key, ok, want in checks:
         if key in data and not ok(data[key]):
-            raise ValueError(f"{path}: {key} = {data[key]!r} but the lattice has {want!r}")
+            raise InvalidFile(f"{path}: {key} = {data[key]!r} but the lattice has {want!r}")
     for key in ("normal", "tangential"):
         if key not in data:
-            raise ValueError(f"{path}: missing '{key}' (one state per contact)")
+            raise InvalidFile(f"{path}: missing '{key}' (one state per contact)")
     c = lattice.c
     normal = [_NORMAL_WORDS.get(v, v) if isinstance(v, str) else v for v in data["normal"]]
     tang = [_TANGENTIAL_WORDS.get(v, v) if isinstance(v, str) else v for v in data["tangential"]]
     for key, values, ok in (("normal", normal, (True, False, 0, 1)),
                             ("tangential", tang, (-1, 0, 1))):
         if len(values) != c:
-            raise ValueError(f"{path}: '{key}' has {len(values)} entries, the lattice has {c} "
+            raise InvalidFile(f"{path}: '{key}' has {len(values)} entries, the lattice has {c} "
                              "contacts")
         bad = [v for v in values if isinstance(v, str) or v not in ok]
         if bad:
-            raise ValueError(f"{path}: '{key}' has invalid states {bad[:3]!r} (allowed: "
+            raise InvalidFile(f"{path}: '{key}' has invalid states {bad[:3]!r} (allowed: "
                              f"{'T/NT' if key == 'normal' else 'NS/+/-'})")
     return np.array(normal, dtype=bool), np.array(tang, dtype=int)
 

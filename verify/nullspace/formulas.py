@@ -28,7 +28,7 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from rigidlcp import models
-from rigidlcp.lcp.errors import NotApplicable
+from rigidlcp.lcp.errors import InvalidInput, NotApplicable
 
 from .contact import KINDS, paper_states, svd_rank
 
@@ -54,7 +54,7 @@ def _lattice_name(lattice: str | models.Lattice) -> str:
         raise NoClosedForm("Eqs. (3.3)/(3.4) are closed forms of the regular arrays (rect, "
                            "tri); a general packing has none: count its null space by SVD "
                            "(null_dim)")
-    raise ValueError(f"lattice must be 'rect' or 'tri', got {lattice!r}")
+    raise InvalidInput(f"lattice must be 'rect' or 'tri', got {lattice!r}")
 
 
 def closed_forms(lattice: models.Lattice) -> dict[str, int]:
@@ -66,7 +66,7 @@ def closed_forms(lattice: models.Lattice) -> dict[str, int]:
 
 def _kind(kind: str) -> str:
     if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+        raise InvalidInput(f"kind must be one of {KINDS}, got {kind!r}")
     return kind
 
 
@@ -107,7 +107,7 @@ def closed_form(lattice: str, lx: int, ly: int, kind: str, walls: str = "rough")
     when walls="frictionless".
     """
     if walls not in ("rough", "frictionless"):
-        raise ValueError(f"walls must be 'rough' or 'frictionless', got {walls!r}")
+        raise InvalidInput(f"walls must be 'rough' or 'frictionless', got {walls!r}")
     p, c = sizes(lattice, lx, ly)
     if _kind(kind) == "normal":
         return c - 2 * p
@@ -127,9 +127,9 @@ def _system(lattice: str, lx: int, ly: int, walls: str, mu: dict) -> models.Syst
     if walls == "frictionless":
         params["mu_wall"] = 0.0
     elif walls != "rough":
-        raise ValueError(f"walls must be 'rough' or 'frictionless', got {walls!r}")
+        raise InvalidInput(f"walls must be 'rough' or 'frictionless', got {walls!r}")
     elif params["mu_wall"] <= 0:
-        raise ValueError("walls='rough' needs mu_wall > 0")
+        raise InvalidInput("walls='rough' needs mu_wall > 0")
     return models.System(models.make_lattice(lattice, lx, ly), **params)
 
 

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput
 
 from .contact import LoopBasis, NullSpace
 
@@ -98,7 +99,7 @@ def plot_vectors(system: models.System, vectors: list[tuple[np.ndarray, np.ndarr
 def plot_null_space(ns: NullSpace, out: str | Path, max_panels: int = 30) -> Path:
     """The localized basis of a null space (Fig. 5), one panel per vector."""
     if ns.localized is None:
-        raise ValueError("compute the localized basis first (null_space(..., localize=True))")
+        raise InvalidInput("compute the localized basis first (null_space(..., localize=True))")
     c = ns.c
     vectors = [(x[:c], x[c:], f"v{k + 1}: {len(ns.contacts_of(x))} contacts")
                for k, x in enumerate(ns.localized.T)]

@@ -25,6 +25,7 @@ from fractions import Fraction
 import numpy as np
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput
 
 _SQRT3 = math.sqrt(3.0)
 _SNAP_B = [Fraction(k, 4) for k in (0, 2, -2, 4, -4, 1, -1, 3, -3, 6, -6, 8, -8)]
@@ -94,7 +95,7 @@ def exact_contact_matrix(
     normal = np.asarray(normal, dtype=bool).reshape(-1)
     tangential = np.asarray(tangential).reshape(-1).astype(int)
     if normal.size != c or tangential.size != c:
-        raise ValueError(f"one state per contact expected ({c})")
+        raise InvalidInput(f"one state per contact expected ({c})")
     H = models.Dynamics(system).H.tocoo()
     minv_float = models.Dynamics(system).Minv
     minv = [snap(v) for v in minv_float]

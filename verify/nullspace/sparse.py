@@ -18,6 +18,8 @@ import scipy.sparse as sp
 from scipy.optimize import linprog
 from threadpoolctl import threadpool_limits
 
+from rigidlcp.lcp.errors import InvalidProblem
+
 EPS = np.finfo(float).eps
 #: A row of an orthonormal null basis with a norm below this is zero (Eq. 3.2).
 SUPPORT_TOL = float(np.sqrt(EPS))
@@ -35,7 +37,7 @@ def svd_rank(M: np.ndarray, tol: float | None = None) -> tuple[np.ndarray, np.nd
     """
     M = np.asarray(M, dtype=float)
     if M.ndim != 2 or not np.all(np.isfinite(M)):
-        raise ValueError("M must be a finite 2-D array")
+        raise InvalidProblem("M must be a finite 2-D array")
     if M.size == 0:
         return np.zeros(0), np.eye(M.shape[1]), 0.0, 0
     # V must be complete (all of R^n): full_matrices only matters when M has fewer rows.

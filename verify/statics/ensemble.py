@@ -28,6 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput, NotApplicable
 
 from .forceset import ForceSet, analyse
 from .hull import reduced_balance
@@ -149,7 +150,7 @@ def _start(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     res = linprog(np.r_[np.zeros(d), -1.0], A_ub=np.c_[A, norms], b_ub=b,
                   bounds=[(None, None)] * d + [(0, None)], method="highs")
     if res.status != 0 or res.x[-1] <= 0:
-        raise ValueError("the admissible forces have no interior point on their hull (a cap "
+        raise NotApplicable("the admissible forces have no interior point on their hull (a cap "
                          f"on sum R below its minimum?): {res.message}")
     return res.x[:d]
 
@@ -220,9 +221,9 @@ def sample(system_or_fs: models.System | ForceSet, n: int = 1000, seed: int = 0,
     fs = (system_or_fs if isinstance(system_or_fs, ForceSet)
           else analyse(system_or_fs, ranges=False))
     if not fs.exists:
-        raise ValueError("no equilibrium: the admissible set is empty (Farkas certificate)")
+        raise NotApplicable("no equilibrium: the admissible set is empty (Farkas certificate)")
     if fs.dimension is None:
-        raise ValueError("the dimension of the admissible set is not settled at this size")
+        raise NotApplicable("the dimension of the admissible set is not settled at this size")
     if cap is None and not _bounded(fs):
         raise UnboundedForceSet("the admissible forces are unbounded (walls can pinch the "
                                 "pile with any force): give a cap on sum R (--cap)")
@@ -245,7 +246,7 @@ def sample(system_or_fs: models.System | ForceSet, n: int = 1000, seed: int = 0,
         elif sampler == "hit-and-run":
             us = hit_and_run(Au, bu, u0, n, thin, rng)
         else:
-            raise ValueError(f"unknown sampler {sampler!r}")
+            raise InvalidInput(f"unknown sampler {sampler!r}")
         lams = lam0[None] + (y0 + us @ L.T) @ M.T
     prob = StaticProblem(fs.system)
     res = np.array([prob.residuals(lam) for lam in lams])

@@ -22,6 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.lcp.quiet import new_highs
 
 #: HiGHS's primal and dual feasibility tolerances (relative to O(1) data: rows are scaled).
@@ -37,7 +38,7 @@ class StaticProblem:
 
     def __init__(self, system: models.System):
         if system.gamma != 0:
-            raise ValueError("a static analysis needs gamma = 0 (a packing at rest)")
+            raise InvalidInput("a static analysis needs gamma = 0 (a packing at rest)")
         dyn = models.Dynamics(system)
         self.system, self.c, self.p = system, system.c, system.p
         self.mu = np.asarray(system.mu, dtype=float)

@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from rigidlcp import models
 from rigidlcp.cli.main import main
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.verify import paper_singularities
 from rigidlcp.verify.nullspace import formulas as vf
 
@@ -82,11 +83,11 @@ def test_where_the_paper_holds_and_where_it_does_not():
 
 
 def test_invalid_arguments():
-    with pytest.raises(ValueError, match="kind"):
+    with pytest.raises(InvalidInput, match="kind"):
         paper_singularities("rect", 3, 3, "both")
-    with pytest.raises(ValueError, match="lattice"):
+    with pytest.raises(InvalidInput, match="lattice"):
         vf.paper_formula("hex", 3, 3, "normal")
-    with pytest.raises(ValueError, match="walls"):
+    with pytest.raises(InvalidInput, match="walls"):
         vf.closed_form("rect", 3, 3, "normal", walls="sticky")
 
 

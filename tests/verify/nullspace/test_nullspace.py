@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 
 from rigidlcp import models
 from rigidlcp.cli.main import main
+from rigidlcp.lcp.errors import InvalidFile
 from rigidlcp.verify.nullspace import contact as vn
 from rigidlcp.verify.nullspace import qsqrt3 as q3
 
@@ -261,13 +262,13 @@ def test_read_states_json_npz_and_errors(tmp_path):
     np.savez(tmp_path / "s.npz", normal=np.array(normal), tangential=t)
     n2, t2 = vn.read_states(str(tmp_path / "s.npz"), lat)
     assert (n2 == n).all() and (t2 == t).all()
-    with pytest.raises(ValueError, match="lx"):
+    with pytest.raises(InvalidFile, match="lx"):
         vn.read_states(str(path), models.rectangular(4, 2))
     path.write_text(json.dumps({"normal": normal[:-1], "tangential": tang}))
-    with pytest.raises(ValueError, match="entries"):
+    with pytest.raises(InvalidFile, match="entries"):
         vn.read_states(str(path), lat)
     path.write_text(json.dumps({"normal": normal, "tangential": ["NS"] * (lat.c - 1) + ["x"]}))
-    with pytest.raises(ValueError, match="invalid"):
+    with pytest.raises(InvalidFile, match="invalid"):
         vn.read_states(str(path), lat)
 
 
