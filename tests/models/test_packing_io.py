@@ -9,9 +9,9 @@ import pytest
 from rigidlcp import models
 from rigidlcp.lcp.errors import InvalidFile, OutputExists
 from rigidlcp.models.deposition import deposit
-from rigidlcp.models.packing import Overlap
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, event_problem, initial_state
+from rigidlcp.models.packing import Overlap
 from rigidlcp.models.packing_io import read_disks, read_packing, write_packing
 
 
