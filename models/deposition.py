@@ -7,7 +7,10 @@ rests on two supports whose forces hold its weight: disk/disk, disk/wall or disk
 that reaches the plane without touching a disk slides along it (to a side drawn from the seed)
 until it touches a disk or a wall. So every disk is placed at a stable resting position of the
 pile, with its contacts exact by construction (distances equal to r_i + r_j up to rounding):
-`models.packing` finds them with its default gap tolerance. Radii are uniform in [a, b]
+`models.packing` finds them with its default gap tolerance. A position found by a grazing
+intersection (a disk beside another at its equator, common in monodisperse piles) is refined
+onto its two best-conditioned supports (`_Pile.polish`), so that a contact meant horizontal is
+not tilted by sqrt(eps). Radii are uniform in [a, b]
 (a = b: monodisperse), drawn from `seed` with the drop abscissae.
 
 `with_vacancies(lattice, fraction, seed)`: a regular array with disks removed at random
@@ -26,6 +29,8 @@ from .lattice import InvalidSystem, Lattice
 from .packing import GAP_TOL, packing
 
 _TOL = 1e-12  # relative: force signs and angles compared with this margin
+#: supports within this gap (times r) of a resting position are refined onto (_Pile.polish)
+POLISH_REACH = 1e-6
 
 
 class _Grid:
@@ -86,10 +91,11 @@ class _Pile:
                 p = self._roll(r, move[1], p, move[2], {c[1] for c in contacts})
         raise RuntimeError("deposition: a disk did not come to rest (please report)")
 
-    def _touching(self, r: float, p: np.ndarray) -> list[tuple[str, int, np.ndarray]]:
+    def _touching(self, r: float, p: np.ndarray, rel: float = 1e-9
+                  ) -> list[tuple[str, int, np.ndarray]]:
         """(kind, index, unit normal from the support to the disk) of every body touching a
-        disk of radius r at p (gap within 1e-9 r)."""
-        tol = 1e-9 * r
+        disk of radius r at p (gap within rel r)."""
+        tol = rel * r
         out = []
         if abs(p[1] - r) <= tol:
             out.append(("plane", -3, np.array([0.0, 1.0])))
@@ -187,6 +193,60 @@ class _Pile:
                 stop = xk
         return np.array([stop, r])
 
+    def polish(self, r: float, p: np.ndarray) -> np.ndarray:
+        """p refined onto its two best-conditioned supports (largest |n1 x n2|) by Newton's
+        method on their gap functions (gradient: the unit normal). Resting positions found by
+        grazing intersections (a fall or a roll ending at a support's equator) carry errors
+        of sqrt(eps) ~ 2e-8 along the badly conditioned direction, which tilt a contact that
+        should be horizontal by that much and make a force network balance it with forces of
+        1/tilt ~ 1e8 weights; refined on the supports that fix p well, such a contact is
+        exact to rounding. The supports are looked for within POLISH_REACH r (such a position
+        misses a third support by ~1e-8 r); the refined point is kept only if each of them is
+        then a contact (gap within 1e-9 r) and nothing overlaps beyond that."""
+        contacts = self._touching(r, p, POLISH_REACH)
+        if len(contacts) < 3:  # on two supports: they are the ones p was computed from
+            return p
+        best, pair = 0.0, None
+        for a in range(len(contacts)):
+            for b in range(a + 1, len(contacts)):
+                n1, n2 = contacts[a][2], contacts[b][2]
+                det = abs(n1[0] * n2[1] - n1[1] * n2[0])
+                if det > best:
+                    best, pair = det, (contacts[a], contacts[b])
+        if pair is None or best < 1e-3:
+            return p
+        q = p.copy()
+        for _ in range(4):
+            g = np.array([self._gap(r, q, c) for c in pair])
+            J = np.array([self._normal(r, q, c) for c in pair])
+            q = q - np.linalg.solve(J, g)
+        for kind, k, _n in pair:  # a wall or the plane: exactly at r from it
+            if kind == "plane":
+                q[1] = r
+            elif k == -1:
+                q[0] = r
+            elif k == -2:
+                q[0] = self.width - r
+        tol = 1e-9 * r
+        if any(abs(self._gap(r, q, c)) > tol for c in contacts):
+            return p
+        for k in self.grid.near(q[0], q[1], r + self.rmax):
+            if math.hypot(*(q - self.x[k])) - r - self.r[k] < -tol:
+                return p
+        return q
+
+    def _gap(self, r: float, p: np.ndarray, contact) -> float:
+        kind, k, _ = contact
+        if kind == "plane":
+            return float(p[1] - r)
+        if kind == "wall":
+            return float(p[0] - r) if k == -1 else float(self.width - r - p[0])
+        return math.hypot(p[0] - self.x[k, 0], p[1] - self.x[k, 1]) - r - float(self.r[k])
+
+    def _normal(self, r: float, p: np.ndarray, contact) -> np.ndarray:
+        kind, k, n = contact
+        return n if kind != "disk" else _unit(p - self.x[k])
+
     def add(self, r: float, c: np.ndarray) -> None:
         k = self.p
         self.x[k], self.r[k] = c, r
@@ -249,7 +309,8 @@ def deposit(n: int, seed: int = 0, radii: tuple[float, float] = (1.0, 1.0),
     pile = _Pile(width, float(r.max()), int(n), rng)
     for k in range(int(n)):
         x0 = rng.uniform(r[k], width - r[k]) if width > 2 * r[k] else width / 2
-        pile.add(float(r[k]), pile.place(float(r[k]), x0))
+        rest = pile.place(float(r[k]), x0)
+        pile.add(float(r[k]), pile.polish(float(r[k]), rest))
         if progress is not None:
             progress(k + 1, int(n))
     m = r**2
