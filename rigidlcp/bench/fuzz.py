@@ -211,6 +211,9 @@ def run_from_args(args: argparse.Namespace) -> int:
                           progress=None if args.no_progress else progress)
         what = f"{args.count} problems, seed {args.seed}"
     print(format_table(result))
+    for (_, method), cell in result["table"].items():
+        if method == "reader":  # a file no method could be given: say why
+            print(f"refused by the reader: {cell['reason']}")
     wrong = sum(c["WRONG"] + c["crash"] for c in result["table"].values())
     print(f"\n{what}, {time.perf_counter() - t0:.0f} s; "
           f"{wrong} silent-wrong or crashing answers"

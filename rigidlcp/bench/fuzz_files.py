@@ -77,6 +77,10 @@ def run_files(paths, methods: tuple[str, ...] | None = None, out: str | Path | N
             P = lcp.load(path)
         except (lcp.InvalidProblem, lcp.NotApplicable) as exc:  # the reader says why, where
             P, refusal = None, str(exc)
+        if P is not None and not isinstance(P, (lcp.LCP, lcp.MLCP)):
+            P, refusal = None, (f"{path}: a {type(P).__name__}, not an LCP or MLCP (fuzz "
+                                "--files judges those; `rigidlcp bench --set FOLDER` takes "
+                                "friction contact too)")
         for method in names:
             cell = table[(path.stem, method)]
             if P is None or not isinstance(P, (lcp.LCP, lcp.MLCP)):

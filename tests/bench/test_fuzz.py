@@ -140,3 +140,19 @@ def test_progress_by_default_on_stderr_and_none_with_no_progress(monkeypatch, ca
     assert "fuzz:" not in captured.out and "| P | lemke |" in captured.out
     assert cli(args + ["--no-progress"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_files_the_reader_refuses_are_named_with_the_reason(tmp_path, capsys):
+    """fuzz --files printed only 'refused' for a file no method could be given (a packing
+    CSV, a friction-contact file): the reason is now printed below the table."""
+    from rigidlcp.cli.main import main as cli
+
+    siconos = Path(__file__).parent.parent / "data" / "siconos"
+    csv = tmp_path / "pile.csv"
+    csv.write_text("x,y,r\n1,1,1\n")
+    assert cli(["fuzz", "--files", str(csv), str(siconos / "FrictionContactProblem00031.dat"),
+                str(siconos / "lcp_CPS_1.dat"), "--methods", "lemke"]) == 0
+    out = capsys.readouterr().out
+    assert f"refused by the reader: {csv}, line 1: no Siconos header fits" in out
+    assert "FrictionContactProblem00031.dat: a FrictionContact2D, not an LCP or MLCP" in out
+    assert "| lcp_CPS_1 | lemke | 1 |" in out
