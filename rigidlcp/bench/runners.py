@@ -21,6 +21,7 @@ import numpy as np
 
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP
+from rigidlcp.lcp.errors import RigidLCPError
 
 from .own import OWN_ANSWER
 from .peers import PEERS, Peer, solve_peer
@@ -165,7 +166,16 @@ class LocalRunner:
         child.close()
         self.conn = parent
         # the worker's start (imports) is not part of any solve's time limit
-        if not (parent.poll(STARTUP) and parent.recv() == "ready"):
+        try:
+            ready = parent.poll(STARTUP) and parent.recv() == "ready"
+        except (EOFError, OSError):  # the worker exited while starting
+            self.proc.join(5)
+            raise RigidLCPError(
+                f"the bench worker exited while starting (exit code {self.proc.exitcode}): "
+                "called from a script, run_bench must be under `if __name__ == \"__main__\":` "
+                "(each worker process imports the script, Python's spawn / forkserver rule; "
+                "its error is printed above)") from None
+        if not ready:
             raise RuntimeError(f"the bench worker did not start within {STARTUP:g} s")
 
     def _warm_up(self, method: str, time_limit: float) -> None:

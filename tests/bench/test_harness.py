@@ -285,3 +285,24 @@ def test_bench_stdout_names_an_unreadable_file(tmp_path, capsys):
     assert out[1].split()[:2] == ["lemke", "1/1"]
     assert any(line.startswith("unreadable: f/broken: ") and "line 6" in line for line in out)
     assert "[1/2]" in captured.err and "[1/2]" not in captured.out
+
+
+def test_an_unguarded_script_gets_one_clear_line(tmp_path):
+    """run_bench at a script's top level (docs/bench.md once showed it so): each worker
+    imports the script and starts the bench again, and dies; the harness says what to do
+    instead of an EOFError traceback."""
+    import subprocess
+    import sys
+
+    script = tmp_path / "mine.py"
+    script.write_text(
+        "from rigidlcp.bench.harness import run_bench\n"
+        "from rigidlcp.bench.problem_sets import get_set\n"
+        "run_bench({'p': get_set('random-p', sizes=(3,), per_size=1)}, ['lemke'], "
+        "time_limit=10)\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          cwd=tmp_path, timeout=120)
+    assert done.returncode != 0
+    last = done.stderr.strip().splitlines()[-1]
+    assert last.startswith("rigidlcp.lcp.errors.RigidLCPError: the bench worker exited")
+    assert 'if __name__ == "__main__":' in last
