@@ -64,7 +64,7 @@ def cmd_certify_run(args: argparse.Namespace) -> int:
     data_path, _ = run_paths(args.run)
     out = Path(args.out) if args.out else data_path.with_name(data_path.stem + "_cert")
     try:
-        res = certify_run(data_path, out, time_limit=args.time_limit, tries=args.tries,
+        res = certify_run(args.run, out, time_limit=args.time_limit, tries=args.tries,
                           ranges=args.ranges, events=parse_events(args.events), jobs=args.jobs,
                           resume=args.resume, force=args.force, progress=not args.no_progress)
     except KeyboardInterrupt:
@@ -77,5 +77,6 @@ def cmd_certify_run(args: argparse.Namespace) -> int:
         if res.skipped:
             print(f"resumed: {res.skipped} events already certified, {res.ran} now")
         print(format_totals(res.totals))
-        print(f"written: {out}/certificates.jsonl, summary.json, determinacy.png")
+        print(f"written: {out}/certificates.jsonl, summary.json, determinacy.png, "
+              "options.json")
     return 0

@@ -158,3 +158,14 @@ def test_witness_at_a_steady_event_says_whether_it_is_steady():
     early = certify_run(run, None, events=[0]).rows[0]
     assert early["steady_event"] is False
     assert all(w["steady"] is None for w in early["witnesses"])
+
+
+def test_a_file_that_is_not_a_run_is_named(tmp_path, capsys):
+    """`certify-run pile.csv` said 'No such file ...: pile.csv.npz' of a file that exists;
+    now, as `ranges` and `plot` do, that it is not a run file; nothing is written."""
+    csv = tmp_path / "pile.csv"
+    csv.write_text("x,y,r\n1,1,1\n")
+    assert main(["certify-run", str(csv)]) == 2
+    err = capsys.readouterr().err
+    assert f"{csv}: not a run file" in err and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["pile.csv"]
