@@ -166,6 +166,12 @@ def cmd_bench(args: argparse.Namespace) -> int:
         only = {p.strip() for p in (args.problems or "").split(",") if p.strip()}
         for spec in specs:
             kw = params if spec in SETS and not spec.startswith("events-") else {}
+            if spec.startswith("events-") and not args.quiet:  # a silent half minute else
+                from rigidlcp.bench.problem_sets import default_cache_dir
+
+                print(f"bench: set {spec}: the event LCPs of its runs, simulated once into "
+                      f"{args.cache or default_cache_dir()} (about 30 s the first time)",
+                      file=sys.stderr, flush=True)
             problems = get_set(spec, seed=args.seed, cache_dir=args.cache, **kw)
             if only:
                 problems = [p for p in problems if p.name in only]

@@ -306,3 +306,19 @@ def test_an_unguarded_script_gets_one_clear_line(tmp_path):
     last = done.stderr.strip().splitlines()[-1]
     assert last.startswith("rigidlcp.lcp.errors.RigidLCPError: the bench worker exited")
     assert 'if __name__ == "__main__":' in last
+
+
+def test_an_event_set_says_it_is_harvested_before_the_silent_runs(monkeypatch, tmp_path,
+                                                                   capsys):
+    """events-rect simulates its runs the first time (half a minute, no bench line yet): a
+    line on stderr says so first (the harvest itself is replaced by a small set here)."""
+    from rigidlcp.bench import problem_sets
+
+    monkeypatch.setattr(problem_sets, "get_set",
+                        lambda spec, **kw: get_set("random-p", sizes=(3,), per_size=1))
+    assert cli_main(["bench", "--set", "events-rect", "--methods", "lemke", "--cache",
+                     str(tmp_path / "cache"), "--out", str(tmp_path / "o"), "--no-siconos",
+                     "--no-isolation"]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == (f"bench: set events-rect: the event LCPs of its runs, simulated once "
+                      f"into {tmp_path / 'cache'} (about 30 s the first time)")
