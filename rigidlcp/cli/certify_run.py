@@ -43,10 +43,14 @@ def parse_events(text: str | None) -> list[int] | None:
     try:
         if ":" in text:
             a, b = text.split(":")
-            return list(range(int(a), int(b)))
-        return [int(x) for x in text.split(",")]
+            events = list(range(int(a), int(b)))
+        else:
+            events = [int(x) for x in text.split(",")]
     except ValueError:
         raise ValueError(f"--events takes K, K1,K2,... or START:STOP, got {text!r}") from None
+    if not events:  # e.g. 5:2: nothing to certify, and an empty output folder would remain
+        raise ValueError(f"--events {text!r} selects no event (START:STOP needs START < STOP)")
+    return events
 
 
 def cmd_certify_run(args: argparse.Namespace) -> int:

@@ -169,3 +169,14 @@ def test_a_file_that_is_not_a_run_is_named(tmp_path, capsys):
     err = capsys.readouterr().err
     assert f"{csv}: not a run file" in err and err.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pile.csv"]
+
+
+def test_an_empty_events_range_is_refused_and_writes_nothing(run_file, tmp_path, capsys):
+    """--events 5:2 certified no event, exited 0 and left an output folder behind."""
+    path, _ = run_file
+    out = tmp_path / "c"
+    assert main(["certify-run", str(path), "--events", "5:2", "--out", str(out)]) == 2
+    assert "selects no event" in capsys.readouterr().err and not out.exists()
+    with pytest.raises(InvalidInput, match="selects no event"):
+        certify_run(path, out, events=[])
+    assert not out.exists()

@@ -150,6 +150,8 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
     options = {"time_limit": float(time_limit), "tries": int(tries), "ranges": bool(ranges)}
     todo_all = list(range(run.n_events)) if events is None else sorted(set(int(k) for k in
                                                                          events))
+    if events is not None and not todo_all:
+        raise InvalidInput("events selects no event")
     bad = [k for k in todo_all if not 0 <= k < run.n_events]
     if bad:
         raise InvalidInput(f"events {bad[:5]} out of range (the run has {run.n_events} events)")
