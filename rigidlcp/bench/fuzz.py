@@ -176,7 +176,7 @@ def run_from_args(args: argparse.Namespace) -> int:
         raise InvalidInput(f"--seed must be >= 0, got {args.seed}")
     if args.out is not None and Path(args.out).exists():
         raise OutputExists(f"--out {args.out} exists; give a new folder")
-    methods = tuple(args.methods.split(",")) if args.methods else None
+    methods = tuple(m for m in args.methods.split(",") if m) if args.methods else None
     for m in methods or ():
         lcp.get_method(m)  # an unknown name raises InvalidProblem
     t0 = time.perf_counter()

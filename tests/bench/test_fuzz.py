@@ -156,3 +156,11 @@ def test_files_the_reader_refuses_are_named_with_the_reason(tmp_path, capsys):
     assert f"refused by the reader: {csv}, line 1: no Siconos header fits" in out
     assert "FrictionContactProblem00031.dat: a FrictionContact2D, not an LCP or MLCP" in out
     assert "| lcp_CPS_1 | lemke | 1 |" in out
+
+
+def test_a_trailing_comma_in_methods_is_ignored_as_in_classes(capsys):
+    from rigidlcp.cli.main import main as cli
+
+    assert cli(["fuzz", "--count", "2", "--classes", "P,", "--methods", "lemke,",
+                "--no-progress"]) == 0
+    assert "| P | lemke | 2 |" in capsys.readouterr().out
