@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidlcp import models
-from rigidlcp.lcp.errors import InvalidInput
+from rigidlcp.lcp.errors import InvalidInput, NotApplicable
 from rigidlcp.models.engine.records import EventRecord, Run
 from rigidlcp.models.event import State, acceleration_tol, event_problem
 from rigidlcp.models.modes import row_modes
@@ -180,7 +180,7 @@ def compare_integrators(system: models.System, seed: int | None = 1,
         raise InvalidInput(f"hs must hold at least two step sizes > 0, got {hs!r}")
     ed = models.simulate(system, seed=seed, t_max=t_max, **(event_options or {}))
     if not ed.records:
-        raise ValueError(f"the event-driven run has no event ({ed.status}: {ed.message})")
+        raise NotApplicable(f"the event-driven run has no event ({ed.status}: {ed.message})")
     last = ed.last
     T = 0.5 * last.t if T is None else float(T)
     cmp = Comparison(system, seed, ed, row_modes(system, last).text(), T)
@@ -204,7 +204,7 @@ def compare_integrators(system: models.System, seed: int | None = 1,
         ts = moreau_jean(system, seed=seed, h=h, t_max=t_max, progress=capture,
                          **(step_options or {}))
         if not ts.records:
-            raise ValueError(f"the time-stepping run (h = {h:g}) has no record ({ts.status})")
+            raise NotApplicable(f"the time-stepping run (h = {h:g}) has no record ({ts.status})")
         sups = [float(snap["max"][0])]
         for j in range(1, phases):
             t0 = j * h / phases
