@@ -32,6 +32,7 @@ def register(sub) -> None:
 
 
 def cmd_ranges(args: argparse.Namespace) -> int:
+    from rigidlcp.lcp.errors import InvalidInput
     from rigidlcp.models.runio import load_run
     from rigidlcp.verify.ranges import steady_ranges
     from rigidlcp.verify.ranges.steady import NoVelocityBound
@@ -41,6 +42,10 @@ def cmd_ranges(args: argparse.Namespace) -> int:
     if args.box is not None and not args.box > 0:
         raise ValueError(f"--box must be > 0, got {args.box}")
     run = load_run(args.run)
+    if run.status != "steady":  # the library's refusal offers a Python-only way out
+        raise InvalidInput(f"{args.run}: the run ended {run.status!r} ({run.message}), not in "
+                           "a steady state: `rigidlcp ranges` needs a run that reached one "
+                           "(rerun `rigidlcp simulate` with a larger --t-max or --max-events)")
     r = run.system.lattice.radii
     if run.status == "steady" and float(r.max()) == float(r.min()):
         _warn_long(run.system, args)  # else refused in one line below, without the note

@@ -63,3 +63,13 @@ def test_bad_input_one_line_exit_2(runs, case, tmp_path, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("rigidlcp ranges: error:") and "\n" not in err
+
+
+def test_a_run_not_steady_is_told_what_to_rerun(runs, capsys):
+    """The refusal named a Python-only way out ("or pass its system"): the command line
+    says which run it was, how it ended and what to rerun."""
+    _, _, _, short = runs
+    assert main(["ranges", str(short)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert f"{short}: the run ended 'time_limit'" in err
+    assert "--t-max or --max-events" in err and "pass its system" not in err
