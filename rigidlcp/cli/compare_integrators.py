@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import math
+import sys
+import time
 
 from rigidlcp.cli.main import seed
 
@@ -41,6 +43,8 @@ def register(sub) -> None:
                    "random:SEED, global, none; default face-min-norm)")
     g.add_argument("--step-selection", default="none", metavar="RULE",
                    help="the time-stepper's selection rule (default none: the solver's point)")
+    g.add_argument("--no-progress", action="store_true",
+                   help="no line on stderr as each step size is done")
     e = p.add_argument_group("ensemble over selection rules (instead of the h halving)")
     e.add_argument("--ensemble", nargs="?", const=",".join(ENSEMBLE_RULES), default=None,
                    metavar="RULES", help="run the event engine once per rule from the same start "
@@ -73,11 +77,18 @@ def cmd_compare_integrators(args) -> int:
     if args.step_rules is not None:
         raise ValueError("--step-rules goes with --ensemble")
     hs = tuple(args.h / 2**k for k in range(args.levels))
+    t0 = time.perf_counter()
+
+    def progress(row) -> None:  # each level takes twice the last: say where it is
+        print(f"compare-integrators: h = {row.h:g} done ({hs.index(row.h) + 1} of {len(hs)}, "
+              f"{time.perf_counter() - t0:.0f} s)", file=sys.stderr, flush=True)
+
     cmp = compare_integrators(system, seed=args.seed, hs=hs, T=args.T, t_max=args.t_max,
                               event_options={"selection": args.selection},
                               step_options={"theta": args.theta,
                                             "selection": args.step_selection},
-                              phases=args.phases)
+                              phases=args.phases,
+                              progress=None if args.no_progress else progress)
     print(format_comparison(cmp))
     bad = [r.h for r in cmp.rows if r.run.status not in ("steady", "time_limit")]
     return 1 if bad else 0

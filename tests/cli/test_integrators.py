@@ -13,9 +13,16 @@ def test_cli_bad_input(capsys):
 def test_cli_compare_prints_the_table(capsys):
     code = main(["compare-integrators", "--lx", "3", "--ly", "1", "--gamma", "0.05",
                  "--h", "8e-3", "--t-max", "1.0"])
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     assert code == 0
     assert "observed order of sup|domega|" in out and out.count(" time_lim ") == 3
+    # a line on stderr per step size (the run was silent for its whole length)
+    lines = captured.err.splitlines()
+    assert [line.split(" (")[0] for line in lines] == [
+        "compare-integrators: h = 0.008 done", "compare-integrators: h = 0.004 done",
+        "compare-integrators: h = 0.002 done"]
+    assert lines[0].split(" (")[1].startswith("1 of 3, ")
 
 
 def test_cli_timestep_saves_a_run_and_refuses_to_overwrite(tmp_path, capsys):
@@ -27,3 +34,9 @@ def test_cli_timestep_saves_a_run_and_refuses_to_overwrite(tmp_path, capsys):
     assert main(["plot", str(out) + ".npz", "--out", str(tmp_path / "png")]) == 0
     assert main(args) == 2
     assert "exists" in capsys.readouterr().err
+
+
+def test_cli_compare_no_progress_is_silent_on_stderr(capsys):
+    assert main(["compare-integrators", "--lx", "2", "--ly", "1", "--gamma", "0.05",
+                 "--h", "8e-3", "--t-max", "0.5", "--no-progress"]) == 0
+    assert capsys.readouterr().err == ""
