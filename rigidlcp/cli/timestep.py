@@ -37,6 +37,7 @@ def register(sub) -> None:
                    "existing run is not overwritten without --force")
     g.add_argument("--force", action="store_true", help="overwrite an existing --out")
     g.add_argument("--json", action="store_true", help="print the summary as JSON")
+    g.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_timestep)
 
 
@@ -51,9 +52,25 @@ def cmd_timestep(args) -> int:
     system = system_from_args(args)
     if args.out:
         check_new(run_paths(args.out), force=args.force)
-    run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta, method=args.method,
-                      t_max=args.t_max, max_steps=args.max_steps,
-                      record_every=args.record_every, selection=args.selection)
+    bar = None
+    if not args.no_progress:  # steps and t on stderr, erased at the end (as simulate's)
+        from rigidlcp.models.progress import new_bar
+
+        bar = new_bar(desc="steps", unit="step", mininterval=0.5)
+
+    def progress(run, t: float, omega) -> None:
+        bar.update(1)
+        if bar.n % 1000 == 0:
+            bar.set_postfix_str(f"t={t:.4g}", refresh=False)
+
+    try:
+        run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta,
+                          method=args.method, t_max=args.t_max, max_steps=args.max_steps,
+                          record_every=args.record_every, selection=args.selection,
+                          progress=progress if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
     summary = run.summary()
     if args.out:
         summary["saved"] = str(save_run(run, args.out))
