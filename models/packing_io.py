@@ -6,14 +6,14 @@
   such wall).
 * .npz: arrays x, y, r [, m, I] and optional scalars left, right (NaN: no such wall).
 * LAMMPS dump (text, `dump ... custom`): the first snapshot's `ITEM: ATOMS` columns x, y and
-  radius (mass optional); atoms in the file's order. Recognized by its first line
-  `ITEM: TIMESTEP`. Its `ITEM: BOX BOUNDS` give the walls from the x line and its boundary
-  flag (one letter per side: lo, hi): "f" (fixed; also a line without flags) a wall at xlo /
-  xhi; "s", "m" (shrink-wrapped: the box follows the atoms' centres) no stated wall (the tight
-  box, as without BOX BOUNDS); "p" (periodic) and a tilted box (triclinic, xy != 0) are refused
-  unless the caller gives that wall (left= / right=: a position or "none"), since neither is a
-  vertical wall and contacts across a periodic boundary are not modelled. The y and z lines are
-  not used: the plane is y = 0 and the frame is not moved.
+  radius (or diameter, halved; mass optional); atoms in the file's order. Recognized by its
+  first line `ITEM: TIMESTEP`. Its `ITEM: BOX BOUNDS` give the walls from the x line and its
+  boundary flag (one letter per side: lo, hi): "f" (fixed; also a line without flags) a wall at
+  xlo / xhi; "s", "m" (shrink-wrapped: the box follows the atoms' centres) no stated wall (the
+  tight box, as without BOX BOUNDS); "p" (periodic) and a tilted box (triclinic, xy != 0) are
+  refused unless the caller gives that wall (left= / right=: a position or "none"), since
+  neither is a vertical wall and contacts across a periodic boundary are not modelled. The y and
+  z lines are not used: the plane is y = 0 and the frame is not moved.
 
 Missing m: m = r^2; missing I: I = m r^2 / 2 (uniform disks; the units of the arrays, where a
 disk of radius 1 has mass 1). Walls not given by the file or the caller: the tight box
@@ -200,13 +200,19 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
     if start is None or count is None or count + 1 >= len(lines):
         raise InvalidFile(f"{path}: a LAMMPS dump needs 'ITEM: NUMBER OF ATOMS' and "
                           "'ITEM: ATOMS ...' lines")
-    n = int(_number(path, count + 2, "number of atoms", lines[count + 1]))
+    n = _number(path, count + 2, "number of atoms", lines[count + 1])
+    if n != int(n) or n < 1:
+        raise InvalidFile(f"{path} line {count + 2}: the number of atoms must be an integer "
+                          f">= 1, got {lines[count + 1].strip()!r}")
+    n = int(n)
     names = lines[start].split()[2:]
-    need = {"x": "x", "y": "y", "r": "radius"}
+    # the radius column, else LAMMPS's per-atom diameter (halved below)
+    need = {"x": "x", "y": "y", "r": "radius" if "radius" in names or "diameter" not in names
+            else "diameter"}
     missing = [v for v in need.values() if v not in names]
     if missing:
         raise InvalidFile(f"{path} line {start + 1}: the ATOMS columns must include x, y and "
-                          f"radius (missing {', '.join(missing)})")
+                          f"radius or diameter (missing {', '.join(missing)})")
     if "mass" in names:
         need["m"] = "mass"
     cols = {c: [] for c in need}
@@ -221,6 +227,8 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
         for c, name in need.items():
             cols[c].append(_number(path, k, name, fields[names.index(name)],
                                    positive=c in ("r", "m")))
+    if need["r"] == "diameter":
+        cols["r"] = [d / 2 for d in cols["r"]]
     disks = _finish(path, cols)
     _lammps_box(path, lines[:start], disks)
     return disks

@@ -183,3 +183,20 @@ def test_npz_errors_name_the_array_entry_and_a_run_is_named(tmp_path):
     save_run(run, tmp_path / "run.npz")
     with pytest.raises(InvalidFile, match="is a run saved by `rigidlcp simulate`, not a packing"):
         read_packing(tmp_path / "run.npz")
+
+
+def test_lammps_diameter_column_and_a_bad_atom_count(tmp_path):
+    """LAMMPS's per-atom `diameter` (dump custom ... diameter) is read as 2 r; an atom count
+    that is not a whole number was truncated, now refused naming its line."""
+    f = tmp_path / "dump.atoms"
+    f.write_text(LAMMPS.replace(" radius mass", " diameter mass")
+                 .replace("1.0 1.0 0 1.0 2.0", "1.0 1.0 0 2.0 2.0")
+                 .replace("3.0 1.0 0 1.0 2.0", "3.0 1.0 0 2.0 2.0"))
+    d = read_disks(f)
+    assert np.array_equal(d.r, [1.0, 1.0]) and read_packing(f).c == 5
+    f.write_text(LAMMPS.replace("ITEM: NUMBER OF ATOMS\n2\n", "ITEM: NUMBER OF ATOMS\n2.5\n"))
+    with pytest.raises(InvalidFile, match=r"line 4: the number of atoms must be an integer"):
+        read_disks(f)
+    f.write_text(LAMMPS.replace(" radius mass", " r mass"))
+    with pytest.raises(InvalidFile, match=r"radius or diameter \(missing radius\)"):
+        read_disks(f)
