@@ -887,6 +887,38 @@ static int accept_one(idx n, const double *M, const double *q, const double *zs,
     return code;
 }
 
+/* The work of solve_accept on C-contiguous data (M n x n, q, z: n doubles, basis: n int64),
+ * without the GIL: the code of solve_problem (-1: out of memory), *acode that of accept_one
+ * (1 when not solved). */
+static int solve_and_accept(idx n, const double *M, const double *q, double tol,
+                            long long max_iter, double *z, int64_t *basis, long long *pivots,
+                            idx *nb, int *acode, double res[3])
+{
+    Work w;
+#if defined(__GNUC__)
+    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
+#else
+    uint64_t stack[STACK_WORDS];
+#endif
+    double bound[3] = {0.0, 0.0, 0.0};
+    *pivots = 0;
+    *nb = 0;
+    *acode = 1;
+    res[0] = res[1] = res[2] = 0.0;
+    if (work_init(&w, n, tol, stack) < 0) return -1;
+    double zbuf[64], *zs = n <= 64 ? zbuf : (double *)malloc((size_t)n * sizeof(double));
+    if (!zs) {
+        work_free(&w);
+        return -1;
+    }
+    int code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, pivots,
+                             bound);
+    if (code == 0) *acode = accept_one(n, M, q, zs, w.bz, bound, basis, nb, z, res);
+    if (zs != zbuf) free(zs);
+    work_free(&w);
+    return code;
+}
+
 /* solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr,
  * refined): `solve_eq` with r = c = d = None (lcp.solve's default Lemke) and, on code 0, the
  * acceptance steps of lcp/acceptance/accuracy.py's `assess_lcp` on the answer and its basis
@@ -912,36 +944,14 @@ static PyObject *py_solve_accept(PyObject *self, PyObject *args)
     if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto done;
     if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
-    Work w;
-#if defined(__GNUC__)
-    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
-#else
-    uint64_t stack[STACK_WORDS];
-#endif
-    if (work_init(&w, n, tol, stack) < 0) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
     long long pivots = 0;
-    double bound[3] = {0.0, 0.0, 0.0}, res[3] = {0.0, 0.0, 0.0};
+    double res[3];
     idx nb = 0;
     int code, acode = 1;
-    double zbuf[64], *zs = n <= 64 ? zbuf : (double *)malloc((size_t)n * sizeof(double));
-    if (!zs) {
-        work_free(&w);
-        PyErr_NoMemory();
-        goto done;
-    }
     Py_BEGIN_ALLOW_THREADS
-    code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, &pivots,
-                         bound);
-    if (code == 0)
-        acode = accept_one(n, M, q, zs, w.bz, bound, (int64_t *)vb.buf, &nb,
-                           (double *)vz.buf, res);
+    code = solve_and_accept(n, (const double *)vM.buf, (const double *)vq.buf, tol, max_iter,
+                            (double *)vz.buf, (int64_t *)vb.buf, &pivots, &nb, &acode, res);
     Py_END_ALLOW_THREADS
-    if (zs != zbuf) free(zs);
-    work_free(&w);
     if (code < 0)
         PyErr_NoMemory();
     else
@@ -1254,6 +1264,73 @@ static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
     Py_RETURN_TRUE;
 }
 
+/* solve_fast(M, q, tol, max_iter, z, w, basis, dot, upto) -> (code, pivots, nbasis, acode,
+ * berr, ferr, refined, raw, scaled): lcp.solve's common call in one crossing from Python
+ * (lcp/solvers/fast_lemke.py): `solve_accept` and then, when the answer was assessed here
+ * (code 0, acode 0), lcp.residual's measure as `solve_lemke` took it -- w = dot(M, z, w) by the
+ * `dot` given (numpy.dot: the same BLAS call as M.dot(z), written into w) and `lcp_measure`'s C
+ * steps when n <= upto (w becomes M z + q) -- with no Python between. raw and scaled are NaN
+ * when not measured here (the caller measures in numpy). M: C-contiguous n x n float64, q, z,
+ * w float64 of length n (ndim 1), basis int64 of length n; else ValueError. */
+static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "solve_fast: nine arguments");
+        return NULL;
+    }
+    double tol = PyFloat_AsDouble(args[2]);
+    long long max_iter = PyLong_AsLongLong(args[3]);
+    idx upto = PyLong_AsSsize_t(args[8]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0}, vb = {0};
+    PyObject *result = NULL;
+    idx n = PyObject_Length(args[1]);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(args[1], &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(args[0], &vM, "M", 'd', n * n, 0) < 0) goto done;
+    if (get_buffer(args[4], &vz, "z", 'd', n, 0) < 0) goto done;
+    if (get_buffer(args[5], &vw, "w", 'd', n, 0) < 0) goto done;
+    if (get_buffer(args[6], &vb, "basis", 'q', n, 0) < 0) goto done;
+    if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
+        PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
+        goto done;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    double *z = (double *)vz.buf, *w = (double *)vw.buf;
+    long long pivots = 0;
+    double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
+    idx nb = 0;
+    int code, acode = 1;
+    Py_BEGIN_ALLOW_THREADS
+    code = solve_and_accept(n, M, q, tol, max_iter, z, (int64_t *)vb.buf, &pivots, &nb, &acode,
+                            res);
+    Py_END_ALLOW_THREADS
+    if (code < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (code == 0 && acode == 0) {
+        PyObject *call[3] = {args[0], args[4], args[5]};
+        PyObject *out = PyObject_Vectorcall(args[7], call, 3, NULL); /* dot(M, z, w) */
+        if (!out) goto done;
+        Py_DECREF(out);
+        if (n <= upto && measure_one(n, M, q, z, w, got) < 0) got[0] = got[1] = NAN;
+    }
+    result = Py_BuildValue("iLniddidd", code, pivots, nb, acode, res[0], res[1], (int)res[2],
+                           got[0], got[1]);
+done:
+    release(&vb);
+    release(&vw);
+    release(&vz);
+    release(&vM);
+    release(&vq);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
      "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None): k "
@@ -1261,6 +1338,9 @@ static PyMethodDef methods[] = {
     {"solve_accept", py_solve_accept, METH_VARARGS,
      "solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr, "
      "refined): solve_eq's default Lemke and the acceptance of its answer in one call."},
+    {"solve_fast", (PyCFunction)(void (*)(void))py_solve_fast, METH_FASTCALL,
+     "solve_fast(M, q, tol, max_iter, z, w, basis, dot, upto) -> (code, pivots, nbasis, acode, "
+     "berr, ferr, refined, raw, scaled): solve_accept, then w = dot(M, z, w) and the measure."},
     {"solve_eq", py_solve_eq, METH_VARARGS,
      "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
      "LCP by Lemke on its equilibrated data."},
