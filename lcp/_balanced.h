@@ -36,9 +36,9 @@ static double pow2_near(double x)
 
 /* Mode 1: is M (finite) balanced? Then *rs = 1/s, *cs = s (or 1, 1 when q = 0) and 0 is
  * returned; NEEDS_RUIZ otherwise, NOT_FINITE if M or q has a NaN or an infinity. colmax:
- * scratch of n doubles. */
+ * scratch of n doubles; *top_out (unless NULL) = max|M| when M and q are finite. */
 static int balanced_units(idx n, const double *M, const double *q, double *colmax, double *rs,
-                          double *cs)
+                          double *cs, double *top_out)
 {
     /* Branch-free maxima (x > m ? x : m) and finiteness test (|x| <= DBL_MAX is false for
      * inf and NaN): random data would defeat the branch predictor. */
@@ -64,6 +64,7 @@ static int balanced_units(idx n, const double *M, const double *q, double *colma
         qmax = a > qmax ? a : qmax;
     }
     if (!finite) return NOT_FINITE;
+    if (top_out) *top_out = top;
     double cmin = DBL_MAX;
     for (idx j = 0; j < n; j++) cmin = colmax[j] < cmin ? colmax[j] : cmin;
     if (!(top > 0 && rmin >= top / BALANCED && cmin >= top / BALANCED)) return NEEDS_RUIZ;

@@ -111,6 +111,7 @@ static void update_plain(double *T, const double *col, const double *row, idx n,
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
 #define HAVE_AVX2_CLONE 1
+#include <immintrin.h>
 /* The same loop vectorized 4 wide: each lane rounds the product and the sum as the scalar
  * loop does (AVX2 without FMA), so the numbers are the same, only sooner. */
 __attribute__((target("avx2"))) static void update_avx2(double *T, const double *col,
@@ -125,6 +126,14 @@ __attribute__((target("avx2"))) static void update_avx2(double *T, const double 
     }
 }
 static int use_avx2 = -1; /* -1: not decided yet */
+static int cpu_avx2(void)
+{
+    if (use_avx2 < 0) {
+        __builtin_cpu_init();
+        use_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    return use_avx2;
+}
 #else
 #define HAVE_AVX2_CLONE 0
 #endif
@@ -653,6 +662,70 @@ static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *
     return 0;
 }
 
+#if HAVE_AVX2_CLONE
+/* fill_scaled for mode 1 (r = c = d = NULL; M and q finite, top = max|M|), in one pass over M:
+ * T[i, j] = ((M_ij rs) cs) / mu, the numbers fill_scaled stores and then divides by mu. Its mu
+ * is max |(M_ij rs) cs| = (top rs) cs: rounding is monotone and odd, so the maximum of the
+ * rounded products is the rounded product of the maximum, known before the pass. Four rows and
+ * four columns at a time, transposed in registers (T is column-major). Returns NOT_FINITE when
+ * a scaled entry overflows, as fill_scaled. */
+__attribute__((target("avx2"))) static int fill_units_avx2(idx n, idx ld, double *T,
+                                                           const double *M, const double *q,
+                                                           double rs, double cs, double top,
+                                                           Scales *S)
+{
+    double mu = (top * rs) * cs;
+    if (!(mu <= DBL_MAX)) return NOT_FINITE; /* an entry overflows: fill_scaled's verdict */
+    if (mu == 0.0) mu = 1.0;
+    const __m256d vr = _mm256_set1_pd(rs), vc = _mm256_set1_pd(cs), vmu = _mm256_set1_pd(mu);
+    idx i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const double *M0 = M + i * n, *M1 = M0 + n, *M2 = M1 + n, *M3 = M2 + n;
+        idx j = 0;
+        for (; j + 4 <= n; j += 4) {
+            __m256d r0 = _mm256_loadu_pd(M0 + j), r1 = _mm256_loadu_pd(M1 + j),
+                    r2 = _mm256_loadu_pd(M2 + j), r3 = _mm256_loadu_pd(M3 + j);
+            r0 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r0, vr), vc), vmu);
+            r1 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r1, vr), vc), vmu);
+            r2 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r2, vr), vc), vmu);
+            r3 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r3, vr), vc), vmu);
+            __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1),
+                    t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+            _mm256_storeu_pd(T + i + ld * j, _mm256_permute2f128_pd(t0, t2, 0x20));
+            _mm256_storeu_pd(T + i + ld * (j + 1), _mm256_permute2f128_pd(t1, t3, 0x20));
+            _mm256_storeu_pd(T + i + ld * (j + 2), _mm256_permute2f128_pd(t0, t2, 0x31));
+            _mm256_storeu_pd(T + i + ld * (j + 3), _mm256_permute2f128_pd(t1, t3, 0x31));
+        }
+        for (; j < n; j++)
+            for (idx k = 0; k < 4; k++) T[i + k + ld * j] = ((M[(i + k) * n + j] * rs) * cs) / mu;
+    }
+    for (; i < n; i++)
+        for (idx j = 0; j < n; j++) T[i + ld * j] = ((M[i * n + j] * rs) * cs) / mu;
+    double nu = 0.0, qmax = 0.0, qmin = DBL_MAX;
+    int finite = 1;
+    for (idx i = 0; i < n; i++) {
+        double v = q[i] * rs, a = fabs(v), aq = fabs(q[i]);
+        finite &= a <= DBL_MAX;
+        nu = a > nu ? a : nu;
+        qmin = v < qmin ? v : qmin;
+        qmax = aq > qmax ? aq : qmax;
+        T[i + ld * (n + 1)] = v;
+    }
+    if (!finite) return NOT_FINITE;
+    for (idx i = 0; i < n; i++) {
+        T[i + ld * n] = 1.0 / 1.0; /* d = ones, delta = 1 */
+        T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
+    }
+    S->mu = mu;
+    S->nu = nu;
+    S->delta = 1.0;
+    S->qmin = qmin;
+    S->mmax = top;
+    S->qmax = qmax;
+    return 0;
+}
+#endif
+
 /* One LCP by the steps of lemke() on the data `solve` gives it (mode 0: as they are; 1: the
  * equilibration of a balanced M done here; 2: the factors r, c of `ruiz` given): q~ >= 0 gives
  * z = 0 and no pivot, else the dictionary and the pivot loop; z in the original units (as
@@ -669,11 +742,17 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     memset(z, 0, n * sizeof(double));
     memset(bz, 0, n);
     if (mode != 2) r = c = NULL;
+    double top = 0.0;
     if (mode == 1) {
-        int code = balanced_units(n, M, q, L->theta, &rs, &cs);
+        int code = balanced_units(n, M, q, L->theta, &rs, &cs, &top);
         if (code) return code;
     }
     Scales S;
+#if HAVE_AVX2_CLONE
+    if (mode == 1 && !d && cpu_avx2()) {
+        if (fill_units_avx2(n, L->ld, T, M, q, rs, cs, top, &S)) return NOT_FINITE;
+    } else
+#endif
     if (fill_scaled(n, L->ld, T, M, q, d, r, c, rs, cs, &S)) return NOT_FINITE;
     bound[0] = S.mmax;
     bound[1] = S.qmax;
@@ -1105,7 +1184,6 @@ static double pairwise_abs(const double *a, idx n)
 }
 
 #if HAVE_AVX2_CLONE
-#include <immintrin.h>
 /* pairwise_abs four lanes wide: the eight partial sums in two registers, each lane adding the
  * same terms in the same order as the scalar r[j] (|x| by clearing the sign bit, as fabs), so
  * the sum is the same number. */
@@ -1153,14 +1231,6 @@ __attribute__((target("avx2"))) static int m_pass_avx2(idx n, const double *M, d
     return finite;
 }
 
-static int cpu_avx2(void)
-{
-    if (use_avx2 < 0) {
-        __builtin_cpu_init();
-        use_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
-    }
-    return use_avx2;
-}
 #endif
 
 /* abs_row_sums(M, out): out[i] = 0 + sum_j |M_ij| summed as numpy's np.add.reduce(np.abs(M),
