@@ -695,7 +695,7 @@ static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *
 }
 
 #if HAVE_AVX2_CLONE
-/* fill_scaled for mode 1 (r = c = d = NULL; M and q finite, top = max|M|), in one pass over M:
+/* fill_scaled for mode 1 (r = c = NULL; M and q finite, top = max|M|), in one pass over M:
  * T[i, j] = ((M_ij rs) cs) / mu, the numbers fill_scaled stores and then divides by mu. Its mu
  * is max |(M_ij rs) cs| = (top rs) cs: rounding is monotone and odd, so the maximum of the
  * rounded products is the rounded product of the maximum, known before the pass. Four rows and
@@ -703,8 +703,8 @@ static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *
  * a scaled entry overflows, as fill_scaled. */
 __attribute__((target("avx2"))) static int fill_units_avx2(idx n, idx ld, double *T,
                                                            const double *M, const double *q,
-                                                           double rs, double cs, double top,
-                                                           Scales *S)
+                                                           const double *d, double rs,
+                                                           double cs, double top, Scales *S)
 {
     double mu = (top * rs) * cs;
     if (!(mu <= DBL_MAX)) return NOT_FINITE; /* an entry overflows: fill_scaled's verdict */
@@ -744,13 +744,18 @@ __attribute__((target("avx2"))) static int fill_units_avx2(idx n, idx ld, double
         T[i + ld * (n + 1)] = v;
     }
     if (!finite) return NOT_FINITE;
+    double delta = -1.0 / 0.0;
     for (idx i = 0; i < n; i++) {
-        T[i + ld * n] = 1.0 / 1.0; /* d = ones, delta = 1 */
+        double di = d ? d[i] : 1.0;
+        if (di > delta) delta = di;
+    }
+    for (idx i = 0; i < n; i++) {
+        T[i + ld * n] = (d ? d[i] : 1.0) / delta;
         T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
     }
     S->mu = mu;
     S->nu = nu;
-    S->delta = 1.0;
+    S->delta = delta;
     S->qmin = qmin;
     S->mmax = top;
     S->qmax = qmax;
@@ -781,8 +786,8 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     }
     Scales S;
 #if HAVE_AVX2_CLONE
-    if (mode == 1 && !d && cpu_avx2()) {
-        if (fill_units_avx2(n, L->ld, T, M, q, rs, cs, top, &S)) return NOT_FINITE;
+    if (mode == 1 && cpu_avx2()) {
+        if (fill_units_avx2(n, L->ld, T, M, q, d, rs, cs, top, &S)) return NOT_FINITE;
     } else
 #endif
     if (fill_scaled(n, L->ld, T, M, q, d, r, c, rs, cs, &S)) return NOT_FINITE;

@@ -164,19 +164,20 @@ def test_dictionary_of_a_balanced_m_is_filled_as_with_explicit_factors(n, mscale
     """solve_eq with r = c = None (the balanced case, equilibrated in C: its dictionary filled
     in one pass, four rows and columns at a time, mu known beforehand) gives what it gives with
     the same units passed as factors (r = 1/s, c = s: the general fill, then the division by
-    mu), bit for bit: code, pivots, z, basis, bounds -- also where the scaled entries overflow
-    (NOT_FINITE), underflow to subnormals or q = 0."""
+    mu), bit for bit: code, pivots, z, basis, bounds, with d = ones or given -- also where the
+    scaled entries overflow (NOT_FINITE), underflow to subnormals or q = 0."""
     rng = np.random.default_rng(n)
     A = rng.standard_normal((n, n))
     M, q = (A @ A.T + np.eye(n)) * mscale, rng.standard_normal(n) * qscale
     qmax = np.max(np.abs(q))
     s = 2.0 ** np.round(np.log2(qmax)) if qmax > 0 else 1.0
-    outs = []
-    for r, c in ((None, None), (np.full(n, 1.0 / s), np.full(n, s))):
-        z, basis = np.zeros(n), np.zeros(n, dtype=np.int64)
-        code, pivots, m, bounds = kernel._lemke_c.solve_eq(M, q, r, c, None, 1e-12,
-                                                           1000 + 100 * n, z, basis)
-        outs.append((code, pivots, m, bounds, z, basis[:m]))
-    if outs[0][0] == kernel.NEEDS_RUIZ:  # s not decided in C (near a midpoint): nothing to see
-        return
-    assert all(same(np.asarray(x), np.asarray(y)) for x, y in zip(*outs)), outs
+    for d in (None, rng.uniform(0.5, 3.0, n)):  # Lemke's covering vector: ones, or given
+        outs = []
+        for r, c in ((None, None), (np.full(n, 1.0 / s), np.full(n, s))):
+            z, basis = np.zeros(n), np.zeros(n, dtype=np.int64)
+            code, pivots, m, bounds = kernel._lemke_c.solve_eq(M, q, r, c, d, 1e-12,
+                                                               1000 + 100 * n, z, basis)
+            outs.append((code, pivots, m, bounds, z, basis[:m]))
+        if outs[0][0] == kernel.NEEDS_RUIZ:  # s not decided in C (near a midpoint)
+            continue
+        assert all(same(np.asarray(x), np.asarray(y)) for x, y in zip(*outs)), outs
