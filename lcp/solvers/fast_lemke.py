@@ -12,9 +12,10 @@ and returns the answer when it is "solved" and accepted. `solve_lemke` does thes
 with the same roundings, and the check of `lcp.accuracy.judge_lcp`, the verdict
 `lcp.trust.Run.judge` gives on an LCP (polish on the basis, backward and forward errors,
 `lcp.residual.lcp_measure`). For a balanced M (`ruiz` then makes no sweep and only changes the
-unit of q) one C call (`_lemke_c.solve_accept`) does the equilibration, the pivots, z back and
-judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`); numpy
-then computes M z and C the rest of lcp.residual's measure. Otherwise `ruiz` runs in numpy,
+unit of q) one C call (`_lemke_c.solve_fast`) does the equilibration, the pivots, z back,
+judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`), M z by
+numpy's own BLAS call (np.dot(M, z, w), called from C) and the rest of lcp.residual's measure.
+Otherwise `ruiz` runs in numpy,
 its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it
 returns the same Solution (z, w, pivots, basis, residuals, message, info) as the general path,
 bit for bit
