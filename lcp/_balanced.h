@@ -34,7 +34,7 @@ static double pow2_near(double x)
     return s;
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #include <immintrin.h>
 #define BALANCED_AVX2 1
 static int balanced_avx2 = -1; /* -1: not decided yet */

@@ -109,7 +109,11 @@ static void update_plain(double *T, const double *col, const double *row, idx n,
     }
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+/* The AVX2 clones (here, in _balanced.h, acceptance/_accuracy_core.h and _lu_core.h) are
+ * chosen at run time where the CPU has AVX2; built with -DRIGIDLCP_NO_AVX2 (or on another
+ * architecture) only the plain loops remain, with the same numbers: benchmarks/ab_builds.py
+ * --ref on such a build compares the two (docs/performance.md, third pass). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #define HAVE_AVX2_CLONE 1
 #include <immintrin.h>
 /* The same loop vectorized 4 wide: each lane rounds the product and the sum as the scalar

@@ -16,7 +16,7 @@ static inline double dmin(double a, double b) { return a < b ? a : b; }
 
 /* Are all n entries of a finite? Then *mx = max |a_i| (from the value on entry). Four lanes
  * wide where the CPU has AVX2 (the maximum of finite numbers does not depend on the order). */
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #include <immintrin.h>
 #define ACC_HAVE_AVX2 1
 __attribute__((target("avx2"))) static int abs_max_finite_avx2(const double *a, idx n,
