@@ -71,6 +71,16 @@ def test_one_call_gives_the_separate_calls_numbers(problem):
 
 
 @compiled
+@settings(max_examples=60, deadline=None)
+@given(random_lcps(max_n=40, kinds=("psd", "p-dominant", "scaled", "extreme", "general")))
+def test_the_whole_call_is_the_general_paths_up_to_n_40(problem):
+    """lcp.solve(P) through the one call against the general path (lcp.trust, whose lemke()
+    builds its dictionary with `setup` and pivots with `run`: another fill than solve_fast's),
+    every field bit for bit, at sizes where the four-lane passes and the blocked fill run."""
+    assert_same_answer(lcp.LCP(*problem))
+
+
+@compiled
 @settings(max_examples=200, deadline=None)
 @given(degenerate_integer_lcps(max_n=6))
 def test_one_call_on_degenerate_problems(problem):
