@@ -109,8 +109,13 @@ static void update_plain(double *T, const double *col, const double *row, idx n,
     }
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+/* The AVX2 clones (here, in _balanced.h, acceptance/_accuracy_core.h and _lu_core.h) are
+ * chosen at run time where the CPU has AVX2; built with -DRIGIDLCP_NO_AVX2 (or on another
+ * architecture) only the plain loops remain, with the same numbers: benchmarks/ab_builds.py
+ * --ref on such a build compares the two (docs/performance.md, third pass). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #define HAVE_AVX2_CLONE 1
+#include <immintrin.h>
 /* The same loop vectorized 4 wide: each lane rounds the product and the sum as the scalar
  * loop does (AVX2 without FMA), so the numbers are the same, only sooner. */
 __attribute__((target("avx2"))) static void update_avx2(double *T, const double *col,
@@ -125,6 +130,14 @@ __attribute__((target("avx2"))) static void update_avx2(double *T, const double 
     }
 }
 static int use_avx2 = -1; /* -1: not decided yet */
+static int cpu_avx2(void)
+{
+    if (use_avx2 < 0) {
+        __builtin_cpu_init();
+        use_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    return use_avx2;
+}
 #else
 #define HAVE_AVX2_CLONE 0
 #endif
@@ -264,6 +277,37 @@ static idx choose(Lemke *L, idx *rows, double *alpha, const double *theta, idx m
     return lexico_min(L, rows, alpha, mt);
 }
 
+/* ------------------------------------------------------------------ the column minimum */
+/* min over a[0..n) as the loop amin = a[i] < amin ? a[i] : amin from amin = a[0] (a NaN
+ * skipped, unless a[0] is one: then NaN). Four lanes wide where the CPU has AVX2: each lane
+ * keeps the same rule (vminpd returns its second operand unless the first is smaller), and the
+ * minimum of numbers does not depend on the order (of two zeros the sign may differ, which no
+ * use of it sees: only amax = -amin compared with thresholds and 1 follows). */
+#if HAVE_AVX2_CLONE
+__attribute__((target("avx2"))) static double column_min_avx2(const double *a, idx n)
+{
+    __m256d m = _mm256_set1_pd(a[0]);
+    idx i = 1;
+    for (; i + 4 <= n; i += 4) m = _mm256_min_pd(_mm256_loadu_pd(a + i), m);
+    double l[4];
+    _mm256_storeu_pd(l, m);
+    double amin = l[0];
+    for (int k = 1; k < 4; k++) amin = l[k] < amin ? l[k] : amin;
+    for (; i < n; i++) amin = a[i] < amin ? a[i] : amin;
+    return amin;
+}
+#endif
+
+static double column_min(const double *a, idx n)
+{
+#if HAVE_AVX2_CLONE
+    if (n >= 16 && cpu_avx2()) return column_min_avx2(a, n);
+#endif
+    double amin = a[0];
+    for (idx i = 1; i < n; i++) amin = a[i] < amin ? a[i] : amin; /* minsd: no branch */
+    return amin;
+}
+
 /* ------------------------------------------------------------------ the run */
 static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
                long long *out_pivots, idx *out_s, int64_t *out_entering)
@@ -323,8 +367,7 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
         ent = entering;
         s = (idx)L->slot_of[entering];
         const double *a = T + ld * s;
-        double amin = a[0];
-        for (idx i = 1; i < n; i++) amin = a[i] < amin ? a[i] : amin; /* minsd: no branch */
+        double amin = column_min(a, n);
         amax = -amin;
         double thr = amax > 1.0 ? L->tol * amax : L->tol;
         if (amax <= thr) {
@@ -332,8 +375,10 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
             break;
         }
         idx m = 0;
-        for (idx i = 0; i < n; i++)
-            if (a[i] < -thr) L->rows[m++] = i;
+        for (idx i = 0; i < n; i++) { /* branch-free: random signs defeat the predictor */
+            L->rows[m] = i;
+            m += a[i] < -thr;
+        }
         if (m == 1) {
             r = L->rows[0];
             continue;
@@ -583,8 +628,8 @@ static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t narg
              vM.shape[0] == n && vM.shape[1] == n;
     if (ok) {
         const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
-        int finite = 1; /* as `check`: branch-free, |x| <= DBL_MAX false for inf and NaN */
-        for (idx k = 0; k < n * n; k++) finite &= fabs(M[k]) <= DBL_MAX;
+        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
+        int finite = abs_max_finite(M, n * n, &top);
         for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
         ok = finite;
     }
@@ -653,6 +698,75 @@ static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *
     return 0;
 }
 
+#if HAVE_AVX2_CLONE
+/* fill_scaled for mode 1 (r = c = NULL; M and q finite, top = max|M|), in one pass over M:
+ * T[i, j] = ((M_ij rs) cs) / mu, the numbers fill_scaled stores and then divides by mu. Its mu
+ * is max |(M_ij rs) cs| = (top rs) cs: rounding is monotone and odd, so the maximum of the
+ * rounded products is the rounded product of the maximum, known before the pass. Four rows and
+ * four columns at a time, transposed in registers (T is column-major). Returns NOT_FINITE when
+ * a scaled entry overflows, as fill_scaled. */
+__attribute__((target("avx2"))) static int fill_units_avx2(idx n, idx ld, double *T,
+                                                           const double *M, const double *q,
+                                                           const double *d, double rs,
+                                                           double cs, double top, Scales *S)
+{
+    double mu = (top * rs) * cs;
+    if (!(mu <= DBL_MAX)) return NOT_FINITE; /* an entry overflows: fill_scaled's verdict */
+    if (mu == 0.0) mu = 1.0;
+    const __m256d vr = _mm256_set1_pd(rs), vc = _mm256_set1_pd(cs), vmu = _mm256_set1_pd(mu);
+    idx i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const double *M0 = M + i * n, *M1 = M0 + n, *M2 = M1 + n, *M3 = M2 + n;
+        idx j = 0;
+        for (; j + 4 <= n; j += 4) {
+            __m256d r0 = _mm256_loadu_pd(M0 + j), r1 = _mm256_loadu_pd(M1 + j),
+                    r2 = _mm256_loadu_pd(M2 + j), r3 = _mm256_loadu_pd(M3 + j);
+            r0 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r0, vr), vc), vmu);
+            r1 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r1, vr), vc), vmu);
+            r2 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r2, vr), vc), vmu);
+            r3 = _mm256_div_pd(_mm256_mul_pd(_mm256_mul_pd(r3, vr), vc), vmu);
+            __m256d t0 = _mm256_unpacklo_pd(r0, r1), t1 = _mm256_unpackhi_pd(r0, r1),
+                    t2 = _mm256_unpacklo_pd(r2, r3), t3 = _mm256_unpackhi_pd(r2, r3);
+            _mm256_storeu_pd(T + i + ld * j, _mm256_permute2f128_pd(t0, t2, 0x20));
+            _mm256_storeu_pd(T + i + ld * (j + 1), _mm256_permute2f128_pd(t1, t3, 0x20));
+            _mm256_storeu_pd(T + i + ld * (j + 2), _mm256_permute2f128_pd(t0, t2, 0x31));
+            _mm256_storeu_pd(T + i + ld * (j + 3), _mm256_permute2f128_pd(t1, t3, 0x31));
+        }
+        for (; j < n; j++)
+            for (idx k = 0; k < 4; k++) T[i + k + ld * j] = ((M[(i + k) * n + j] * rs) * cs) / mu;
+    }
+    for (; i < n; i++)
+        for (idx j = 0; j < n; j++) T[i + ld * j] = ((M[i * n + j] * rs) * cs) / mu;
+    double nu = 0.0, qmax = 0.0, qmin = DBL_MAX;
+    int finite = 1;
+    for (idx i = 0; i < n; i++) {
+        double v = q[i] * rs, a = fabs(v), aq = fabs(q[i]);
+        finite &= a <= DBL_MAX;
+        nu = a > nu ? a : nu;
+        qmin = v < qmin ? v : qmin;
+        qmax = aq > qmax ? aq : qmax;
+        T[i + ld * (n + 1)] = v;
+    }
+    if (!finite) return NOT_FINITE;
+    double delta = -1.0 / 0.0;
+    for (idx i = 0; i < n; i++) {
+        double di = d ? d[i] : 1.0;
+        if (di > delta) delta = di;
+    }
+    for (idx i = 0; i < n; i++) {
+        T[i + ld * n] = (d ? d[i] : 1.0) / delta;
+        T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
+    }
+    S->mu = mu;
+    S->nu = nu;
+    S->delta = delta;
+    S->qmin = qmin;
+    S->mmax = top;
+    S->qmax = qmax;
+    return 0;
+}
+#endif
+
 /* One LCP by the steps of lemke() on the data `solve` gives it (mode 0: as they are; 1: the
  * equilibration of a balanced M done here; 2: the factors r, c of `ruiz` given): q~ >= 0 gives
  * z = 0 and no pivot, else the dictionary and the pivot loop; z in the original units (as
@@ -669,11 +783,17 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     memset(z, 0, n * sizeof(double));
     memset(bz, 0, n);
     if (mode != 2) r = c = NULL;
+    double top = 0.0;
     if (mode == 1) {
-        int code = balanced_units(n, M, q, L->theta, &rs, &cs);
+        int code = balanced_units(n, M, q, L->theta, &rs, &cs, &top);
         if (code) return code;
     }
     Scales S;
+#if HAVE_AVX2_CLONE
+    if (mode == 1 && cpu_avx2()) {
+        if (fill_units_avx2(n, L->ld, T, M, q, d, rs, cs, top, &S)) return NOT_FINITE;
+    } else
+#endif
     if (fill_scaled(n, L->ld, T, M, q, d, r, c, rs, cs, &S)) return NOT_FINITE;
     bound[0] = S.mmax;
     bound[1] = S.qmax;
@@ -887,6 +1007,38 @@ static int accept_one(idx n, const double *M, const double *q, const double *zs,
     return code;
 }
 
+/* The work of solve_accept on C-contiguous data (M n x n, q, z: n doubles, basis: n int64),
+ * without the GIL: the code of solve_problem (-1: out of memory), *acode that of accept_one
+ * (1 when not solved). */
+static int solve_and_accept(idx n, const double *M, const double *q, double tol,
+                            long long max_iter, double *z, int64_t *basis, long long *pivots,
+                            idx *nb, int *acode, double res[3])
+{
+    Work w;
+#if defined(__GNUC__)
+    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
+#else
+    uint64_t stack[STACK_WORDS];
+#endif
+    double bound[3] = {0.0, 0.0, 0.0};
+    *pivots = 0;
+    *nb = 0;
+    *acode = 1;
+    res[0] = res[1] = res[2] = 0.0;
+    if (work_init(&w, n, tol, stack) < 0) return -1;
+    double zbuf[64], *zs = n <= 64 ? zbuf : (double *)malloc((size_t)n * sizeof(double));
+    if (!zs) {
+        work_free(&w);
+        return -1;
+    }
+    int code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, pivots,
+                             bound);
+    if (code == 0) *acode = accept_one(n, M, q, zs, w.bz, bound, basis, nb, z, res);
+    if (zs != zbuf) free(zs);
+    work_free(&w);
+    return code;
+}
+
 /* solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr,
  * refined): `solve_eq` with r = c = d = None (lcp.solve's default Lemke) and, on code 0, the
  * acceptance steps of lcp/acceptance/accuracy.py's `assess_lcp` on the answer and its basis
@@ -912,36 +1064,14 @@ static PyObject *py_solve_accept(PyObject *self, PyObject *args)
     if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto done;
     if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
-    Work w;
-#if defined(__GNUC__)
-    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
-#else
-    uint64_t stack[STACK_WORDS];
-#endif
-    if (work_init(&w, n, tol, stack) < 0) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
     long long pivots = 0;
-    double bound[3] = {0.0, 0.0, 0.0}, res[3] = {0.0, 0.0, 0.0};
+    double res[3];
     idx nb = 0;
     int code, acode = 1;
-    double zbuf[64], *zs = n <= 64 ? zbuf : (double *)malloc((size_t)n * sizeof(double));
-    if (!zs) {
-        work_free(&w);
-        PyErr_NoMemory();
-        goto done;
-    }
     Py_BEGIN_ALLOW_THREADS
-    code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, &pivots,
-                         bound);
-    if (code == 0)
-        acode = accept_one(n, M, q, zs, w.bz, bound, (int64_t *)vb.buf, &nb,
-                           (double *)vz.buf, res);
+    code = solve_and_accept(n, (const double *)vM.buf, (const double *)vq.buf, tol, max_iter,
+                            (double *)vz.buf, (int64_t *)vb.buf, &pivots, &nb, &acode, res);
     Py_END_ALLOW_THREADS
-    if (zs != zbuf) free(zs);
-    work_free(&w);
     if (code < 0)
         PyErr_NoMemory();
     else
@@ -1094,6 +1224,56 @@ static double pairwise_abs(const double *a, idx n)
 #undef ABS
 }
 
+#if HAVE_AVX2_CLONE
+/* pairwise_abs four lanes wide: the eight partial sums in two registers, each lane adding the
+ * same terms in the same order as the scalar r[j] (|x| by clearing the sign bit, as fabs), so
+ * the sum is the same number. */
+__attribute__((target("avx2"))) static double pairwise_abs_avx2(const double *a, idx n)
+{
+    if (n < 8) {
+        double res = 0.0;
+        for (idx i = 0; i < n; i++) res += fabs(a[i]);
+        return res;
+    }
+    if (n <= 128) {
+        const __m256d sign = _mm256_set1_pd(-0.0);
+        __m256d r0 = _mm256_andnot_pd(sign, _mm256_loadu_pd(a));
+        __m256d r1 = _mm256_andnot_pd(sign, _mm256_loadu_pd(a + 4));
+        idx i;
+        for (i = 8; i < n - (n % 8); i += 8) {
+            r0 = _mm256_add_pd(r0, _mm256_andnot_pd(sign, _mm256_loadu_pd(a + i)));
+            r1 = _mm256_add_pd(r1, _mm256_andnot_pd(sign, _mm256_loadu_pd(a + i + 4)));
+        }
+        double r[8];
+        _mm256_storeu_pd(r, r0);
+        _mm256_storeu_pd(r + 4, r1);
+        double res = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]));
+        for (; i < n; i++) res += fabs(a[i]);
+        return res;
+    }
+    idx n2 = n / 2;
+    n2 -= n2 % 8;
+    return pairwise_abs_avx2(a, n2) + pairwise_abs_avx2(a + n2, n - n2);
+}
+
+/* measure_one's pass over M (finiteness, max|M|, the row sums of |M| in numpy's order), with
+ * pairwise_abs_avx2 and _accuracy_core.h's abs_max_finite_avx2. */
+__attribute__((target("avx2"))) static int m_pass_avx2(idx n, const double *M, double *mmax,
+                                                       double *norm)
+{
+    int finite = 1;
+    for (idx i = 0; i < n; i++) {
+        const double *Mi = M + i * n;
+        finite &= abs_max_finite_avx2(Mi, n, mmax);
+        double row = 0.0 + pairwise_abs_avx2(Mi, n);
+        finite &= row <= DBL_MAX;
+        *norm = row > *norm ? row : *norm;
+    }
+    return finite;
+}
+
+#endif
+
 /* abs_row_sums(M, out): out[i] = 0 + sum_j |M_ij| summed as numpy's np.add.reduce(np.abs(M),
  * axis=1) (M m x n C-contiguous float64, out m float64): the probe of lcp/_lemke_kernel.py. */
 static PyObject *py_abs_row_sums(PyObject *self, PyObject *args)
@@ -1133,17 +1313,26 @@ static int measure_one(idx n, const double *M, const double *q, const double *z,
 {
     double mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
     int finite = 1; /* branch-free maxima and finiteness test, as in balanced_units */
+#if HAVE_AVX2_CLONE
+    int wide = cpu_avx2(); /* M's pass four lanes wide: the same numbers (see m_pass_avx2) */
+    if (wide) finite = m_pass_avx2(n, M, &mmax, &norm);
+#else
+    const int wide = 0;
+#endif
     for (idx i = 0; i < n; i++) {
-        const double *Mi = M + i * n;
-        for (idx j = 0; j < n; j++) {
-            double a = fabs(Mi[j]);
-            finite &= a <= DBL_MAX;
-            mmax = a > mmax ? a : mmax;
+        if (!wide) {
+            const double *Mi = M + i * n;
+            for (idx j = 0; j < n; j++) {
+                double a = fabs(Mi[j]);
+                finite &= a <= DBL_MAX;
+                mmax = a > mmax ? a : mmax;
+            }
+            double row = 0.0 + pairwise_abs(Mi, n);
+            norm = row > norm ? row : norm;
+            finite &= row <= DBL_MAX;
         }
-        double row = 0.0 + pairwise_abs(Mi, n);
-        norm = row > norm ? row : norm;
         double aq = fabs(q[i]), az = fabs(z[i]), wi = fabs(w[i] + q[i]);
-        finite &= (aq <= DBL_MAX) & (az <= DBL_MAX) & (wi <= DBL_MAX) & (row <= DBL_MAX);
+        finite &= (aq <= DBL_MAX) & (az <= DBL_MAX) & (wi <= DBL_MAX);
         qmax = aq > qmax ? aq : qmax;
         zmax = az > zmax ? az : zmax;
     }
@@ -1254,6 +1443,73 @@ static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
     Py_RETURN_TRUE;
 }
 
+/* solve_fast(M, q, tol, max_iter, z, w, basis, dot, upto) -> (code, pivots, nbasis, acode,
+ * berr, ferr, refined, raw, scaled): lcp.solve's common call in one crossing from Python
+ * (lcp/solvers/fast_lemke.py): `solve_accept` and then, when the answer was assessed here
+ * (code 0, acode 0), lcp.residual's measure as `solve_lemke` took it -- w = dot(M, z, w) by the
+ * `dot` given (numpy.dot: the same BLAS call as M.dot(z), written into w) and `lcp_measure`'s C
+ * steps when n <= upto (w becomes M z + q) -- with no Python between. raw and scaled are NaN
+ * when not measured here (the caller measures in numpy). M: C-contiguous n x n float64, q, z,
+ * w float64 of length n (ndim 1), basis int64 of length n; else ValueError. */
+static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 9) {
+        PyErr_SetString(PyExc_TypeError, "solve_fast: nine arguments");
+        return NULL;
+    }
+    double tol = PyFloat_AsDouble(args[2]);
+    long long max_iter = PyLong_AsLongLong(args[3]);
+    idx upto = PyLong_AsSsize_t(args[8]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0}, vb = {0};
+    PyObject *result = NULL;
+    idx n = PyObject_Length(args[1]);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(args[1], &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(args[0], &vM, "M", 'd', n * n, 0) < 0) goto done;
+    if (get_buffer(args[4], &vz, "z", 'd', n, 0) < 0) goto done;
+    if (get_buffer(args[5], &vw, "w", 'd', n, 0) < 0) goto done;
+    if (get_buffer(args[6], &vb, "basis", 'q', n, 0) < 0) goto done;
+    if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
+        PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
+        goto done;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    double *z = (double *)vz.buf, *w = (double *)vw.buf;
+    long long pivots = 0;
+    double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
+    idx nb = 0;
+    int code, acode = 1;
+    Py_BEGIN_ALLOW_THREADS
+    code = solve_and_accept(n, M, q, tol, max_iter, z, (int64_t *)vb.buf, &pivots, &nb, &acode,
+                            res);
+    Py_END_ALLOW_THREADS
+    if (code < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (code == 0 && acode == 0) {
+        PyObject *call[3] = {args[0], args[4], args[5]};
+        PyObject *out = PyObject_Vectorcall(args[7], call, 3, NULL); /* dot(M, z, w) */
+        if (!out) goto done;
+        Py_DECREF(out);
+        if (n <= upto && measure_one(n, M, q, z, w, got) < 0) got[0] = got[1] = NAN;
+    }
+    result = Py_BuildValue("iLniddidd", code, pivots, nb, acode, res[0], res[1], (int)res[2],
+                           got[0], got[1]);
+done:
+    release(&vb);
+    release(&vw);
+    release(&vz);
+    release(&vM);
+    release(&vq);
+    return result;
+}
+
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
      "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None): k "
@@ -1261,6 +1517,9 @@ static PyMethodDef methods[] = {
     {"solve_accept", py_solve_accept, METH_VARARGS,
      "solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr, "
      "refined): solve_eq's default Lemke and the acceptance of its answer in one call."},
+    {"solve_fast", (PyCFunction)(void (*)(void))py_solve_fast, METH_FASTCALL,
+     "solve_fast(M, q, tol, max_iter, z, w, basis, dot, upto) -> (code, pivots, nbasis, acode, "
+     "berr, ferr, refined, raw, scaled): solve_accept, then w = dot(M, z, w) and the measure."},
     {"solve_eq", py_solve_eq, METH_VARARGS,
      "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
      "LCP by Lemke on its equilibrated data."},

@@ -14,6 +14,60 @@ static inline double dmin(double a, double b) { return a < b ? a : b; }
 #define MAX_M 400
 #define STEPS 5
 
+/* Are all n entries of a finite? Then *mx = max |a_i| (from the value on entry). Four lanes
+ * wide where the CPU has AVX2 (the maximum of finite numbers does not depend on the order). */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
+#include <immintrin.h>
+#define ACC_HAVE_AVX2 1
+__attribute__((target("avx2"))) static int abs_max_finite_avx2(const double *a, idx n,
+                                                               double *mx)
+{
+    const __m256d sign = _mm256_set1_pd(-0.0), big = _mm256_set1_pd(DBL_MAX);
+    __m256d m = _mm256_set1_pd(*mx), bad = _mm256_setzero_pd();
+    idx i = 0;
+    for (; i + 4 <= n; i += 4) {
+        __m256d v = _mm256_andnot_pd(sign, _mm256_loadu_pd(a + i));
+        bad = _mm256_or_pd(bad, _mm256_cmp_pd(v, big, _CMP_NLE_UQ)); /* > DBL_MAX or NaN */
+        m = _mm256_max_pd(m, v);
+    }
+    double l[4];
+    _mm256_storeu_pd(l, m);
+    double top = l[0];
+    for (int k = 1; k < 4; k++) top = l[k] > top ? l[k] : top;
+    int finite = _mm256_movemask_pd(bad) == 0;
+    for (; i < n; i++) {
+        double v = fabs(a[i]);
+        finite &= v <= DBL_MAX;
+        top = v > top ? v : top;
+    }
+    *mx = top;
+    return finite;
+}
+static int acc_avx2 = -1; /* -1: not decided yet */
+#else
+#define ACC_HAVE_AVX2 0
+#endif
+
+static int abs_max_finite(const double *a, idx n, double *mx)
+{
+#if ACC_HAVE_AVX2
+    if (acc_avx2 < 0) {
+        __builtin_cpu_init();
+        acc_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    if (acc_avx2) return abs_max_finite_avx2(a, n, mx);
+#endif
+    double top = *mx;
+    int finite = 1;
+    for (idx i = 0; i < n; i++) {
+        double v = fabs(a[i]);
+        finite &= v <= DBL_MAX;
+        top = v > top ? v : top;
+    }
+    *mx = top;
+    return finite;
+}
+
 /* berr of lcp/accuracy.py (nu = 0). */
 static double backward_error(idx n, const double *M, const double *q, const double *x,
                              double mmax, double qmax, double floor)
@@ -126,10 +180,31 @@ static double skeel_bound(idx m, const double *A, const idx *perm, const double 
             x[k] = x[perm[k]];
             x[perm[k]] = t;
         }
-    for (idx i = 0; i < m; i++)
+    /* C(L)^-1: x[i] += |A[i, j]| x[j] for j = 0, ..., i - 1 in this order; four rows at once
+     * as lu_solve's L (the same numbers, sooner) */
+    idx i = 0;
+    for (; i + 4 <= m; i += 4) {
+        const double *A0 = A + i * m, *A1 = A0 + m, *A2 = A1 + m, *A3 = A2 + m;
+        double x0 = x[i], x1 = x[i + 1], x2 = x[i + 2], x3 = x[i + 3];
+        for (idx j = 0; j < i; j++) {
+            double xj = x[j];
+            x0 += fabs(A0[j]) * xj;
+            x1 += fabs(A1[j]) * xj;
+            x2 += fabs(A2[j]) * xj;
+            x3 += fabs(A3[j]) * xj;
+        }
+        x1 += fabs(A1[i]) * x0;
+        x2 += fabs(A2[i]) * x0;
+        x3 += fabs(A3[i]) * x0;
+        x2 += fabs(A2[i + 1]) * x1;
+        x3 += fabs(A3[i + 1]) * x1;
+        x3 += fabs(A3[i + 2]) * x2;
+        x[i] = x0, x[i + 1] = x1, x[i + 2] = x2, x[i + 3] = x3;
+    }
+    for (; i < m; i++)
         for (idx j = 0; j < i; j++) x[i] += fabs(A[i * m + j]) * x[j];
     double top = 0.0;
-    for (idx i = m - 1; i >= 0; i--) {
+    for (i = m - 1; i >= 0; i--) {
         for (idx j = i + 1; j < m; j++) x[i] += fabs(A[i * m + j]) * x[j];
         x[i] /= fabs(A[i * m + i]);
         top = dmax(top, x[i]);
@@ -141,6 +216,41 @@ static double skeel_bound(idx m, const double *A, const idx *perm, const double 
  * bound of the norm, up to its rounding and the factor 4/3 of its alternative vector) is then
  * far below 1 / (m eps) too, and the test's outcome is the one the estimate would give. */
 #define SKEEL_MARGIN 1e-3
+
+/* out_i = init_i + sum_j |K_ij| x_j (x NULL: + |K_ij|; init NULL: from 0), each row summed
+ * for j = 0, 1, ..., m - 1 in this order, four rows at once (independent chains: the same
+ * numbers as row by row, sooner). out may be init. */
+static void abs_row_sums_by4(idx m, const double *K, const double *x, const double *init,
+                             double *out)
+{
+    idx i = 0;
+    for (; i + 4 <= m; i += 4) {
+        const double *K0 = K + i * m, *K1 = K0 + m, *K2 = K1 + m, *K3 = K2 + m;
+        double s0 = init ? init[i] : 0.0, s1 = init ? init[i + 1] : 0.0,
+               s2 = init ? init[i + 2] : 0.0, s3 = init ? init[i + 3] : 0.0;
+        if (x)
+            for (idx j = 0; j < m; j++) {
+                double xj = x[j];
+                s0 += fabs(K0[j]) * xj;
+                s1 += fabs(K1[j]) * xj;
+                s2 += fabs(K2[j]) * xj;
+                s3 += fabs(K3[j]) * xj;
+            }
+        else
+            for (idx j = 0; j < m; j++) {
+                s0 += fabs(K0[j]);
+                s1 += fabs(K1[j]);
+                s2 += fabs(K2[j]);
+                s3 += fabs(K3[j]);
+            }
+        out[i] = s0, out[i + 1] = s1, out[i + 2] = s2, out[i + 3] = s3;
+    }
+    for (; i < m; i++) {
+        double s = init ? init[i] : 0.0;
+        for (idx j = 0; j < m; j++) s += x ? fabs(K[i * m + j]) * x[j] : fabs(K[i * m + j]);
+        out[i] = s;
+    }
+}
 
 /* r = K y + k, accumulated in long double, rounded to double. */
 static void residual_ld(idx m, const double *K, const double *k, const double *y, double *r)
@@ -175,16 +285,39 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     for (idx i = 0; i < n; i++) qmax = dmax(qmax, fabs(q[i]));
     for (idx i = 0; i < n; i++)
         if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
-    /* |M|_max and ||M||_inf in one pass, for the data's scale (lcp/accuracy.py's data_scale):
+    /* |M|_max and ||M||_inf, for the data's scale (lcp/accuracy.py's data_scale):
      * |q| + ||M||_inf |q| / |M|_max */
-    for (idx i = 0; i < n; i++) {
-        double s = 0.0;
-        for (idx j = 0; j < n; j++) {
-            double v = fabs(M[i * n + j]);
-            s += v;
-            mmax = dmax(mmax, v);
+    if (abs_max_finite(M, n * n, &mmax)) {
+        /* all finite: the maxima do not depend on the order, and each row sum is taken in its
+         * own order, four rows at once (independent chains: the same numbers, sooner) */
+        idx i = 0;
+        for (; i + 4 <= n; i += 4) {
+            const double *M0 = M + i * n, *M1 = M0 + n, *M2 = M1 + n, *M3 = M2 + n;
+            double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+            for (idx j = 0; j < n; j++) {
+                s0 += fabs(M0[j]);
+                s1 += fabs(M1[j]);
+                s2 += fabs(M2[j]);
+                s3 += fabs(M3[j]);
+            }
+            norm = dmax(dmax(dmax(dmax(norm, s0), s1), s2), s3);
         }
-        norm = dmax(norm, s);
+        for (; i < n; i++) {
+            double s = 0.0;
+            for (idx j = 0; j < n; j++) s += fabs(M[i * n + j]);
+            norm = dmax(norm, s);
+        }
+    } else {  /* a NaN or an infinity: the order of the maxima matters; the plain pass */
+        mmax = 0.0;
+        for (idx i = 0; i < n; i++) {
+            double s = 0.0;
+            for (idx j = 0; j < n; j++) {
+                double v = fabs(M[i * n + j]);
+                s += v;
+                mmax = dmax(mmax, v);
+            }
+            norm = dmax(norm, s);
+        }
     }
     if (!isfinite(norm)) return 1;
     double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
@@ -222,12 +355,11 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     for (idx i = 0; i < m; i++) {
         kp[i] = q[a[i]];
         y[i] = z[a[i]];
-        rows[i] = 0.0;
-        for (idx j = 0; j < m; j++) {
-            K[i * m + j] = M[a[i] * n + a[j]];
-            rows[i] += fabs(K[i * m + j]);
-        }
+        const double *Mi = M + a[i] * n;
+        double *Ki = K + i * m;
+        for (idx j = 0; j < m; j++) Ki[j] = Mi[a[j]];
     }
+    abs_row_sums_by4(m, K, NULL, NULL, rows);
     memcpy(A, K, (size_t)m * m * sizeof(double));
     int code = 0;
     if (m > 0) {
@@ -251,11 +383,13 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             residual_ld(m, K, kp, y, r);
             double ymax = 0.0;
             for (idx i = 0; i < m; i++) {
-                double s = fabs(kp[i]);
-                for (idx j = 0; j < m; j++) s += fabs(K[i * m + j]) * fabs(y[j]);
-                g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * s;
-                ymax = dmax(ymax, fabs(y[i]));
+                d[i] = fabs(y[i]);
+                ymax = dmax(ymax, d[i]);
             }
+            for (idx i = 0; i < m; i++) g[i] = fabs(kp[i]);
+            abs_row_sums_by4(m, K, d, g, g);  /* g_i = |k_i| + sum_j |K_ij| |y_j| */
+            for (idx i = 0; i < m; i++)
+                g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * g[i];
             double bound = abs_inv_norm(m, A, perm, g, d, inv);
             ferr = bound / dmax(ymax, 1e-300) + eps;
             /* Skeel's condition || |K^-1| |K| 1 ||: singular to working precision beyond

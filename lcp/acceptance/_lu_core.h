@@ -13,7 +13,7 @@ static void row_update_plain(double *ai, const double *ak, double l, idx len)
     for (idx j = 0; j < len; j++) ai[j] -= l * ak[j];
 }
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 __attribute__((target("avx2"))) static void row_update_avx2(double *ai, const double *ak,
                                                            double l, idx len)
 {

@@ -305,7 +305,7 @@ static int solve_problem(idx n, const double *M, const double *q, const double *
     Ctx C = {n, Mt, qt, work, t, ints + 2 * nd};
     double rs = 1.0, cs = 1.0;
     int code = 0;
-    if (!r) code = balanced_units(n, M, q, t, &rs, &cs);
+    if (!r) code = balanced_units(n, M, q, t, &rs, &cs, NULL);
     if (code) goto out;
     /* lcp/acceptance/scaling.py: M * r[:, None] * c[None, :] and q * r; max|M|, max|q| of the data */
     double mmax = 0.0, qmax = 0.0, mscale = 0.0, qtmax = 0.0;

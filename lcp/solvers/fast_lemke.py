@@ -12,9 +12,10 @@ and returns the answer when it is "solved" and accepted. `solve_lemke` does thes
 with the same roundings, and the check of `lcp.accuracy.judge_lcp`, the verdict
 `lcp.trust.Run.judge` gives on an LCP (polish on the basis, backward and forward errors,
 `lcp.residual.lcp_measure`). For a balanced M (`ruiz` then makes no sweep and only changes the
-unit of q) one C call (`_lemke_c.solve_accept`) does the equilibration, the pivots, z back and
-judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`); numpy
-then computes M z and C the rest of lcp.residual's measure. Otherwise `ruiz` runs in numpy,
+unit of q) one C call (`_lemke_c.solve_fast`) does the equilibration, the pivots, z back,
+judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`), M z by
+numpy's own BLAS call (np.dot(M, z, w), called from C) and the rest of lcp.residual's measure.
+Otherwise `ruiz` runs in numpy,
 its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it
 returns the same Solution (z, w, pivots, basis, residuals, message, info) as the general path,
 bit for bit
@@ -59,30 +60,35 @@ _solve_eq = _kernel._lemke_c.solve_eq if _kernel.COMPILED else None
 _solve_accept = (_kernel._lemke_c.solve_accept
                  if _kernel.COMPILED and _accuracy.__dict__.get("_accuracy_c") else None)
 _measure = _kernel._lemke_c.lcp_measure if _kernel.COMPILED else None
-_empty, _intp = np.empty, np.intp
+#: `_solve_accept`, numpy's M z (np.dot(M, z, w): the BLAS call of M.dot(z)) and the measure's C
+#: steps in one call (lcp/_lemke_c.c: solve_fast)
+_solve_fast = _kernel._lemke_c.solve_fast if _solve_accept is not None else None
+_empty, _intp, _dot = np.empty, np.intp, np.dot
+_upto = _kernel.sums_verified_upto
 
 
 def solve_lemke(problem) -> Solution | None:
     """`lcp.solve(problem, "lemke")` for an lcp.LCP when its first attempt is accepted (the
     Solution the general path would return), else None (see the module docstring)."""
     M, q = problem.M, problem.q
-    if not (type(M) is np.ndarray and type(q) is np.ndarray and M.dtype is _F64
-            and q.dtype is _F64 and q.ndim == 1 and M.shape == (q.size, q.size)
-            and applies()):
+    if not (type(M) is np.ndarray and type(q) is np.ndarray and applies()):
         return None
     n = q.size
-    z = _empty(n)
-    basis = _empty(n, dtype=_intp)
     max_iter = 1000 + 100 * n  # lemke()'s default
-    if _solve_accept is None:
-        return _solve_ruiz(M, q, n, max_iter, z, basis, balanced=True)
-    try:  # C-contiguous finite float64 data only (else ValueError or BufferError)
-        # the solve and `assess_lcp`'s C steps in one call (lcp/_lemke_c.c: solve_accept)
-        code, pivots, m, acode, berr, ferr, refined = _solve_accept(M, q, DEFAULT_TOL,
-                                                                    max_iter, z, basis)
+    if _solve_fast is None:
+        if not (M.dtype is _F64 and q.dtype is _F64 and q.ndim == 1 and M.shape == (n, n)):
+            return None
+        return _solve_ruiz(M, q, n, max_iter, _empty(n), _empty(n, dtype=_intp),
+                           balanced=True)
+    z, w, basis = _empty(n), _empty(n), _empty(n, dtype=_intp)
+    try:  # C-contiguous native float64 M (n x n) and q (n), finite (else ValueError or
+        # BufferError): the solve, `assess_lcp`'s C steps, M z and the measure in one call
+        # (lcp/_lemke_c.c: solve_fast)
+        code, pivots, m, acode, berr, ferr, refined, raw, scaled = _solve_fast(
+            M, q, DEFAULT_TOL, max_iter, z, w, basis, _dot, _upto())
         if code == _kernel.NEEDS_RUIZ:
             return _solve_ruiz(M, q, n, max_iter, z, basis)
-    except (ValueError, BufferError):  # e.g. a Fortran-ordered or read-only M: general path
+    except (ValueError, BufferError, TypeError):  # e.g. Fortran order, read-only, q 0-d
         return None
     if code != _kernel.SOLVED or acode < 0:  # not solved, or numbers the check could overflow
         return None
@@ -90,13 +96,10 @@ def solve_lemke(problem) -> Solution | None:
     if acode:  # not handled in C (e.g. a singular pattern): judge_lcp's numpy steps
         return _judged(M, q, z, basis, pivots)
     # judge_lcp's verdict after `assess_lcp` (done in C above): z is the answer (polished when
-    # refined), then lcp.residual's measure
-    w = M.dot(z)  # lcp_measure's steps, inlined: numpy's M z, the rest in C
-    got = _measure(M, q, z, w) if n <= _kernel.sums_verified_upto() else None
-    if got is None:  # measured by numpy (lcp_measure recomputes w)
+    # refined), then lcp.residual's measure (w = M z + q and the numbers in C, unless n exceeds
+    # the row length whose sums C is known to round as numpy does, or a number overflowed)
+    if raw != raw:  # NaN: not measured in C; measured by numpy (lcp_measure recomputes w)
         w, raw, scaled, _, _ = lcp_measure(M, q, z)
-    else:
-        raw, scaled = got[0], got[1]
     if not (scaled <= TOL and berr <= TOL and ferr <= FERR_TOL):
         return None
     info = {"equilibrated": True, "polished": True} if refined else {"equilibrated": True}

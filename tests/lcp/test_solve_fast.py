@@ -1,0 +1,193 @@
+"""The one-crossing route of `lcp.solve`'s common call (lcp/_lemke_c.c: solve_fast, used by
+lcp/solvers/fast_lemke.py): the solve, its acceptance, numpy's M z and the measure in one C
+call give what the separate calls give (solve_accept, then M.dot(z) and lcp_measure), bit for
+bit, on random, badly scaled, degenerate, infeasible and ill-conditioned problems, across the
+sizes where the C code changes its buffers; and the verdict on its numbers rejects an answer
+that fails any part of the acceptance (the general path then answers)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+
+from rigidlcp import lcp
+from rigidlcp.lcp import _lemke_kernel as kernel
+from rigidlcp.lcp.acceptance import residual
+from rigidlcp.lcp.solvers import fast_lemke
+
+from .test_fast_lemke import assert_same_answer, random_lcps, same
+from .test_lemke import degenerate_integer_lcps
+
+compiled = pytest.mark.skipif(fast_lemke._solve_fast is None,
+                              reason="the C extensions are not built or are off")
+
+
+def two_calls(M, q, upto):
+    """What solve_lemke did before solve_fast: solve_accept, numpy's M z, the C measure."""
+    n = q.size
+    z, basis = np.empty(n), np.empty(n, dtype=np.intp)
+    code, pivots, m, acode, berr, ferr, refined = fast_lemke._solve_accept(
+        M, q, fast_lemke.DEFAULT_TOL, 1000 + 100 * n, z, basis)
+    w, raw, scaled = None, np.nan, np.nan
+    if code == 0 and acode == 0:
+        w = M.dot(z)
+        got = fast_lemke._measure(M, q, z, w) if n <= upto else None
+        if got is not None:
+            raw, scaled = got[0], got[1]
+        else:
+            w = M.dot(z)
+    return (code, pivots, m, acode, berr, ferr, refined, raw, scaled), z, w, basis[:m]
+
+
+def one_call(M, q, upto):
+    n = q.size
+    z, w, basis = np.empty(n), np.empty(n), np.empty(n, dtype=np.intp)
+    out = fast_lemke._solve_fast(M, q, fast_lemke.DEFAULT_TOL, 1000 + 100 * n, z, w, basis,
+                                 np.dot, upto)
+    return out, z, w, basis[:out[2]]
+
+
+def assert_one_call_is_two(M, q):
+    upto = kernel.sums_verified_upto()
+    for limit in (upto, 0):  # measured in C, and left to numpy (raw, scaled NaN)
+        a, za, wa, ba = two_calls(M, q, limit)
+        b, zb, wb, bb = one_call(M, q, limit)
+        assert all(same(x, y) for x, y in zip(a, b)), (a, b)
+        if a[0] != 0:  # not solved (or not balanced): z, w mean nothing
+            continue
+        assert same(za, zb) and same(ba, bb)
+        if a[3] == 0:
+            # w: numpy's M z (np.dot into w, the BLAS call of M.dot), + q when measured in C
+            assert same(wb, wa if limit else M.dot(zb))
+
+
+@compiled
+@settings(max_examples=200, deadline=None)
+@given(random_lcps(max_n=40, kinds=("general", "psd", "p-dominant", "scaled", "extreme",
+                                    "q>=0")))
+def test_one_call_gives_the_separate_calls_numbers(problem):
+    assert_one_call_is_two(*problem)
+
+
+@compiled
+@settings(max_examples=60, deadline=None)
+@given(random_lcps(max_n=40, kinds=("psd", "p-dominant", "scaled", "extreme", "general")))
+def test_the_whole_call_is_the_general_paths_up_to_n_40(problem):
+    """lcp.solve(P) through the one call against the general path (lcp.trust, whose lemke()
+    builds its dictionary with `setup` and pivots with `run`: another fill than solve_fast's),
+    every field bit for bit, at sizes where the four-lane passes and the blocked fill run."""
+    assert_same_answer(lcp.LCP(*problem))
+
+
+@compiled
+@settings(max_examples=200, deadline=None)
+@given(degenerate_integer_lcps(max_n=6))
+def test_one_call_on_degenerate_problems(problem):
+    M, q = problem
+    assert_one_call_is_two(M.astype(float), q.astype(float))
+
+
+@compiled
+@pytest.mark.parametrize("n", [1, 4, 15, 16, 17, 28, 29, 63, 64, 65, 100, 131])
+def test_one_call_across_buffer_sizes(n):
+    """Around the stack / heap boundary of the work array (n = 28 / 29), the column padding
+    (n = 16) and the z buffer (n = 64); nonsymmetric, ill-conditioned and PSD data."""
+    rng = np.random.default_rng(n)
+    A = rng.standard_normal((n, n))
+    U, _, V = np.linalg.svd(rng.standard_normal((n, n)))
+    for M in (A @ A.T + 0.1 * np.eye(n), A + np.diag(np.abs(A).sum(axis=1)),
+              U @ np.diag(np.logspace(0, -12, n)) @ U.T, U @ np.diag(np.logspace(0, 9, n)) @ V):
+        assert_one_call_is_two(M, rng.standard_normal(n))
+
+
+@compiled
+def test_infeasible_and_unbalanced_problems_are_handed_back():
+    """A ray (infeasible) is not solved: code 1-3 and nothing measured; an unbalanced M comes
+    back as NEEDS_RUIZ before any pivot; the whole call then answers as the general path."""
+    ray = lcp.LCP(np.array([[1.0, -1.0], [-1.0, 1.0]]), np.array([-1.0, -1.0]))
+    out, _, _, _ = one_call(ray.M, ray.q, 100)
+    assert out[0] != kernel.SOLVED and np.isnan(out[7])
+    D = np.diag([1e-6, 1.0, 1e6])
+    S = lcp.LCP(D @ (np.eye(3) + 0.3) @ D, -np.ones(3))
+    out, _, _, _ = one_call(S.M, S.q, 100)
+    assert out[0] == kernel.NEEDS_RUIZ and out[1] == 0
+    for P in (ray, S):
+        assert_same_answer(P)
+
+
+@compiled
+@pytest.mark.parametrize("M, q", [
+    (np.ones(9), -np.ones(3)),                 # M a vector of n * n entries
+    (np.ones((1, 9)), -np.ones(3)),            # n * n entries, not n x n
+    (np.ones((3, 3)), -np.ones((3, 1))),       # q a column
+    (np.ones((3, 3)), np.float64(-1.0)),       # q a number
+    (np.ones((3, 3), dtype=">f8"), -np.ones(3)),  # not native
+])
+def test_one_call_refuses_other_shapes_and_types(M, q):
+    """The C call checks the shapes and dtypes the Python checks did; solve_lemke declines and
+    the general path answers or raises as before."""
+    with pytest.raises((ValueError, TypeError, BufferError)):
+        one_call(M, q, 100)
+    P = lcp.LCP(np.eye(3), -np.ones(3))
+    object.__setattr__(P, "M", M)
+    object.__setattr__(P, "q", q)
+    assert fast_lemke.solve_lemke(P) is None
+
+
+@compiled
+@pytest.mark.parametrize("slot, value", [(4, 1e-7), (5, 1.0), (8, 1e-7), (8, np.nan),
+                                         (4, np.inf), (5, np.nan), (7, np.nan)])
+def test_a_failed_measure_is_never_solved(monkeypatch, slot, value):
+    """Whatever number of the acceptance fails -- backward error (slot 4), forward bound (5),
+    scaled residual (8) -- or is not a number, solve_lemke declines (None) and the general
+    path judges the answer itself. (raw NaN, slot 7, means "not measured in C": numpy
+    measures, and the answer is the general path's.)"""
+    rng = np.random.default_rng(7)
+    A = rng.standard_normal((6, 6))
+    P = lcp.LCP(A @ A.T + np.eye(6), rng.standard_normal(6))
+    assert fast_lemke.solve_lemke(P) is not None
+    real = fast_lemke._solve_fast
+
+    def tampered(*args):
+        out = list(real(*args))
+        out[slot] = value
+        return tuple(out)
+
+    monkeypatch.setattr(fast_lemke, "_solve_fast", tampered)
+    if slot == 7:
+        sol = fast_lemke.solve_lemke(P)
+        assert sol is not None
+        assert_same_answer(P)
+    else:
+        assert fast_lemke.solve_lemke(P) is None
+    sol = lcp.solve(P)
+    assert sol.status == "solved" and residual.check(P, sol.z).accepted
+
+
+@compiled
+@pytest.mark.parametrize("mscale, qscale", [(1.0, 1.0), (1e300, 1e-300), (1e-300, 1e300),
+                                            (1e-200, 1e-150), (1e250, 1e100), (1e-310, 1.0),
+                                            (1.0, 0.0)])
+@pytest.mark.parametrize("n", [3, 8, 13, 30])
+def test_dictionary_of_a_balanced_m_is_filled_as_with_explicit_factors(n, mscale, qscale):
+    """solve_eq with r = c = None (the balanced case, equilibrated in C: its dictionary filled
+    in one pass, four rows and columns at a time, mu known beforehand) gives what it gives with
+    the same units passed as factors (r = 1/s, c = s: the general fill, then the division by
+    mu), bit for bit: code, pivots, z, basis, bounds, with d = ones or given -- also where the
+    scaled entries overflow (NOT_FINITE), underflow to subnormals or q = 0."""
+    rng = np.random.default_rng(n)
+    A = rng.standard_normal((n, n))
+    M, q = (A @ A.T + np.eye(n)) * mscale, rng.standard_normal(n) * qscale
+    qmax = np.max(np.abs(q))
+    s = 2.0 ** np.round(np.log2(qmax)) if qmax > 0 else 1.0
+    for d in (None, rng.uniform(0.5, 3.0, n)):  # Lemke's covering vector: ones, or given
+        outs = []
+        for r, c in ((None, None), (np.full(n, 1.0 / s), np.full(n, s))):
+            z, basis = np.zeros(n), np.zeros(n, dtype=np.int64)
+            code, pivots, m, bounds = kernel._lemke_c.solve_eq(M, q, r, c, d, 1e-12,
+                                                               1000 + 100 * n, z, basis)
+            outs.append((code, pivots, m, bounds, z, basis[:m]))
+        if outs[0][0] == kernel.NEEDS_RUIZ:  # s not decided in C (near a midpoint)
+            continue
+        assert all(same(np.asarray(x), np.asarray(y)) for x, y in zip(*outs)), outs
