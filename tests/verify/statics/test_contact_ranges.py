@@ -1,0 +1,100 @@
+"""verify.statics.contact_ranges: the range LPs split into chunks (worker processes) give the
+ends of one LP per end without any filter (scipy's linprog on P written with its cone rows, an
+independent method), and the serial ranges.
+
+The chunked run is exercised two ways: in this process, over any partition of the contacts
+into chunks solved by two ForceLPs with the witnesses carried and merged as the workers do
+(a property over generated piles), and once for real with two worker processes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import linprog
+
+from rigidlcp import models
+from rigidlcp.models.deposition import deposit
+from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of, sliding_of
+from rigidlcp.verify.statics.forceset import analyse
+from rigidlcp.verify.statics.model import ForceLP, StaticProblem
+
+
+def _unfiltered_ends(prob: StaticProblem) -> tuple[np.ndarray, np.ndarray]:
+    """Every end by its own LP (linprog, cone rows as rows, no warm start, no filter)."""
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+    lo, hi = np.zeros(prob.n), np.zeros(prob.n)
+    for k in range(prob.n):
+        for sgn, out in ((1.0, lo), (-1.0, hi)):
+            e = np.zeros(prob.n)
+            e[k] = sgn
+            res = linprog(e, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
+                          b_eq=prob.b, bounds=bounds, method="highs")
+            assert res.status in (0, 3), res.message
+            out[k] = res.x[k] if res.status == 0 else -sgn * np.inf
+    return lo, hi
+
+
+def _same(got: np.ndarray, want: np.ndarray, scale: float) -> None:
+    inf = ~np.isfinite(want)
+    assert np.array_equal(got[inf], want[inf]), np.flatnonzero(inf)
+    assert np.all(np.abs(got[~inf] - want[~inf]) <= 1e-7 * scale), np.max(
+        np.abs(got[~inf] - want[~inf]))
+
+
+def _pile(n: int, seed: int, mu: float):
+    lat = deposit(n, seed=seed, radii=(0.8, 1.2), width=2.0 * max(3, n // 3))
+    return models.System(lat, mu_pp=mu, mu_plane=mu, mu_wall=mu)
+
+
+@settings(max_examples=8)
+@given(n=st.integers(3, 14), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.0),
+       cuts=st.lists(st.integers(1, 40), min_size=1, max_size=6))
+def test_chunks_with_merged_witnesses_give_the_unfiltered_ends(n, seed, mu, cuts):
+    system = _pile(n, seed, mu)
+    fs = analyse(system, ranges=False)
+    if not fs.exists:
+        return
+    prob = StaticProblem(system)
+    c = prob.c
+    bounds = sorted({0, c, *[x % (c + 1) for x in cuts]})
+    chunks = [np.arange(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
+    lps = [ForceLP(prob), ForceLP(prob)]  # two "workers", each warm from its own chunks
+    for lp in lps:
+        lp.solve(np.zeros(prob.n))
+    wit = Witnesses.of(prob, fs.solution)
+    lo, hi = np.zeros(prob.n), np.zeros(prob.n)
+    for x, ch in enumerate(chunks):
+        mine = Witnesses(wit.r_min.copy(), wit.s_max.copy(), wit.s_min.copy(),
+                         wit.seen.copy())  # what a worker receives
+        lo_x, hi_x, _, unchecked = ranges_of(prob, lps[x % 2], fs.implicit, ch, mine)
+        assert unchecked == 0
+        m = len(ch)
+        lo[ch], hi[ch], lo[c + ch], hi[c + ch] = lo_x[:m], hi_x[:m], lo_x[m:], hi_x[m:]
+        wit.merge(mine)
+    want_lo, want_hi = _unfiltered_ends(prob)
+    scale = max(1.0, float(np.max(np.abs(want_hi[np.isfinite(want_hi)]), initial=0.0)))
+    _same(lo, want_lo, scale)
+    _same(hi, want_hi, scale)
+    # the sliding contacts, chunk by chunk, are those of the serial run
+    serial = analyse(system)
+    slide = np.concatenate([sliding_of(prob, lps[x % 2], fs.implicit, hi[:c], wit.seen, ch)[0]
+                            for x, ch in enumerate(chunks)])
+    assert np.array_equal(slide, serial.sliding)
+    _same(serial.lo, want_lo, scale)
+    _same(serial.hi, want_hi, scale)
+
+
+@pytest.mark.parametrize("n, seed, mu", [(24, 1, 0.5)])
+def test_two_worker_processes_give_the_serial_ranges(n, seed, mu):
+    system = _pile(n, seed, mu)
+    one, two = analyse(system), analyse(system, jobs=2)
+    assert one.exists and two.exists and two.unchecked == 0
+    scale = max(1.0, float(np.max(np.abs(one.hi[np.isfinite(one.hi)]))))
+    _same(two.lo, one.lo, scale)
+    _same(two.hi, one.hi, scale)
+    assert np.array_equal(two.sliding, one.sliding)
+    assert two.to_dict()["contacts"][0].keys() == one.to_dict()["contacts"][0].keys()
