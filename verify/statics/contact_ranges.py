@@ -175,6 +175,8 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
     """The ranges of every R and S and the sliding contacts (module docstring). witness: a
     checked point of P; lp: a ForceLP of P (built here if None; unused when jobs > 1);
     progress(done, total, "ranges") as the ends are settled."""
+    if jobs < 1:
+        raise ValueError(f"jobs must be >= 1, got {jobs}")
     c = prob.c
     total, done = lp_count(prob, implicit), 0
 
