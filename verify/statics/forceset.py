@@ -18,7 +18,8 @@
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
-  every optimum checked to lie in P.
+  every optimum checked to lie in P (verify.statics.contact_ranges; in `jobs` worker
+  processes when jobs > 1).
 * sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (a checked
   optimum of a range LP at the bound is a witness; else an LP with
   that cone row made an equality), and their count against McNamara & Herrmann's 2M - 3N
