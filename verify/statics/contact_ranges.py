@@ -2,10 +2,11 @@
 verify.statics.forceset's `analyse`), in this process or split over worker processes.
 
 Each end is the optimum of a range LP (ForceLP: primal simplex, warm-started from the previous
-optimum) checked to lie in P, or a bound that holds on all of P and is attained at a checked
-point of P, so needs no LP: min R = 0 (R >= 0) when some checked point has R = 0, and
-max S = mu max R (S <= mu R) or min S = -mu max R when one has S = +-mu max R. Witness values
-are within 1e-9 of the force scale of the bound, as LP optima are.
+optimum) checked to lie in P and certified by its row duals (weak duality, `ForceLP.certified`;
+an optimum failing either check is counted in `unchecked`), or a bound that holds on all of P
+and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0) when some checked
+point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when one has
+S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP optima are.
 
 With jobs > 1 the contacts are cut into chunks solved by `jobs` worker processes, each holding
 its own ForceLP of P warm from chunk to chunk; the witnesses found so far (by every worker)
@@ -60,7 +61,7 @@ class Witnesses:
 @dataclass
 class Ranges:
     """lo, hi: (2c,) ranges of [R; S] (+-inf unbounded); sliding (c,); lps solved; unchecked:
-    LP optima that failed the check against P (none expected)."""
+    LP optima that failed the check against P or of their dual bound (none expected)."""
 
     lo: np.ndarray
     hi: np.ndarray
@@ -104,7 +105,7 @@ def ranges_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], contacts,
             return -sgn * np.inf
         if status != "optimal":
             raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
-        ok = prob.admissible(lam)
+        ok = prob.admissible(lam) and lp.certified(e, lam)
         unchecked += not ok
         if ok:
             wit.add(prob, lam)

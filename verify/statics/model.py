@@ -103,6 +103,7 @@ class ForceLP:
         self.h, self.nw = h, nw
         self.cols = np.arange(nw, dtype=np.int32)
         self.TT = sp.csr_matrix(self.T.T)
+        self.KT = sp.csr_matrix((prob.A @ self.T).T)  # the balance rows' transpose, in w
 
     def solve(self, cost: np.ndarray) -> tuple[str, np.ndarray | None]:
         """("optimal", lambda) | ("unbounded", None) | ("infeasible", None) | ("failed", None)."""
@@ -117,6 +118,20 @@ class ForceLP:
         if status == st.kInfeasible:
             return "infeasible", None
         return "failed", None
+
+    def certified(self, cost: np.ndarray, lam: np.ndarray, tol: float = 1e-9) -> bool:
+        """Whether the row duals y of the last optimum (lam) certify its value by weak
+        duality: y is dual feasible, its reduced costs d = T^T cost - K^T y >= -tol max(1, |y|)
+        on the columns w >= 0 (K = A T: balance in cone coordinates), and the gap
+        cost . lam - b . y is within tol of the force scale (of the objective, of |b| . |y| and
+        of the largest weight). Then cost . lambda >= b . y on all of P, to that tolerance."""
+        y = np.asarray(self.h.getSolution().row_dual, dtype=float)
+        cost = np.asarray(cost, dtype=float)
+        d = self.TT @ cost - self.KT @ y
+        obj, dual = float(cost @ lam), float(self.prob.b @ y)
+        big = max(self.prob.scale, abs(obj), float(np.abs(self.prob.b) @ np.abs(y)))
+        return (float(np.min(d, initial=0.0)) >= -tol * max(1.0, float(np.max(np.abs(y))))
+                and abs(obj - dual) <= tol * big)
 
     def set_cone_row(self, row: int, equality: bool) -> None:
         """Make cone row `row` (0..2k-1: S - mu R <= 0 for the k frictional contacts, then

@@ -98,3 +98,29 @@ def test_two_worker_processes_give_the_serial_ranges(n, seed, mu):
     _same(two.hi, one.hi, scale)
     assert np.array_equal(two.sliding, one.sliding)
     assert two.to_dict()["contacts"][0].keys() == one.to_dict()["contacts"][0].keys()
+
+
+@settings(max_examples=6)
+@given(n=st.integers(3, 12), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.0))
+def test_dual_bound_certifies_the_optimum_and_refuses_a_cost_it_does_not_bound(n, seed, mu):
+    """ForceLP.certified: the row duals of max R_a certify R_a <= max on P (weak duality);
+    read against the cost -e_b of another contact whose R_b exceeds its value at that optimum
+    somewhere in P (an unfiltered LP finds it), they must not, or R_b would be bounded by it."""
+    system = _pile(n, seed, mu)
+    if not analyse(system, ranges=False).exists:
+        return
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    _, want_hi = _unfiltered_ends(prob)
+    for a in range(prob.c):
+        e = np.zeros(prob.n)
+        e[a] = -1.0
+        status, lam = lp.solve(e)
+        if status != "optimal":
+            continue
+        assert prob.admissible(lam) and lp.certified(e, lam), a
+        for b in range(prob.c):
+            if want_hi[b] > lam[b] + 1e-6 * max(1.0, abs(lam[b])):
+                f = np.zeros(prob.n)
+                f[b] = -1.0
+                assert not lp.certified(f, lam), (a, b)
