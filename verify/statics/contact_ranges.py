@@ -144,12 +144,13 @@ def ranges_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], contacts,
 def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.ndarray,
                seen: np.ndarray, contacts) -> tuple[np.ndarray, int]:
     """Whether S = +-mu R with R > 0 is attainable at each of `contacts` (forceset's
-    docstring), and the LPs solved; hi_R: (c,) max R; seen: (c,) contacts already found at the
-    bound at a checked optimum (no LP needed)."""
+    docstring), the LPs solved and their optima that failed a check (in P, and certified by
+    their duals on the face: a "no" rests on that bound); hi_R: (c,) max R; seen: (c,)
+    contacts already found at the bound at a checked optimum (no LP needed)."""
     k = prob.fric.size
     row_of = {int(a): n for n, a in enumerate(prob.fric)}
     out = np.array([bool(seen[a]) for a in contacts], dtype=bool)
-    lps = 0
+    lps = unchecked = 0
     for x, a in enumerate(contacts):
         kind = implicit[a]
         if prob.mu[a] <= 0 or kind == "R=0" or out[x]:
@@ -159,16 +160,18 @@ def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.n
             continue
         n = row_of[int(a)]
         for row in (n, k + n):
-            lp.set_cone_row(row, True)
+            col = lp.set_cone_row(row, True)
             e = np.zeros(prob.n)
             e[a] = -1.0
             status, lam = lp.solve(e)
             lps += 1
+            if status == "optimal":
+                unchecked += not (prob.admissible(lam) and lp.certified(e, lam, fixed=(col,)))
             lp.set_cone_row(row, False)
             if status == "unbounded" or (status == "optimal" and lam[a] > ZERO * prob.scale):
                 out[x] = True
                 break
-    return out, lps
+    return out, lps, unchecked
 
 
 def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
@@ -193,8 +196,8 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
     lp = lp or ForceLP(prob)
     every = np.arange(c)
     lo, hi, lps, unchecked = ranges_of(prob, lp, implicit, every, wit, step)
-    sliding, more = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
-    return Ranges(lo, hi, sliding, lps + more, unchecked)
+    sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
+    return Ranges(lo, hi, sliding, lps + more, unchecked + bad)
 
 
 _WORKER: dict = {}
@@ -216,8 +219,8 @@ def _range_chunk(task):
 
 def _sliding_chunk(task):
     implicit, contacts, hi_R, seen = task
-    out, lps = sliding_of(_WORKER["prob"], _WORKER["lp"], implicit, hi_R, seen, contacts)
-    return contacts, out, lps
+    return contacts, *sliding_of(_WORKER["prob"], _WORKER["lp"], implicit, hi_R, seen,
+                                 contacts)
 
 
 def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
@@ -254,9 +257,10 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
                          for a in contacts if implicit[a] != "R=0")))
 
         def merge_sliding(res) -> None:
-            contacts, s, lps = res
+            contacts, s, lps, unchecked = res
             sliding[contacts] = s
             out.lps += lps
+            out.unchecked += unchecked
 
         run(_range_chunk, lambda ch: (implicit, ch, wit), merge_ranges)
         run(_sliding_chunk, lambda ch: (implicit, ch, hi[:c], wit.seen), merge_sliding)

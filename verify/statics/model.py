@@ -119,26 +119,32 @@ class ForceLP:
             return "infeasible", None
         return "failed", None
 
-    def certified(self, cost: np.ndarray, lam: np.ndarray, tol: float = 1e-9) -> bool:
+    def certified(self, cost: np.ndarray, lam: np.ndarray, tol: float = 1e-9,
+                  fixed: tuple[int, ...] = ()) -> bool:
         """Whether the row duals y of the last optimum (lam) certify its value by weak
         duality: y is dual feasible, its reduced costs d = T^T cost - K^T y >= -tol max(1, |y|)
-        on the columns w >= 0 (K = A T: balance in cone coordinates), and the gap
-        cost . lam - b . y is within tol of the force scale (of the objective, of |b| . |y| and
-        of the largest weight). Then cost . lambda >= b . y on all of P, to that tolerance."""
+        on the columns w >= 0 (K = A T: balance in cone coordinates; `fixed`: columns fixed at
+        0 by `set_cone_row`, whose d may have any sign), and the gap cost . lam - b . y is
+        within tol of the force scale (of the objective, of |b| . |y| and of the largest
+        weight). Then cost . lambda >= b . y on all of P (on its face with the fixed columns
+        at 0), to that tolerance."""
         y = np.asarray(self.h.getSolution().row_dual, dtype=float)
         cost = np.asarray(cost, dtype=float)
         d = self.TT @ cost - self.KT @ y
+        d[list(fixed)] = 0.0
         obj, dual = float(cost @ lam), float(self.prob.b @ y)
         big = max(self.prob.scale, abs(obj), float(np.abs(self.prob.b) @ np.abs(y)))
         return (float(np.min(d, initial=0.0)) >= -tol * max(1.0, float(np.max(np.abs(y))))
                 and abs(obj - dual) <= tol * big)
 
-    def set_cone_row(self, row: int, equality: bool) -> None:
+    def set_cone_row(self, row: int, equality: bool) -> int:
         """Make cone row `row` (0..2k-1: S - mu R <= 0 for the k frictional contacts, then
-        -S - mu R <= 0) an equality (S = +-mu R: u = 0 or v = 0) or restore it."""
+        -S - mu R <= 0) an equality (S = +-mu R: u = 0 or v = 0) or restore it; returns the
+        column (u or v) whose bounds changed."""
         k = self.prob.fric.size
-        col = self.u_col[row] if row < k else self.v_col[row - k]
-        self.h.changeColBounds(int(col), 0.0, 0.0 if equality else self.hs.kHighsInf)
+        col = int(self.u_col[row] if row < k else self.v_col[row - k])
+        self.h.changeColBounds(col, 0.0, 0.0 if equality else self.hs.kHighsInf)
+        return col
 
 
 def cone_lp(prob: StaticProblem):

@@ -81,9 +81,10 @@ def test_chunks_with_merged_witnesses_give_the_unfiltered_ends(n, seed, mu, cuts
     _same(hi, want_hi, scale)
     # the sliding contacts, chunk by chunk, are those of the serial run
     serial = analyse(system)
-    slide = np.concatenate([sliding_of(prob, lps[x % 2], fs.implicit, hi[:c], wit.seen, ch)[0]
-                            for x, ch in enumerate(chunks)])
-    assert np.array_equal(slide, serial.sliding)
+    runs = [sliding_of(prob, lps[x % 2], fs.implicit, hi[:c], wit.seen, ch)
+            for x, ch in enumerate(chunks)]
+    assert np.array_equal(np.concatenate([r[0] for r in runs]), serial.sliding)
+    assert sum(r[2] for r in runs) == 0 and serial.unchecked == 0
     _same(serial.lo, want_lo, scale)
     _same(serial.hi, want_hi, scale)
 
