@@ -18,8 +18,9 @@
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
-  every optimum checked to lie in P (verify.statics.contact_ranges; in `jobs` worker
-  processes when jobs > 1).
+  every optimum checked to lie in P and its value certified by the LP's duals
+  (verify.statics.contact_ranges; in `jobs` worker processes when jobs > 1); an optimum
+  failing either check is counted ("unchecked_optima" in the JSON).
 * sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (a checked
   optimum of a range LP at the bound is a witness; else an LP with
   that cone row made an equality), and their count against McNamara & Herrmann's 2M - 3N
@@ -58,7 +59,7 @@ class ForceSet:
     lo: np.ndarray | None = None
     hi: np.ndarray | None = None
     sliding: np.ndarray | None = None
-    unchecked: int = 0  # LP optima that failed the check against P (none expected)
+    unchecked: int = 0  # LP optima failing the check against P or of their duals (none seen)
     residuals: tuple[float, float] = (0.0, 0.0)  # of `solution`: balance, laws (force units)
     lps: int = 0
     exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
