@@ -3,10 +3,11 @@ verify.statics.forceset's `analyse`), in this process or split over worker proce
 
 Each end is the optimum of a range LP (ForceLP: primal simplex, warm-started from the previous
 optimum) checked to lie in P and certified by its row duals (weak duality, `ForceLP.certified`;
-an optimum failing either check is counted in `unchecked`), or a bound that holds on all of P
-and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0) when some checked
-point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when one has
-S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP optima are.
+an infinite end by HiGHS's primal ray, `ForceLP.ray_checked`; an end failing its check is
+counted in `unchecked`), or a bound that holds on all of P and is attained at a checked point
+of P, so needs no LP: min R = 0 (R >= 0) when some checked point has R = 0, and
+max S = mu max R (S <= mu R) or min S = -mu max R when one has S = +-mu max R. Witness values
+are within 1e-9 of the force scale of the bound, as LP optima are.
 
 With jobs > 1 the contacts are cut into chunks solved by `jobs` worker processes, each holding
 its own ForceLP of P warm from chunk to chunk; the witnesses found so far (by every worker)
@@ -102,6 +103,7 @@ def ranges_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], contacts,
         status, lam = lp.solve(e)
         lps += 1
         if status == "unbounded":
+            unchecked += not lp.ray_checked(e)
             return -sgn * np.inf
         if status != "optimal":
             raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
@@ -167,6 +169,8 @@ def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.n
             lps += 1
             if status == "optimal":
                 unchecked += not (prob.admissible(lam) and lp.certified(e, lam, fixed=(col,)))
+            elif status == "unbounded":
+                unchecked += not lp.ray_checked(e, fixed=(col,))
             lp.set_cone_row(row, False)
             if status == "unbounded" or (status == "optimal" and lam[a] > ZERO * prob.scale):
                 out[x] = True

@@ -137,6 +137,26 @@ class ForceLP:
         return (float(np.min(d, initial=0.0)) >= -tol * max(1.0, float(np.max(np.abs(y))))
                 and abs(obj - dual) <= tol * big)
 
+    def ray_checked(self, cost: np.ndarray, tol: float = 1e-9,
+                    fixed: tuple[int, ...] = ()) -> bool:
+        """Whether HiGHS's primal ray r (cone coordinates) after an "unbounded" proves it: r >= 0
+        (0 on the `fixed` columns), K r = 0 and cost . T r < 0, each to tol of the ray's own
+        terms; then lambda + t T r stays in P for every t >= 0 and cost . lambda -> -inf."""
+        _, has_ray, values = self.h.getPrimalRay()
+        if not has_ray:
+            return False
+        r = np.asarray(values, dtype=float)
+        big = float(np.max(np.abs(r), initial=0.0))
+        if big == 0.0:
+            return False
+        lam = self.T @ r
+        drop = -float(np.asarray(self.TT @ np.asarray(cost, dtype=float)) @ r)
+        terms = abs(self.KT.T) @ np.abs(r)
+        return (float(np.min(r, initial=0.0)) >= -tol * big
+                and all(abs(r[j]) <= tol * big for j in fixed)
+                and bool(np.all(np.abs(self.KT.T @ r) <= tol * np.maximum(terms, big)))
+                and drop > tol * float(np.max(np.abs(lam))))
+
     def set_cone_row(self, row: int, equality: bool) -> int:
         """Make cone row `row` (0..2k-1: S - mu R <= 0 for the k frictional contacts, then
         -S - mu R <= 0) an equality (S = +-mu R: u = 0 or v = 0) or restore it; returns the

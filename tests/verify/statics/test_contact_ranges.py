@@ -125,3 +125,24 @@ def test_dual_bound_certifies_the_optimum_and_refuses_a_cost_it_does_not_bound(n
                 f = np.zeros(prob.n)
                 f[b] = -1.0
                 assert not lp.certified(f, lam), (a, b)
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.5])
+def test_unbounded_ends_are_proved_by_a_checked_ray(mu):
+    """Three disks in a pyramid between walls 4 apart (test_forceset's case 3): the bottom
+    pair's contact and the walls can pinch with any force, so max R is +inf there; each such
+    end comes with HiGHS's primal ray, checked (ForceLP.ray_checked), and the same ray read
+    against the opposite cost (which it increases) is refused."""
+    x = [[1.0, 1.0], [3.0, 1.0], [2.0, 1.0 + np.sqrt(3.0)]]
+    lat = models.make_packing(x, np.ones(3), m=np.ones(3), left=0.0, right=4.0)
+    system = models.System(lat, mu_pp=mu, mu_plane=mu, mu_wall=mu)
+    fs = analyse(system)
+    assert fs.exists and fs.unchecked == 0
+    assert np.isinf(fs.hi[: fs.c]).sum() == 3  # the pair and the two walls
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    for a in np.flatnonzero(np.isinf(fs.hi[: fs.c])):
+        e = np.zeros(prob.n)
+        e[a] = -1.0
+        assert lp.solve(e)[0] == "unbounded"
+        assert lp.ray_checked(e) and not lp.ray_checked(-e), a
