@@ -1,16 +1,17 @@
 """The range [min, max] of every R and S over P and the contacts that can slide (the LPs of
 verify.statics.forceset's `analyse`), in this process or split over worker processes.
 
-Each end is the optimum of a range LP (ForceLP: primal simplex, warm-started from the previous
-optimum) checked to lie in P and certified by its row duals (weak duality, `ForceLP.certified`;
-an infinite end by HiGHS's primal ray, `ForceLP.ray_checked`; an end failing its check is
-counted in `unchecked`), or a bound that holds on all of P and is attained at a checked point
-of P, so needs no LP: min R = 0 (R >= 0) when some checked point has R = 0, and
-max S = mu max R (S <= mu R) or min S = -mu max R when one has S = +-mu max R. Witness values
-are within 1e-9 of the force scale of the bound, as LP optima are.
+Each end is the optimum of a range LP (DualForceLP: dual simplex on its dual, warm-started from
+the previous optimum) checked to lie in P and certified by the dual's optimum y (weak duality,
+`DualForceLP.certified`; an infinite end by HiGHS's primal ray of ForceLP,
+`ForceLP.ray_checked`; an end failing its check is counted in `unchecked`), or a bound that
+holds on all of P and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0)
+when some checked point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when
+one has S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP
+optima are.
 
 With jobs > 1 the contacts are cut into chunks solved by `jobs` worker processes, each holding
-its own ForceLP of P warm from chunk to chunk; the witnesses found so far (by every worker)
+its own LPs of P warm from chunk to chunk; the witnesses found so far (by every worker)
 travel with each chunk, so the filtering above works across workers. The LPs are the same
 LPs with the same checks: the ends agree with jobs = 1 to the LPs' tolerance (tested).
 """
@@ -26,7 +27,7 @@ import numpy as np
 from rigidlcp import models
 
 from .hull import ZERO
-from .model import ForceLP, StaticProblem
+from .model import DualForceLP, ForceLP, StaticProblem
 
 
 @dataclass
@@ -86,10 +87,10 @@ def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
     return 2 * len(todo) + 2 * sum(1 for a in todo if prob.mu[a] > 0 and not implicit[a])
 
 
-def ranges_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], contacts,
+def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str], contacts,
               wit: Witnesses, step=None) -> tuple[np.ndarray, np.ndarray, int, int]:
     """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S), LPs solved,
-    optima that failed the check; wit is updated with every checked optimum. step(n): called
+    ends that failed their check; wit is updated with every checked optimum. step(n): called
     with the number of ends settled (by LP or filter) after each contact."""
     c, n, mu = prob.c, prob.n, prob.mu
     m = len(contacts)
@@ -199,7 +200,7 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
         return _in_workers(prob, implicit, wit, step, jobs)
     lp = lp or ForceLP(prob)
     every = np.arange(c)
-    lo, hi, lps, unchecked = ranges_of(prob, lp, implicit, every, wit, step)
+    lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step)
     sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
     return Ranges(lo, hi, sliding, lps + more, unchecked + bad)
 
@@ -212,12 +213,15 @@ def _start(system: models.System) -> None:
     prob = StaticProblem(system)
     lp = ForceLP(prob)
     lp.solve(np.zeros(prob.n))
-    _WORKER.update(prob=prob, lp=lp)
+    dual = DualForceLP(prob, lp)
+    dual.solve(np.zeros(prob.n))
+    _WORKER.update(prob=prob, lp=lp, dual=dual)
 
 
 def _range_chunk(task):
     implicit, contacts, wit = task
-    lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["lp"], implicit, contacts, wit)
+    lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["dual"], implicit, contacts,
+                                       wit)
     return contacts, lo, hi, lps, unchecked, wit
 
 

@@ -19,7 +19,7 @@ from rigidlcp import models
 from rigidlcp.models.deposition import deposit
 from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of, sliding_of
 from rigidlcp.verify.statics.forceset import analyse
-from rigidlcp.verify.statics.model import ForceLP, StaticProblem
+from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 
 
 def _unfiltered_ends(prob: StaticProblem) -> tuple[np.ndarray, np.ndarray]:
@@ -62,7 +62,10 @@ def test_chunks_with_merged_witnesses_give_the_unfiltered_ends(n, seed, mu, cuts
     c = prob.c
     bounds = sorted({0, c, *[x % (c + 1) for x in cuts]})
     chunks = [np.arange(a, b) for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
-    lps = [ForceLP(prob), ForceLP(prob)]  # two "workers", each warm from its own chunks
+    # two "workers", each warm from its own chunks: one solves the range LPs through their
+    # dual (DualForceLP, as the workers do), the other by ForceLP's primal simplex
+    primal = [ForceLP(prob), ForceLP(prob)]
+    lps = [DualForceLP(prob, primal[0]), primal[1]]
     for lp in lps:
         lp.solve(np.zeros(prob.n))
     wit = Witnesses.of(prob, fs.solution)
@@ -81,7 +84,7 @@ def test_chunks_with_merged_witnesses_give_the_unfiltered_ends(n, seed, mu, cuts
     _same(hi, want_hi, scale)
     # the sliding contacts, chunk by chunk, are those of the serial run
     serial = analyse(system)
-    runs = [sliding_of(prob, lps[x % 2], fs.implicit, hi[:c], wit.seen, ch)
+    runs = [sliding_of(prob, primal[x % 2], fs.implicit, hi[:c], wit.seen, ch)
             for x, ch in enumerate(chunks)]
     assert np.array_equal(np.concatenate([r[0] for r in runs]), serial.sliding)
     assert sum(r[2] for r in runs) == 0 and serial.unchecked == 0
@@ -102,16 +105,19 @@ def test_two_worker_processes_give_the_serial_ranges(n, seed, mu):
 
 
 @settings(max_examples=6)
-@given(n=st.integers(3, 12), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.0))
-def test_dual_bound_certifies_the_optimum_and_refuses_a_cost_it_does_not_bound(n, seed, mu):
-    """ForceLP.certified: the row duals of max R_a certify R_a <= max on P (weak duality);
-    read against the cost -e_b of another contact whose R_b exceeds its value at that optimum
-    somewhere in P (an unfiltered LP finds it), they must not, or R_b would be bounded by it."""
+@given(n=st.integers(3, 12), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.0),
+       through_dual=st.booleans())
+def test_dual_bound_certifies_the_optimum_and_refuses_a_cost_it_does_not_bound(n, seed, mu,
+                                                                              through_dual):
+    """ForceLP.certified (row duals) and DualForceLP.certified (the dual LP's optimum): the y
+    of max R_a certifies R_a <= max on P (weak duality); read against the cost -e_b of another
+    contact whose R_b exceeds its value at that optimum somewhere in P (an unfiltered LP finds
+    it), it must not, or R_b would be bounded by it."""
     system = _pile(n, seed, mu)
     if not analyse(system, ranges=False).exists:
         return
     prob = StaticProblem(system)
-    lp = ForceLP(prob)
+    lp = DualForceLP(prob, ForceLP(prob)) if through_dual else ForceLP(prob)
     _, want_hi = _unfiltered_ends(prob)
     for a in range(prob.c):
         e = np.zeros(prob.n)
@@ -140,9 +146,11 @@ def test_unbounded_ends_are_proved_by_a_checked_ray(mu):
     assert fs.exists and fs.unchecked == 0
     assert np.isinf(fs.hi[: fs.c]).sum() == 3  # the pair and the two walls
     prob = StaticProblem(system)
-    lp = ForceLP(prob)
-    for a in np.flatnonzero(np.isinf(fs.hi[: fs.c])):
-        e = np.zeros(prob.n)
-        e[a] = -1.0
-        assert lp.solve(e)[0] == "unbounded"
-        assert lp.ray_checked(e) and not lp.ray_checked(-e), a
+    for lp in (ForceLP(prob), DualForceLP(prob, ForceLP(prob))):
+        for a in np.flatnonzero(np.isinf(fs.hi[: fs.c])):
+            e = np.zeros(prob.n)
+            e[a] = -1.0
+            assert lp.solve(e)[0] == "unbounded"
+            assert lp.ray_checked(e), a
+            if isinstance(lp, ForceLP):
+                assert not lp.ray_checked(-e), a
