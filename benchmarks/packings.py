@@ -9,9 +9,9 @@ deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, def
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
 ranges N: the whole analysis: also the range of every R and S and the sliding contacts, the
 range LPs in --jobs worker processes (verify.statics.contact_ranges).
-sample N:K: the ranges of K contacts spread evenly over an N-disk pile (one warm ForceLP, in
-this process), and the whole pile's range LPs extrapolated from them (c / K times the time):
-an estimate where the whole run takes too long.
+sample N:K: the ranges of K contacts spread evenly over an N-disk pile (one warm DualForceLP
+as in `analyse`, in this process), and the whole pile's range LPs extrapolated from them
+(c / K times the time): an estimate where the whole run takes too long.
 Wall-clock seconds and CPU seconds (process time, worker processes included) of one run each.
 """
 
@@ -27,7 +27,7 @@ from rigidlcp import models
 from rigidlcp.models.deposition import deposit
 from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of
 from rigidlcp.verify.statics.forceset import analyse
-from rigidlcp.verify.statics.model import ForceLP, StaticProblem
+from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 
 
 def _sizes(text: str) -> list[int]:
@@ -52,7 +52,7 @@ def _sample(system: models.System, k: int) -> tuple[str, float, float]:
     if not fs.exists:
         return f"no equilibrium ({fs.exists})", 0.0, 0.0
     prob = StaticProblem(system)
-    lp = ForceLP(prob)
+    lp = DualForceLP(prob, ForceLP(prob))
     lp.solve(np.zeros(prob.n))
     picks = np.unique(np.linspace(0, prob.c - 1, k).round().astype(int))
     wit = Witnesses.of(prob, fs.solution)
