@@ -154,3 +154,25 @@ def test_unbounded_ends_are_proved_by_a_checked_ray(mu):
             assert lp.ray_checked(e), a
             if isinstance(lp, ForceLP):
                 assert not lp.ray_checked(-e), a
+
+
+@settings(max_examples=10)
+@given(n=st.integers(3, 20), seed=st.integers(0, 10**4), mu=st.floats(0.05, 1.2))
+def test_analyse_gives_the_ranges_of_the_primal_simplex_loop(n, seed, mu):
+    """main's range LPs (ForceLP's primal simplex, one warm LP, the same filters), computed
+    here, against analyse's (through the dual): the same ends to the LPs' tolerance, nothing
+    unchecked."""
+    system = _pile(n, seed, mu)
+    fs = analyse(system)
+    if not fs.exists:
+        return
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    every = np.arange(prob.c)
+    # over every contact in order, ranges_of's [R; S] layout is P's
+    want_lo, want_hi, _, unchecked = ranges_of(prob, lp, fs.implicit, every,
+                                               Witnesses.of(prob, fs.solution))
+    scale = max(1.0, float(np.max(np.abs(want_hi[np.isfinite(want_hi)]), initial=0.0)))
+    assert unchecked == 0 and fs.unchecked == 0
+    _same(fs.lo, want_lo, scale)
+    _same(fs.hi, want_hi, scale)
