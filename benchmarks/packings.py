@@ -2,32 +2,66 @@
 test; it prints a markdown table).
 
     python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
-                                  [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
+                                  [--mu 0.5] [--seed 1] [--radii 0.8:1.2] [--jobs 1]
+                                  [--sample 1000:64]
 
 deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
-ranges N: the whole analysis: also the range of every R and S and the sliding contacts.
-Wall-clock seconds and CPU seconds (process time) of one run each.
+ranges N: the whole analysis: also the range of every R and S and the sliding contacts, the
+range LPs in --jobs worker processes (verify.statics.contact_ranges).
+sample N:K: the ranges of K contacts spread evenly over an N-disk pile (one warm DualForceLP
+as in `analyse`, in this process), and the whole pile's range LPs extrapolated from them
+(c / K times the time): an estimate where the whole run takes too long.
+Wall-clock seconds and CPU seconds (process time, worker processes included) of one run each.
 """
 
 from __future__ import annotations
 
 import argparse
+import resource
 import time
+
+import numpy as np
 
 from rigidlcp import models
 from rigidlcp.models.deposition import deposit
+from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of
 from rigidlcp.verify.statics.forceset import analyse
+from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 
 
 def _sizes(text: str) -> list[int]:
     return [int(v) for v in text.split(",") if v]
 
 
+def _cpu() -> float:
+    """CPU seconds of this process and of its finished children (the range workers)."""
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + kids.ru_utime + kids.ru_stime
+
+
 def _timed(fn):
-    t, c = time.perf_counter(), time.process_time()
+    t, c = time.perf_counter(), _cpu()
     out = fn()
-    return out, time.perf_counter() - t, time.process_time() - c
+    return out, time.perf_counter() - t, _cpu() - c
+
+
+def _sample(system: models.System, k: int) -> tuple[str, float, float]:
+    """The ranges of k contacts spread over the pile, and the whole pile's extrapolated."""
+    fs = analyse(system, ranges=False)
+    if not fs.exists:
+        return f"no equilibrium ({fs.exists})", 0.0, 0.0
+    prob = StaticProblem(system)
+    lp = DualForceLP(prob, ForceLP(prob))
+    lp.solve(np.zeros(prob.n))
+    picks = np.unique(np.linspace(0, prob.c - 1, k).round().astype(int))
+    wit = Witnesses.of(prob, fs.solution)
+    (_, _, lps, unchecked), wall, cpu = _timed(
+        lambda: ranges_of(prob, lp, fs.implicit, picks, wit))
+    f = prob.c / picks.size
+    return (f"{picks.size} of {prob.c} contacts: {lps} LPs ({unchecked} unchecked), "
+            f"{cpu / max(lps, 1):.3f} CPU s per LP; whole pile ~{lps * f:.0f} LPs, "
+            f"~{cpu * f:.1f} CPU s"), wall, cpu
 
 
 def main() -> int:
@@ -38,13 +72,18 @@ def main() -> int:
     ap.add_argument("--mu", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--radii", default="0.8:1.2")
+    ap.add_argument("--jobs", type=int, default=1, help="worker processes of the range LPs")
+    ap.add_argument("--sample", default="", help="N:K (see above)")
     args = ap.parse_args()
     radii = tuple(float(v) for v in args.radii.split(":"))
-    print(f"radii {radii[0]}:{radii[1]}, seed {args.seed}, mu = {args.mu} on every contact\n")
+    print(f"radii {radii[0]}:{radii[1]}, seed {args.seed}, mu = {args.mu} on every contact, "
+          f"range LPs in {args.jobs} process(es)\n")
+    sample = tuple(int(v) for v in args.sample.split(":")) if args.sample else None
     print("| task | disks | contacts | result | wall s | CPU s |")
     print("|---|---|---|---|---|---|")
     piles = {}
-    for n in sorted(set(args.deposit) | set(args.statics) | set(args.ranges)):
+    extra = {sample[0]} if sample else set()
+    for n in sorted(set(args.deposit) | set(args.statics) | set(args.ranges) | extra):
         pile, wall, cpu = _timed(lambda n=n: deposit(n, seed=args.seed, radii=radii))
         piles[n] = pile
         if n in args.deposit:
@@ -54,7 +93,8 @@ def main() -> int:
         for n in sizes:
             pile = piles[n]
             system = models.System(pile, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
-            fs, wall, cpu = _timed(lambda s=system, f=full: analyse(s, ranges=f))
+            fs, wall, cpu = _timed(lambda s=system, f=full: analyse(s, ranges=f,
+                                                                    jobs=args.jobs))
             result = (f"exists, dim {fs.dimension}" if fs.exists else
                       f"undecided ({fs.undecided})" if fs.exists is None else
                       "no equilibrium (Farkas, exact)" if fs.exact else
@@ -63,6 +103,12 @@ def main() -> int:
                 result += f", {fs.lps} LPs, {int(fs.sliding.sum())} can slide"
             print(f"| {task} | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |",
                   flush=True)
+    if sample:
+        n, k = sample
+        pile = piles[n]
+        system = models.System(pile, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
+        result, wall, cpu = _sample(system, k)
+        print(f"| ranges, sample | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |")
     return 0
 
 

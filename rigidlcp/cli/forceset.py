@@ -33,6 +33,9 @@ def register(sub) -> None:
                    help="relative gap tolerance of contact detection (default 1e-9)")
     p.add_argument("--no-ranges", action="store_true",
                    help="existence and dimension only (no range LPs)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="worker processes for the range LPs (default 1: in this process; "
+                   "each worker holds its own LP, so N workers use N cores)")
     p.add_argument("--samples", type=int, default=0, metavar="N",
                    help="also draw N uniform samples of the admissible forces (force-network "
                    "ensemble; hopsy if installed, else hit-and-run) and write samples.npz and "
@@ -72,6 +75,8 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         raise Overlap(f"{exc}; --gap-tol G accepts overlaps up to G x radius", exc.i, exc.j,
                       exc.overlap) from None
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
+    if args.jobs < 1:
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
     if args.samples and not args.out:
@@ -106,7 +111,8 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         bars[0].n = done
         bars[0].refresh()
 
-    fs = analyse(system, ranges=not args.no_ranges, progress=progress if show else None)
+    fs = analyse(system, ranges=not args.no_ranges, progress=progress if show else None,
+                 jobs=args.jobs)
     for bar in bars:
         bar.close()
     ens = None

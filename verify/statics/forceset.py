@@ -18,7 +18,9 @@
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
-  every optimum checked to lie in P.
+  every optimum checked to lie in P and its value certified by the LP's duals
+  (verify.statics.contact_ranges; in `jobs` worker processes when jobs > 1); an optimum
+  failing either check is counted ("unchecked_optima" in the JSON).
 * sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (a checked
   optimum of a range LP at the bound is a witness; else an LP with
   that cone row made an equality), and their count against McNamara & Herrmann's 2M - 3N
@@ -35,8 +37,9 @@ import numpy as np
 
 from rigidlcp import models
 
+from .contact_ranges import contact_ranges
 from .farkas import farkas
-from .hull import ZERO, dimension, implicit_equalities
+from .hull import dimension, implicit_equalities
 from .model import ForceLP, StaticProblem, interior_point
 
 
@@ -56,7 +59,7 @@ class ForceSet:
     lo: np.ndarray | None = None
     hi: np.ndarray | None = None
     sliding: np.ndarray | None = None
-    unchecked: int = 0  # LP optima that failed the check against P (none expected)
+    unchecked: int = 0  # LP optima failing the check against P or of their duals (none seen)
     residuals: tuple[float, float] = (0.0, 0.0)  # of `solution`: balance, laws (force units)
     lps: int = 0
     exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
@@ -125,9 +128,11 @@ class ForceSet:
         return out
 
 
-def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceSet:
+def analyse(system: models.System, ranges: bool = True, progress=None,
+            jobs: int = 1) -> ForceSet:
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
-    progress(done, total, stage): called as the LPs of the ranges are solved."""
+    progress(done, total, stage): called as the LPs of the ranges are solved; jobs: worker
+    processes for the range LPs (verify.statics.contact_ranges; 1: in this process)."""
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
     # the IPM is fast, and its point a relative-interior witness; when it finds no point in
@@ -163,107 +168,8 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     fs.implicit = implicit_equalities(prob, lam if interior else None)
     fs.dimension, fs.rank_gap = dimension(prob, fs.implicit)
     if ranges:
-        _ranges(prob, lp or ForceLP(prob), fs, progress)
+        r = contact_ranges(prob, lp, fs.implicit, witness, progress, jobs)
+        fs.lo, fs.hi, fs.sliding = r.lo, r.hi, r.sliding
+        fs.lps += r.lps
+        fs.unchecked += r.unchecked
     return fs
-
-
-def _ranges(prob: StaticProblem, lp: ForceLP, fs: ForceSet, progress) -> None:
-    """The ranges, with LPs skipped where a checked point of P already attains a bound that
-    holds on all of P: min R = 0 (R >= 0) when some checked optimum has R = 0, and
-    max S = mu max R (S <= mu R) or min S = -mu max R when one has S = +-mu max R. Witness
-    values are within 1e-9 of the force scale of the bound, as LP optima are."""
-    c, n, mu = prob.c, prob.n, prob.mu
-    lo, hi = np.zeros(n), np.zeros(n)
-    seen = np.zeros(c, dtype=bool)  # contacts found at |S| = mu R, R > 0 at some optimum
-    r_min = fs.solution[:c].copy()  # smallest R, largest and smallest S at checked points
-    s_max, s_min = fs.solution[c:].copy(), fs.solution[c:].copy()
-    todo = [a for a in range(c) if fs.implicit[a] != "R=0"]
-    total = len(todo) * 2 + sum(1 for a in todo if mu[a] > 0 and not fs.implicit[a]) * 2
-    done = 0
-
-    def tol(lam: np.ndarray | None = None) -> float:
-        big = float(np.max(np.abs(lam), initial=0.0)) if lam is not None else 0.0
-        return 1e-9 * max(prob.scale, big)
-
-    def bound(k: int, sgn: float) -> float:
-        nonlocal done
-        e = np.zeros(n)
-        e[k] = sgn
-        status, lam = lp.solve(e)
-        fs.lps += 1
-        done += 1
-        if status == "unbounded":
-            return -sgn * np.inf
-        if status != "optimal":
-            raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
-        ok = prob.admissible(lam)
-        fs.unchecked += not ok
-        if ok:
-            seen[:] |= _at_bound(prob, lam)
-            np.minimum(r_min, lam[:c], out=r_min)
-            np.maximum(s_max, lam[c:], out=s_max)
-            np.minimum(s_min, lam[c:], out=s_min)
-        return float(lam[k])
-
-    for a in todo:
-        hi[a] = bound(a, -1.0)
-        if r_min[a] <= ZERO * prob.scale:  # R = 0 attained: min R = 0
-            lo[a] = max(float(r_min[a]), 0.0)
-            done += 1
-        else:
-            lo[a] = bound(a, 1.0)
-        kind = fs.implicit[a]
-        if mu[a] > 0 and kind:  # S = +- mu R on all of P
-            sg = mu[a] if kind == "S=+muR" else -mu[a]
-            lo[c + a], hi[c + a] = sorted((sg * lo[a], sg * hi[a]))
-        elif mu[a] > 0:
-            top = mu[a] * hi[a]
-            if np.isfinite(top) and s_max[a] >= top - tol():
-                hi[c + a] = min(float(s_max[a]), top)
-                done += 1
-            else:
-                hi[c + a] = bound(c + a, -1.0)
-            if np.isfinite(top) and s_min[a] <= -top + tol():
-                lo[c + a] = max(float(s_min[a]), -top)
-                done += 1
-            else:
-                lo[c + a] = bound(c + a, 1.0)
-        if progress:
-            progress(done, total, "ranges")
-    fs.lo, fs.hi = lo, hi
-    fs.sliding = _sliding(prob, lp, fs, seen)
-
-
-def _at_bound(prob: StaticProblem, lam: np.ndarray) -> np.ndarray:
-    """Contacts at the Coulomb bound with R > 0 at a checked point of P (|S| >= mu R up to
-    1e-9 of the force scale, R > ZERO x scale): witnesses that they can slide."""
-    c, mu = prob.c, prob.mu
-    R, S = lam[:c], lam[c:]
-    tol = 1e-9 * max(prob.scale, float(np.max(np.abs(lam), initial=0.0)))
-    return (mu > 0) & (R > ZERO * prob.scale) & (np.abs(S) >= mu * R - tol)
-
-
-def _sliding(prob: StaticProblem, lp: ForceLP, fs: ForceSet,
-             seen: np.ndarray | None = None) -> np.ndarray:
-    """Whether S = +-mu R with R > 0 is attainable at each contact (module docstring);
-    seen: contacts already found at the bound at a checked optimum (no LP needed)."""
-    c, k = prob.c, prob.fric.size
-    out = np.zeros(c, dtype=bool) if seen is None else seen.copy()
-    for n, a in enumerate(prob.fric):
-        kind = fs.implicit[a]
-        if kind == "R=0" or out[a]:
-            continue
-        if kind:
-            out[a] = fs.hi[a] > ZERO * prob.scale
-            continue
-        for row in (n, k + n):
-            lp.set_cone_row(row, True)
-            e = np.zeros(prob.n)
-            e[a] = -1.0
-            status, lam = lp.solve(e)
-            fs.lps += 1
-            lp.set_cone_row(row, False)
-            if status == "unbounded" or (status == "optimal" and lam[a] > ZERO * prob.scale):
-                out[a] = True
-                break
-    return out

@@ -1,0 +1,275 @@
+"""The range [min, max] of every R and S over P and the contacts that can slide (the LPs of
+verify.statics.forceset's `analyse`), in this process or split over worker processes.
+
+Each end is the optimum of a range LP (DualForceLP: dual simplex on its dual, warm-started from
+the previous optimum) checked to lie in P and certified by the dual's optimum y (weak duality,
+`DualForceLP.certified`; an infinite end by HiGHS's primal ray of ForceLP,
+`ForceLP.ray_checked`; an end failing its check is counted in `unchecked`), or a bound that
+holds on all of P and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0)
+when some checked point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when
+one has S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP
+optima are.
+
+With jobs > 1 the contacts are cut into chunks solved by `jobs` worker processes, each holding
+its own LPs of P warm from chunk to chunk; the witnesses found so far (by every worker)
+travel with each chunk, so the filtering above works across workers. The LPs are the same
+LPs with the same checks: the ends agree with jobs = 1 to the LPs' tolerance (tested).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+
+import numpy as np
+
+from rigidlcp import models
+
+from .hull import ZERO
+from .model import DualForceLP, ForceLP, StaticProblem
+
+
+@dataclass
+class Witnesses:
+    """Per contact, over the checked points of P met so far: the smallest R (r_min), the
+    largest and smallest S (s_max, s_min), and whether |S| = mu R with R > 0 (seen)."""
+
+    r_min: np.ndarray
+    s_max: np.ndarray
+    s_min: np.ndarray
+    seen: np.ndarray
+
+    @classmethod
+    def of(cls, prob: StaticProblem, lam: np.ndarray) -> Witnesses:
+        c = prob.c
+        return cls(lam[:c].copy(), lam[c:].copy(), lam[c:].copy(), at_bound(prob, lam))
+
+    def add(self, prob: StaticProblem, lam: np.ndarray) -> None:
+        c = prob.c
+        self.seen |= at_bound(prob, lam)
+        np.minimum(self.r_min, lam[:c], out=self.r_min)
+        np.maximum(self.s_max, lam[c:], out=self.s_max)
+        np.minimum(self.s_min, lam[c:], out=self.s_min)
+
+    def merge(self, other: Witnesses) -> None:
+        """Each entry is attained at some checked point, so the best of two is too."""
+        self.seen |= other.seen
+        np.minimum(self.r_min, other.r_min, out=self.r_min)
+        np.maximum(self.s_max, other.s_max, out=self.s_max)
+        np.minimum(self.s_min, other.s_min, out=self.s_min)
+
+
+@dataclass
+class Ranges:
+    """lo, hi: (2c,) ranges of [R; S] (+-inf unbounded); sliding (c,); lps solved; unchecked:
+    LP optima that failed the check against P or of their dual bound (none expected)."""
+
+    lo: np.ndarray
+    hi: np.ndarray
+    sliding: np.ndarray
+    lps: int = 0
+    unchecked: int = 0
+
+
+def at_bound(prob: StaticProblem, lam: np.ndarray) -> np.ndarray:
+    """Contacts at the Coulomb bound with R > 0 at a checked point of P (|S| >= mu R up to
+    1e-9 of the force scale, R > ZERO x scale): witnesses that they can slide."""
+    c, mu = prob.c, prob.mu
+    R, S = lam[:c], lam[c:]
+    tol = 1e-9 * max(prob.scale, float(np.max(np.abs(lam), initial=0.0)))
+    return (mu > 0) & (R > ZERO * prob.scale) & (np.abs(S) >= mu * R - tol)
+
+
+def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
+    """The most range LPs `contact_ranges` may need (the progress total)."""
+    todo = [a for a in range(prob.c) if implicit[a] != "R=0"]
+    return 2 * len(todo) + 2 * sum(1 for a in todo if prob.mu[a] > 0 and not implicit[a])
+
+
+def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str], contacts,
+              wit: Witnesses, step=None) -> tuple[np.ndarray, np.ndarray, int, int]:
+    """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S), LPs solved,
+    ends that failed their check; wit is updated with every checked optimum. step(n): called
+    with the number of ends settled (by LP or filter) after each contact."""
+    c, n, mu = prob.c, prob.n, prob.mu
+    m = len(contacts)
+    lo, hi = np.zeros(2 * m), np.zeros(2 * m)
+    lps = unchecked = 0
+
+    def bound(k: int, sgn: float) -> float:
+        nonlocal lps, unchecked
+        e = np.zeros(n)
+        e[k] = sgn
+        status, lam = lp.solve(e)
+        lps += 1
+        if status == "unbounded":
+            unchecked += not lp.ray_checked(e)
+            return -sgn * np.inf
+        if status != "optimal":
+            raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
+        ok = prob.admissible(lam) and lp.certified(e, lam)
+        unchecked += not ok
+        if ok:
+            wit.add(prob, lam)
+        return float(lam[k])
+
+    def tol() -> float:
+        return 1e-9 * prob.scale
+
+    for x, a in enumerate(contacts):
+        kind, ends = implicit[a], 0
+        if kind == "R=0":  # R = S = 0 on all of P
+            if step:
+                step(0)
+            continue
+        hi[x] = bound(a, -1.0)
+        lo[x] = max(float(wit.r_min[a]), 0.0) if wit.r_min[a] <= ZERO * prob.scale else \
+            bound(a, 1.0)  # R = 0 attained: min R = 0
+        ends += 2
+        if mu[a] > 0 and kind:  # S = +- mu R on all of P
+            sg = mu[a] if kind == "S=+muR" else -mu[a]
+            lo[m + x], hi[m + x] = sorted((sg * lo[x], sg * hi[x]))
+        elif mu[a] > 0:
+            top = mu[a] * hi[x]
+            hi[m + x] = (min(float(wit.s_max[a]), top)
+                         if np.isfinite(top) and wit.s_max[a] >= top - tol()
+                         else bound(c + a, -1.0))
+            lo[m + x] = (max(float(wit.s_min[a]), -top)
+                         if np.isfinite(top) and wit.s_min[a] <= -top + tol()
+                         else bound(c + a, 1.0))
+            ends += 2
+        if step:
+            step(ends)
+    return lo, hi, lps, unchecked
+
+
+def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.ndarray,
+               seen: np.ndarray, contacts) -> tuple[np.ndarray, int]:
+    """Whether S = +-mu R with R > 0 is attainable at each of `contacts` (forceset's
+    docstring), the LPs solved and their optima that failed a check (in P, and certified by
+    their duals on the face: a "no" rests on that bound); hi_R: (c,) max R; seen: (c,)
+    contacts already found at the bound at a checked optimum (no LP needed)."""
+    k = prob.fric.size
+    row_of = {int(a): n for n, a in enumerate(prob.fric)}
+    out = np.array([bool(seen[a]) for a in contacts], dtype=bool)
+    lps = unchecked = 0
+    for x, a in enumerate(contacts):
+        kind = implicit[a]
+        if prob.mu[a] <= 0 or kind == "R=0" or out[x]:
+            continue
+        if kind:
+            out[x] = hi_R[a] > ZERO * prob.scale
+            continue
+        n = row_of[int(a)]
+        for row in (n, k + n):
+            col = lp.set_cone_row(row, True)
+            e = np.zeros(prob.n)
+            e[a] = -1.0
+            status, lam = lp.solve(e)
+            lps += 1
+            if status == "optimal":
+                unchecked += not (prob.admissible(lam) and lp.certified(e, lam, fixed=(col,)))
+            elif status == "unbounded":
+                unchecked += not lp.ray_checked(e, fixed=(col,))
+            lp.set_cone_row(row, False)
+            if status == "unbounded" or (status == "optimal" and lam[a] > ZERO * prob.scale):
+                out[x] = True
+                break
+    return out, lps, unchecked
+
+
+def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
+                   witness: np.ndarray, progress=None, jobs: int = 1) -> Ranges:
+    """The ranges of every R and S and the sliding contacts (module docstring). witness: a
+    checked point of P; lp: a ForceLP of P (built here if None; unused when jobs > 1);
+    progress(done, total, "ranges") as the ends are settled."""
+    if jobs < 1:
+        raise ValueError(f"jobs must be >= 1, got {jobs}")
+    c = prob.c
+    total, done = lp_count(prob, implicit), 0
+
+    def step(ends: int) -> None:
+        nonlocal done
+        done += ends
+        if progress:
+            progress(done, total, "ranges")
+
+    wit = Witnesses.of(prob, witness)
+    if jobs > 1 and c > 1:
+        return _in_workers(prob, implicit, wit, step, jobs)
+    lp = lp or ForceLP(prob)
+    every = np.arange(c)
+    lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step)
+    sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
+    return Ranges(lo, hi, sliding, lps + more, unchecked + bad)
+
+
+_WORKER: dict = {}
+
+
+def _start(system: models.System) -> None:
+    """A worker's P and its ForceLP, solved once so that every chunk starts warm."""
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    lp.solve(np.zeros(prob.n))
+    dual = DualForceLP(prob, lp)
+    dual.solve(np.zeros(prob.n))
+    _WORKER.update(prob=prob, lp=lp, dual=dual)
+
+
+def _range_chunk(task):
+    implicit, contacts, wit = task
+    lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["dual"], implicit, contacts,
+                                       wit)
+    return contacts, lo, hi, lps, unchecked, wit
+
+
+def _sliding_chunk(task):
+    implicit, contacts, hi_R, seen = task
+    return contacts, *sliding_of(_WORKER["prob"], _WORKER["lp"], implicit, hi_R, seen,
+                                 contacts)
+
+
+def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
+                jobs: int) -> Ranges:
+    c = prob.c
+    lo, hi = np.zeros(prob.n), np.zeros(prob.n)
+    sliding = np.zeros(c, dtype=bool)
+    out = Ranges(lo, hi, sliding)
+    size = max(1, min(64, c // (8 * jobs)))  # small chunks: balance, and fresh witnesses
+    chunks = [np.arange(s, min(s + size, c)) for s in range(0, c, size)]
+    # spawn: fresh interpreters, no inherited threads or locks (HiGHS, BLAS) from this one
+    with ProcessPoolExecutor(max_workers=min(jobs, len(chunks)), initializer=_start,
+                             initargs=(prob.system,),
+                             mp_context=multiprocessing.get_context("spawn")) as pool:
+
+        def run(fn, make, merge) -> None:
+            queue, pending = list(chunks), set()
+            while queue or pending:
+                while queue and len(pending) < 2 * jobs:
+                    pending.add(pool.submit(fn, make(queue.pop(0))))
+                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                for fut in finished:
+                    merge(fut.result())
+
+        def merge_ranges(res) -> None:
+            contacts, lo_x, hi_x, lps, unchecked, w = res
+            m = len(contacts)
+            lo[contacts], hi[contacts] = lo_x[:m], hi_x[:m]
+            lo[c + contacts], hi[c + contacts] = lo_x[m:], hi_x[m:]
+            out.lps += lps
+            out.unchecked += unchecked
+            wit.merge(w)
+            step(int(sum(2 + 2 * (prob.mu[a] > 0 and not implicit[a])
+                         for a in contacts if implicit[a] != "R=0")))
+
+        def merge_sliding(res) -> None:
+            contacts, s, lps, unchecked = res
+            sliding[contacts] = s
+            out.lps += lps
+            out.unchecked += unchecked
+
+        run(_range_chunk, lambda ch: (implicit, ch, wit), merge_ranges)
+        run(_sliding_chunk, lambda ch: (implicit, ch, hi[:c], wit.seen), merge_sliding)
+    return out
