@@ -33,7 +33,9 @@ sum_i ra_i^2 / D_i (= gamma F_g >= ... on the paper's systems). It enters each L
 columns z_i >= tangents of ra_i^2 / D_i at ra = -+M*, -+M*/2 (ra^2 >= 2 t ra - t^2), 0 <= z_i
 <= M*^2 / D_i (the rotation cap), and the row -u_obs' . lambda >= sum_i z_i: every valid
 steady state with z_i = ra_i^2 / D_i satisfies them. A disk at a cap state has z_i = M*^2 / D_i
-exactly.
+exactly. In a case where a contact's a_t is a constant a_beta != 0 (its disks at cap points, or
+a one-disk contact whose disk is at one), its term -S_beta a_beta >= 0 is linear and is kept:
+the row is -u_obs' . lambda + sum_const S_beta a_beta >= sum_i z_i (`power_row`).
 
 Each case is one linear program: the relaxation P of verify.ranges.bounds (a_n = 0, no
 translation, R >= 0, |S| <= mu R, S = 0 where mu = 0) over the proved force box (valid for
@@ -147,7 +149,8 @@ class _Cases:
         self.ub = np.r_[form.ub[:2 * c], M * M / D]
         nomu = np.flatnonzero(mu == 0)
         self.lb[c + nomu] = self.ub[c + nomu] = 0.0
-        self.A = sp.csr_matrix(A)
+        self.Ad, self.A = A, sp.csr_matrix(A)
+        self.r_pw, self.pw = self.r_a + F, pw
         self.lo0, self.hi0 = lo, hi
         self.cost = np.r_[np.asarray(cost, float), np.zeros(p)]
         self.mu = mu[fr]
@@ -187,6 +190,17 @@ class _Cases:
                 out[k] = 0
         return out
 
+    def power_row(self, disks: np.ndarray) -> np.ndarray:
+        """The power cut's row in the case: -u_obs' . lambda - sum z + sum S_beta a_beta over
+        the contacts whose a_t is a constant a_beta != 0 there (both disks at a cap point, or
+        a one-disk contact at one): the terms -S a >= 0 kept exactly where they are linear."""
+        row = self.pw.copy()
+        for k in range(self.fric.size):
+            lo, hi, _, _ = self.interval(disks, k)
+            if lo == hi and abs(lo) > 1e-12:
+                row[self.c + self.fric[k]] += lo * self.M
+        return row
+
     def bounds(self, disks: np.ndarray, contacts: dict[int, int]
                ) -> tuple[np.ndarray, np.ndarray]:
         """The row bounds (lo, hi) of the case's LP."""
@@ -214,6 +228,13 @@ class _Cases:
         """(certified lower bound, LP point) of the case."""
         lo, hi = self.bounds(disks, contacts)
         h = self.h
+        row = self.power_row(disks)
+        for j in np.flatnonzero(row != self.Ad[self.r_pw]):
+            h.changeCoeff(self.r_pw, int(j), float(row[j]))
+        if np.any(row != self.Ad[self.r_pw]):
+            self.Ad = self.Ad.copy()
+            self.Ad[self.r_pw] = row
+            self.A = sp.csr_matrix(self.Ad)
         for i in np.flatnonzero((lo != self.cur_lo) | (hi != self.cur_hi)):
             h.changeRowBounds(int(i), float(lo[i]), float(hi[i]))
         self.cur_lo, self.cur_hi = lo, hi

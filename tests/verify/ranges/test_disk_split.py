@@ -57,6 +57,7 @@ def test_case_facts_hold_on_valid_steady_states(lattice, gamma):
     assert wits
     r = system.lattice.radius
     I = 1.0 / dyn.Minv[2 * p:]
+    kept = 0.0
     for w in wits:
         lam = np.concatenate([w.R, w.S])
         scale = max(1.0, float(np.max(np.abs(lam))))
@@ -80,10 +81,19 @@ def test_case_facts_hold_on_valid_steady_states(lattice, gamma):
                                                 abs=1e-8 * scale)
         lo, hi = cases.bounds(disks, {})
         z = ra ** 2 / (r * r * dyn.Minv[2 * p:])
-        row = cases.A @ np.concatenate([lam, z])
+        xz = np.concatenate([lam, z])
+        row = cases.A @ xz
+        row[cases.r_pw] = cases.power_row(disks) @ xz  # the case's own power cut
+        # ... which keeps exactly the terms -S a of the contacts with a constant a_t != 0
+        const = np.array([(lambda iv: iv[0] == iv[1] and iv[0] != 0)(cases.interval(disks, k))
+                          for k in range(fr.size)])
+        rest = -float(np.dot(w.S[fr[~const]], a[c + fr[~const]]))
+        assert row[cases.r_pw] == pytest.approx(rest, abs=1e-12 * scale)
+        kept += float(np.sum(np.abs(w.S[fr[const]] * a[c + fr[const]])))
         tol = 1e-8 * scale
         assert np.all(row >= lo - tol) and np.all(row <= hi + tol)
         assert np.all(z <= cases.ub[2 * c:] + 1e-15)
+    assert kept > 0  # some witness has a sliding contact of constant a_t in its case
 
 
 @pytest.mark.parametrize("lattice, gamma", SYSTEMS)
