@@ -29,9 +29,10 @@ nu'^T (H^T lambda + f) = (a - u_obs') . lambda gives, as a_n = 0,
     sum_i ra_i^2 / D_i = sum_i I_i alpha_i^2 = S . a_t - u_obs' . lambda     (D_i = r^2 / I_i),
 
 and S . a_t <= 0 contact by contact on every valid steady state, so -u_obs' . lambda >=
-sum_i ra_i^2 / D_i (= gamma F_g >= ... on the paper's systems). It enters each LP through
-columns z_i >= tangents of ra_i^2 / D_i at ra = -+M*, -+M*/2 (ra^2 >= 2 t ra - t^2), 0 <= z_i
-<= M*^2 / D_i (the rotation cap), and the row -u_obs' . lambda >= sum_i z_i: every valid
+sum_i ra_i^2 / D_i (-u_obs' . lambda = gamma F_g here: the plane is the moving obstacle). It
+enters each LP through
+columns z_i >= tangents of ra_i^2 / D_i at ra = +-k M* / 4, k = 1..4 (ra^2 >= 2 t ra - t^2),
+0 <= z_i <= M*^2 / D_i (the rotation cap), and the row -u_obs' . lambda >= sum_i z_i: every valid
 steady state with z_i = ra_i^2 / D_i satisfies them. A disk at a cap state has z_i = M*^2 / D_i
 exactly. In a case where a contact's a_t is a constant a_beta != 0 (its disks at cap points, or
 a one-disk contact whose disk is at one), its term -S_beta a_beta >= 0 is linear and is kept:
@@ -110,7 +111,7 @@ class _Cases:
     """The LP of one case in one HiGHS instance. Columns x = [R; S] (2c) | z (p, the power
     cut's ra_i^2 / D_i). Rows: E x = e | mu R + S >= 0 | mu R - S >= 0 (per frictional
     contact; = 0 fixes S = -mu R, +mu R) | ra (per disk) | a_t (per frictional contact) | the
-    power cut | its tangents (per disk, at ra = -M*, -M*/2, M*/2, M*)."""
+    power cut | its tangents (per disk, at ra = +-k M* / 4, k = 1..4)."""
 
     def __init__(self, form: Formulation, cost: np.ndarray, M: float):
         import highspy
@@ -130,7 +131,7 @@ class _Cases:
         D = r * r * dyn.Minv[2 * p:]
         # power cut: -u_obs' . lambda - sum_i z_i >= 0, z_i >= (2 t ra_i - t^2) / D_i
         pw = np.r_[-np.asarray(dyn.u_obs_dot, float), -np.ones(p)]
-        ts = M * np.array([-1.0, -0.5, 0.5, 1.0])
+        ts = M * np.array([-1.0, -0.75, -0.5, -0.25, 0.25, 0.5, 0.75, 1.0])
         tan = np.vstack([np.hstack([-2 * t / D[i] * ra[i], np.eye(p)[i]])
                          for i in range(p) for t in ts])
         tan_lo = np.array([-t * t / D[i] for i in range(p) for t in ts])
