@@ -2,7 +2,8 @@
 
 * its facts hold on checked valid steady states: the power identity (computed here from
   models.Dynamics), the cut, every sign-fixed contact's S = -+mu R, and the witness lies in
-  the LP of its own case (row by row);
+  the LP of its own case (row by row), and the velocities (alpha, gamma) make its forces a
+  checked steady state (no case on velocities);
 * with the target at an end proved by the MILP, the bound reaches the end and never passes
   it; with a target above, it stays at or below the end, whatever the budget;
 * the 10x1 rows of issue 21's table (both ends proved by the MILP), where the cap split
@@ -93,6 +94,11 @@ def test_case_facts_hold_on_valid_steady_states(lattice, gamma):
         tol = 1e-8 * scale
         assert np.all(row >= lo - tol) and np.all(row <= hi + tol)
         assert np.all(z <= cases.ub[2 * c:] + 1e-15)
+        # the velocities need no case: (omega, V) = (alpha, gamma) makes the forces a checked
+        # valid steady state (docs/mechanics.md)
+        again = witness_of(form, lam)
+        assert again is not None and again.residual <= 1e-8
+        np.testing.assert_allclose(again.S, w.S)
     assert kept > 0  # some witness has a sliding contact of constant a_t in its case
 
 
