@@ -1,7 +1,7 @@
 """Ranges over all valid steady states (verify.ranges.steady_ranges, issue 21): a script, not
 a test.
 
-    python benchmarks/ranges.py [--time-limit SECONDS] [--skip-alpha]
+    python benchmarks/ranges.py [--time-limit SECONDS] [--skip-alpha] [--deep SECONDS]
 
 1. The four rows of issue 21's table (rect 10x1 at 0.05/0.1/0, gamma 0.01 and 0.02; rect 10x1
    at 0.1/0.2/0, gamma 0.02; Fig. 9: rect 10x4 at 0.1/0.2/0, gamma 0.16), each from the run of
@@ -10,6 +10,9 @@ a test.
    attained by a checked witness, else the MILP with lazy kinematics; "time limit" ends show
    the best value met, which is *not* a bound).
 2. Fig. 9's system: mu_g and every angular acceleration, with the time of each end.
+
+Ends left at the time limit get a proved bound (verify.ranges.cap_split; with --deep S also
+verify.ranges.disk_split's case split on the disks' cap states, S seconds per end).
 """
 
 from __future__ import annotations
@@ -40,8 +43,11 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--time-limit", type=float, default=5.0, help="seconds per MILP end")
     ap.add_argument("--skip-alpha", action="store_true")
+    ap.add_argument("--deep", type=float, default=0.0,
+                    help="seconds of the disk split per end left open (0: cap split only)")
     args = ap.parse_args()
-    print(f"time limit {args.time_limit:g} s per end\n")
+    split = True if args.deep <= 0 else args.deep
+    print(f"time limit {args.time_limit:g} s per end, disk split {args.deep:g} s per open end\n")
     print("| case | run mu_g | own states | all valid steady states | seconds |")
     print("|---|---|---|---|---|")
     fig9_run = None
@@ -52,7 +58,7 @@ def main() -> int:
         if ly == 4:
             fig9_run = run
         t0 = time.perf_counter()
-        r = steady_ranges(run, which="mu_g", time_limit=args.time_limit)
+        r = steady_ranges(run, which="mu_g", time_limit=args.time_limit, split=split)
         secs = time.perf_counter() - t0
         own, every = r.own["mu_g"], r.mu_g
         print(f"| {name} | {run.records[-1].mu_g:.7f} | [{cell(own.lo)}, {cell(own.hi)}] | "
@@ -62,7 +68,7 @@ def main() -> int:
     print("\nFig. 9 (rect 10x4, seed 1): mu_g and every angular acceleration over all valid "
           "steady states")
     t0 = time.perf_counter()
-    r = steady_ranges(fig9_run, which="alpha", time_limit=args.time_limit)
+    r = steady_ranges(fig9_run, which="alpha", time_limit=args.time_limit, split=split)
     total = time.perf_counter() - t0
     print("| observable | min | max | run | s (min) | s (max) |")
     print("|---|---|---|---|---|---|")
@@ -77,6 +83,10 @@ def main() -> int:
     print(f"\n{decided} of {2 * len(r.ranges)} ends decided ({by_bound} attain the certified "
           f"relaxation bound; the others: HiGHS closed the gap); total {total:.1f} s "
           f"(force box R <= {r.U:g}, {'proved' if r.box_proved else 'not proved'})")
+    for name, rg in r.ranges.items():
+        for e in (rg.lo, rg.hi):
+            if e.status != OPTIMAL:
+                print(f"{name}: {e.note}")
     return 0
 
 

@@ -41,6 +41,7 @@ from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .bounds import rotation_cap
+from .disk_split import _load, disk_split_bound, witness_of
 from .milp import certified_result
 from .observables import alpha_rows
 from .result import OPTIMAL, TIME_LIMIT
@@ -148,37 +149,45 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     return CapSplitBound(float(best), worst, cases, empty, time.perf_counter() - t0)
 
 
-def _load(h, hs, cost, A, row_lo, row_hi, lb, ub) -> None:
-    """Pass the LP min cost.x, row_lo <= A x <= row_hi, lb <= x <= ub to the instance h."""
-    lp = hs.HighsLp()
-    Ac = sp.csc_matrix(A)
-    lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-    lp.col_cost_, lp.col_lower_, lp.col_upper_ = cost, lb, ub
-    lp.row_lower_, lp.row_upper_ = row_lo, row_hi
-    lp.a_matrix_.format_ = hs.MatrixFormat.kColwise
-    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
-        Ac.indptr, Ac.indices, Ac.data)
-    h.passModel(lp)
-
-
-def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray]) -> None:
+def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],
+                    deep: float = 0.0) -> None:
     """Give each end left at the time limit the proved bound of `cap_split_bound` (End.bound,
-    and a note), where it applies; an end whose best value met attains it is decided."""
+    and a note), where it applies; with deep > 0 also that of verify.ranges.disk_split's case
+    split (deep seconds per end; the better bound is kept, and a case point satisfying every
+    contact law is checked as a witness). An end whose best value met attains its bound is
+    decided."""
     for name, L in obs.items():
         for side, sense in (("lo", 1.0), ("hi", -1.0)):
             end = getattr(ranges[name], side)
             if end.status != TIME_LIMIT:
                 continue
             res = cap_split_bound(form, sense * L)
-            if res is None or not np.isfinite(res.bound):
+            how, bound = "", -np.inf
+            if res is not None and np.isfinite(res.bound):
+                end.seconds += res.seconds
+                how, bound = (f"the case split on the cap contacts with a_t = 0 ({res.cases} "
+                              f"certified LPs, {res.empty} empty)"), res.bound
+            dres = None
+            if deep > 0:
+                target = np.inf if end.best is None else sense * end.best
+                dres = disk_split_bound(form, sense * L, target, deep)
+            if dres is not None:
+                end.seconds += dres.seconds
+                wit = None if dres.candidate is None else witness_of(form, dres.candidate)
+                if wit is not None and sense * float(L @ np.r_[wit.R, wit.S]) < (
+                        np.inf if end.best is None else sense * end.best):
+                    end.best, end.witness = float(L @ np.r_[wit.R, wit.S]), wit
+                    end.residual = wit.residual
+                if dres.bound > bound:
+                    how, bound = (f"the case split on the disks' cap states ({dres.cases} "
+                                  f"certified LPs, {dres.empty} empty, {dres.open} left)"), \
+                        dres.bound
+            if not np.isfinite(bound):
                 continue
-            end.bound = sense * res.bound
-            end.seconds += res.seconds
-            how = (f"proved {'>=' if sense > 0 else '<='} {end.bound:.10g} by the case split on "
-                   f"the cap contacts with a_t = 0 ({res.cases} certified LPs, "
-                   f"{res.empty} empty)")
+            end.bound = sense * bound
+            how = f"proved {'>=' if sense > 0 else '<='} {end.bound:.10g} by {how}"
             if end.best is not None and end.witness is not None and (
-                    sense * end.best <= res.bound + 1e-9 * max(1.0, abs(res.bound))):
+                    sense * end.best <= bound + 1e-9 * max(1.0, abs(bound))):
                 end.status, end.value = OPTIMAL, end.best
                 end.note = f"{how}; attained by the witness"
             else:

@@ -145,7 +145,7 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None, kinematics: str = "lazy", split: bool = True
+                  V_mode: str | None = None, kinematics: str = "lazy", split: bool | float = True
                   ) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
@@ -153,8 +153,8 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
     box: the force box when no bound is proved. kinematics: "lazy" (velocities checked on
     each optimum, verify.ranges.milp) or "big-M" (in the MILP). split: an end left at the
-    time limit gets a proved bound by verify.ranges.cap_split where it applies. Raises
-    NotSteady when no valid steady state exists or the run is not steady."""
+    time limit gets a proved bound by verify.ranges.cap_split where it applies (a number s:
+    also disk_split's, s seconds per end). Raises NotSteady (none valid, run not steady)."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -196,7 +196,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                     new.seconds += old.seconds
                     setattr(ranges[name], side, new)
     if split:  # a proved bound on each end still open (verify.ranges.cap_split)
-        bound_open_ends(form, ranges, obs)
+        bound_open_ends(form, ranges, obs, 0.0 if split is True else float(split))
     for name, L in obs.items():
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))
