@@ -49,13 +49,16 @@ GAP = 1e-9
 
 @dataclass
 class LocalCertificate:
-    """A certificate moving only `disks`: y (3p, zero elsewhere; |y|_inf = 1) with C y <= 0 and
-    b . y = -gap < 0 checked exactly. windows: LPs solved to find it."""
+    """A certificate moving only `disks`. exact: the checked rational y, {column of y (u, v, w
+    blocks of p): value} on the disks' columns (zero elsewhere), with C y <= 0 and b . y < 0
+    exactly; y: its float image (3p, |y|_inf = 1; rounding may leave ~1e-16 violations);
+    gap = -b . y; windows: LPs solved to find it."""
 
     y: np.ndarray
     disks: np.ndarray
     gap: float
     windows: int
+    exact: dict
 
 
 class _Cone:
@@ -120,15 +123,11 @@ def _small(x: float):
     return fmpq(f.numerator, f.denominator)
 
 
-def _to_float(v) -> float:
-    return int(v.p) / int(v.q)  # python-flint 0.6's fmpq has no __float__
-
-
 def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
-                active_tol: float = 1e-9) -> np.ndarray | None:
+                active_tol: float = 1e-9) -> dict | None:
     """A rational y on the disks D near yD (3|D|: u, v, w blocks), the cone rows yD makes
     nearly active made exactly active, checked exactly: C_D y <= 0 and b_D . y < 0 for the
-    stored H, b, mu (module docstring). The full float y (3p, zero off D, |y|_inf = 1), or
+    stored H, b, mu (module docstring). {column of the full y: Fraction} on D's columns, or
     None when the check fails."""
     from flint import fmpq, fmpq_mat
 
@@ -172,9 +171,7 @@ def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
         if work >= 0:
             continue
         if all(sum((r * yi for r, yi in zip(row, cand)), fmpq(0)) <= 0 for row in exact_rows):
-            y = np.zeros(3 * prob.p)
-            y[cols] = [_to_float(v) for v in cand]
-            return y / float(np.max(np.abs(y)))
+            return {int(k): Fraction(int(v.p), int(v.q)) for k, v in zip(cols, cand)}
     return None
 
 
@@ -242,11 +239,15 @@ def _settle(prob: StaticProblem, cone: _Cone, D: np.ndarray, yD: np.ndarray,
     if S.size == 0 or S.size > EXACT_MAX_DISKS:
         return None
     yS = yD.reshape(3, k)[:, moving].reshape(-1)
-    y = exact_local(prob, S, yS)
-    if y is None:  # the support's own LP: a vertex of the smaller problem
+    exact = exact_local(prob, S, yS)
+    if exact is None:  # the support's own LP: a vertex of the smaller problem
         value, yS = window_lp(cone, S)
         if yS is not None and value < 0:
-            y = exact_local(prob, S, yS)
-    if y is None:
+            exact = exact_local(prob, S, yS)
+    if exact is None:
         return None
-    return LocalCertificate(y, S, -float(prob.b @ y), solved)
+    y = np.zeros(3 * prob.p)
+    for k, v in exact.items():
+        y[k] = v.numerator / v.denominator
+    y /= float(np.max(np.abs(y)))
+    return LocalCertificate(y, S, -float(prob.b @ y), solved, exact)
