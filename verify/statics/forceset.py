@@ -4,7 +4,9 @@
 
 * exists: a lambda in P (checked against P), or a Farkas certificate that P is empty (virtual
   velocities under which every contact opens or slides within its cone while gravity does
-  work), checked in floating point with a radius or in exact rational arithmetic
+  work): first a local one, moving a cluster of disks with the others fixed, found in small
+  windows and checked in exact rational arithmetic (verify.statics.local), else the global
+  one, checked in floating point with a radius or in exact rational arithmetic
   (verify.statics.farkas); when neither passes, exists is None (undecided, with the reason),
   never a guess.
 * dimension: of P itself, i.e. of its affine hull. An inequality of P that holds with equality
@@ -163,9 +165,11 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
             return ForceSet(system, False, certificate=cert.y, radius=cert.radius, lps=3,
                             exact=cert.exact)
     witness = lam
-    if interior and max(prob.residuals(lam)) > 1e-12 * prob.scale:
+    if interior and prob.p <= VERTEX_MAX_P and max(prob.residuals(lam)) > 1e-12 * prob.scale:
         # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
-        # reported network is a simplex vertex when that is closer (checked the same way)
+        # reported network is a simplex vertex when that is closer (checked the same way);
+        # not on large packings: that simplex had not ended after 10 CPU minutes on a
+        # 100 x 100 array written as a packing (docs/packings.md, Scale)
         lp = ForceLP(prob)
         status, vertex = lp.solve(np.zeros(prob.n))
         if (status == "optimal" and prob.admissible(vertex)
@@ -177,6 +181,10 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     if ranges:
         _ranges(prob, lp or ForceLP(prob), fs, progress)
     return fs
+
+
+#: Largest number of disks for which the IPM's checked point is replaced by a closer vertex.
+VERTEX_MAX_P = 3000
 
 
 class _Local(Certificate):
