@@ -2,11 +2,13 @@
 test; it prints a markdown table).
 
     python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
-                                  [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
+                                  [--arrays 100] [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
 
 deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
 ranges N: the whole analysis: also the range of every R and S and the sliding contacts.
+arrays L: existence and dimension of the L x L rectangular and triangular arrays written as
+packings (`models.make_packing`: packings that stand, where deposited piles at scale fall).
 Wall-clock seconds and CPU seconds (process time) of one run each.
 """
 
@@ -35,6 +37,7 @@ def main() -> int:
     ap.add_argument("--deposit", type=_sizes, default=[1000, 10000])
     ap.add_argument("--statics", type=_sizes, default=[100, 1000])
     ap.add_argument("--ranges", type=_sizes, default=[100])
+    ap.add_argument("--arrays", type=_sizes, default=[])
     ap.add_argument("--mu", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--radii", default="0.8:1.2")
@@ -63,6 +66,17 @@ def main() -> int:
                 result += f", {fs.lps} LPs, {int(fs.sliding.sum())} can slide"
             print(f"| {task} | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |",
                   flush=True)
+    for L in args.arrays:
+        for kind in ("rect", "tri"):
+            lat = models.make_lattice(kind, L, L)
+            pk = models.make_packing(lat.x, lat.radii, left=lat.left, right=lat.right)
+            system = models.System(pk, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
+            fs, wall, cpu = _timed(lambda s=system: analyse(s, ranges=False))
+            result = (f"exists, dim {fs.dimension}" if fs.exists else
+                      f"undecided ({fs.undecided})" if fs.exists is None else
+                      "no equilibrium")
+            print(f"| existence + dimension, {kind} {L}x{L} array | {pk.p} | {pk.c} | {result} "
+                  f"| {wall:.2f} | {cpu:.2f} |", flush=True)
     return 0
 
 
