@@ -14,8 +14,8 @@ certificate of the global LP moves 11 disks near the top; docs/packings.md, Scal
 cluster's certificate is checked in exact rational arithmetic, which needs no radius bound.
 `scan` looks for one in square windows of the packing (side L, stride L / 2, so that every
 cluster whose centres span at most L / 2 in x and in y lies inside one window), from the top
-of the pile down, L doubling from START_DIAMETERS largest diameters until a window holds
-MAX_WINDOW_DISKS disks. Each window is one small LP, min b_D . y_D, C_D y_D <= 0,
+of the pile down, L doubling from START_DIAMETERS largest diameters while no window holds
+more than MAX_WINDOW_DISKS disks. Each window is one small LP, min b_D . y_D, C_D y_D <= 0,
 |y_D| <= 1, by HiGHS's simplex (a vertex: its nearly active rows are the exact ones); an
 optimum below zero is shrunk to its support and checked exactly (`exact_local`): the nearly
 active rows made exactly active by a rational y (python-flint's row reduction, free unknowns
@@ -39,8 +39,10 @@ from .model import StaticProblem
 
 #: First window side, in largest diameters (the 3000-disk pile's cluster spans ~4).
 START_DIAMETERS = 6.0
-#: No window larger than this many disks (beyond it the global Farkas LP is the tool).
-MAX_WINDOW_DISKS = 1500
+#: No window larger than this many disks after the first side (beyond it the global Farkas
+#: LP is the tool: on a 10^4-disk pile whose small windows held no certificate, windows of
+#: ~800 disks took minutes).
+MAX_WINDOW_DISKS = 500
 #: Largest support (disks) checked in exact arithmetic.
 EXACT_MAX_DISKS = 200
 #: A window's LP optimum b . y below -GAP x (the window's largest weight) is tried.
@@ -214,7 +216,8 @@ def scan(prob: StaticProblem, start: float = START_DIAMETERS,
     while levels is None or level < levels:
         level += 1
         wins = windows(prob, side)
-        biggest = max(D.size for D in wins)
+        if level > 1 and max(D.size for D in wins) > max_disks:
+            return None
         for D in wins:
             value, yD = window_lp(cone, D)
             solved += 1
@@ -224,7 +227,7 @@ def scan(prob: StaticProblem, start: float = START_DIAMETERS,
                     return cert
         if progress:
             progress(solved, side)
-        if len(wins) == 1 or biggest >= max_disks:
+        if len(wins) == 1:
             return None
         side *= 2
     return None
