@@ -37,7 +37,8 @@ from rigidlcp.lcp.quiet import new_highs
 from .farkas import cone_rows
 from .model import StaticProblem
 
-#: First window side, in largest diameters (the 3000-disk pile's cluster spans ~4).
+#: First window side, in largest diameters (the 11 disks of the 3000-disk pile's global
+#: certificate span ~4; its local ones, 2-3 disks, ~2).
 START_DIAMETERS = 6.0
 #: No window larger than this many disks after the first side (beyond it the global Farkas
 #: LP is the tool: on a 10^4-disk pile whose small windows held no certificate, windows of
@@ -45,7 +46,7 @@ START_DIAMETERS = 6.0
 MAX_WINDOW_DISKS = 500
 #: Largest support (disks) checked in exact arithmetic.
 EXACT_MAX_DISKS = 200
-#: A window's LP optimum b . y below -GAP x (the window's largest weight) is tried.
+#: A window's LP optimum b . y below -GAP x (the largest disk weight) is checked exactly.
 GAP = 1e-9
 
 
