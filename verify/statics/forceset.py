@@ -168,8 +168,8 @@ def analyse(system: models.System, ranges: bool = True, progress=None) -> ForceS
     if interior and prob.p <= VERTEX_MAX_P and max(prob.residuals(lam)) > 1e-12 * prob.scale:
         # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
         # reported network is a simplex vertex when that is closer (checked the same way);
-        # not on large packings: that simplex had not ended after 10 CPU minutes on a
-        # 100 x 100 array written as a packing (docs/packings.md, Scale)
+        # not on large packings: that simplex had not ended after 14 minutes wall (load
+        # 6-14) on a 100 x 100 array written as a packing (docs/packings.md, Scale)
         lp = ForceLP(prob)
         status, vertex = lp.solve(np.zeros(prob.n))
         if (status == "optimal" and prob.admissible(vertex)
