@@ -2,13 +2,15 @@
 test; it prints a markdown table).
 
     python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
-                                  [--mu 0.5] [--seed 1] [--radii 0.8:1.2] [--jobs 1]
-                                  [--sample 1000:64]
+                                  [--arrays 100] [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
+                                  [--jobs 1] [--sample 1000:64]
 
 deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
 ranges N: the whole analysis: also the range of every R and S and the sliding contacts, the
 range LPs in --jobs worker processes (verify.statics.contact_ranges).
+arrays L: existence and dimension of the L x L rectangular and triangular arrays written as
+packings (`models.make_packing`: packings that stand, where deposited piles at scale fall).
 sample N:K: the ranges of K contacts spread evenly over an N-disk pile (one warm DualForceLP
 as in `analyse`, in this process), and the whole pile's range LPs extrapolated from them
 (c / K times the time): an estimate where the whole run takes too long.
@@ -69,6 +71,7 @@ def main() -> int:
     ap.add_argument("--deposit", type=_sizes, default=[1000, 10000])
     ap.add_argument("--statics", type=_sizes, default=[100, 1000])
     ap.add_argument("--ranges", type=_sizes, default=[100])
+    ap.add_argument("--arrays", type=_sizes, default=[])
     ap.add_argument("--mu", type=float, default=0.5)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--radii", default="0.8:1.2")
@@ -103,6 +106,17 @@ def main() -> int:
                 result += f", {fs.lps} LPs, {int(fs.sliding.sum())} can slide"
             print(f"| {task} | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |",
                   flush=True)
+    for L in args.arrays:
+        for kind in ("rect", "tri"):
+            lat = models.make_lattice(kind, L, L)
+            pk = models.make_packing(lat.x, lat.radii, left=lat.left, right=lat.right)
+            system = models.System(pk, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
+            fs, wall, cpu = _timed(lambda s=system: analyse(s, ranges=False))
+            result = (f"exists, dim {fs.dimension}" if fs.exists else
+                      f"undecided ({fs.undecided})" if fs.exists is None else
+                      "no equilibrium")
+            print(f"| existence + dimension, {kind} {L}x{L} array | {pk.p} | {pk.c} | {result} "
+                  f"| {wall:.2f} | {cpu:.2f} |", flush=True)
     if sample:
         n, k = sample
         pile = piles[n]

@@ -4,7 +4,9 @@
 
 * exists: a lambda in P (checked against P), or a Farkas certificate that P is empty (virtual
   velocities under which every contact opens or slides within its cone while gravity does
-  work), checked in floating point with a radius or in exact rational arithmetic
+  work): first a local one, moving a cluster of disks with the others fixed, found in small
+  windows and checked in exact rational arithmetic (verify.statics.local), else the global
+  one, checked in floating point with a radius or in exact rational arithmetic
   (verify.statics.farkas); when neither passes, exists is None (undecided, with the reason),
   never a guess.
 * dimension: of P itself, i.e. of its affine hull. An inequality of P that holds with equality
@@ -38,8 +40,9 @@ import numpy as np
 from rigidlcp import models
 
 from .contact_ranges import contact_ranges
-from .farkas import farkas
+from .farkas import Certificate, farkas
 from .hull import dimension, implicit_equalities
+from .local import START_DIAMETERS, scan
 from .model import ForceLP, StaticProblem, interior_point
 
 
@@ -64,6 +67,7 @@ class ForceSet:
     lps: int = 0
     exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
     undecided: str = ""
+    moving: np.ndarray | None = None  # a local certificate's disks (the others held fixed)
 
     @property
     def c(self) -> int:
@@ -97,6 +101,8 @@ class ForceSet:
         if not self.exists:
             out["farkas_radius"] = None if self.radius == np.inf else self.radius
             out["farkas_exact"] = self.exact
+            if self.moving is not None:
+                out["farkas_disks"] = [int(k) for k in self.moving]
             if self.exists is None:
                 out["undecided"] = self.undecided
             out["contacts"] = [{"i": int(i), "j": int(j), "R": None, "S": None}
@@ -135,30 +141,40 @@ def analyse(system: models.System, ranges: bool = True, progress=None,
     processes for the range LPs (verify.statics.contact_ranges; 1: in this process)."""
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
+    # deposited piles lose their equilibrium locally: small windows first (a few LPs per
+    # disk, each exactly checked; 0.3 CPU s on the 10^4-disk pile, docs/packings.md, Scale)
+    local = scan(prob, levels=1)
+    if local is not None:
+        return _falls(system, local.y, local.disks, local.windows)
     # the IPM is fast, and its point a relative-interior witness; when it finds no point in
-    # its box, a Farkas certificate (one LP, IPM) usually settles existence before any
-    # simplex (27 CPU s for the equilibrium LP of a 3000-disk pile without equilibrium)
+    # its box, a Farkas certificate (wider windows, then one LP, IPM) usually settles
+    # existence before any simplex (27 CPU s for the equilibrium LP of a 3000-disk pile
+    # without equilibrium)
     status, lam = interior_point(prob, 1e3 * weight)
     interior = status == "optimal" and prob.admissible(lam)
     lp = cert = None
     if not interior:
         if status != "optimal":  # HiGHS's IPM says "infeasible" or stops undecided
-            cert = farkas(prob)
+            cert = _certificate(prob)
         if cert is None or not cert.proves:
             lp = ForceLP(prob)
             status, lam = lp.solve(np.zeros(prob.n))
         if cert is not None and cert.proves or status != "optimal" or not prob.admissible(lam):
-            cert = cert if cert is not None else farkas(prob)
+            cert = cert if cert is not None else _certificate(prob)
             if not cert.proves:  # neither a checked solution nor a checked certificate
                 return ForceSet(system, None, radius=cert.radius, lps=3,
                                 undecided=f"equilibrium LP {status}; Farkas certificate "
                                 f"not proved (radius {cert.radius:.3g} weights' units)")
+            if isinstance(cert, _Local):
+                return _falls(system, cert.y, cert.disks, cert.windows + 1)
             return ForceSet(system, False, certificate=cert.y, radius=cert.radius, lps=3,
                             exact=cert.exact)
     witness = lam
-    if interior and max(prob.residuals(lam)) > 1e-12 * prob.scale:
+    if interior and prob.p <= VERTEX_MAX_P and max(prob.residuals(lam)) > 1e-12 * prob.scale:
         # the IPM's point (no crossover) is within its own tolerance, ~1e-8, of P; the
-        # reported network is a simplex vertex when that is closer (checked the same way)
+        # reported network is a simplex vertex when that is closer (checked the same way);
+        # not on large packings: that simplex had not ended after 14 minutes wall (load
+        # 6-14) on a 100 x 100 array written as a packing (docs/packings.md, Scale)
         lp = ForceLP(prob)
         status, vertex = lp.solve(np.zeros(prob.n))
         if (status == "optimal" and prob.admissible(vertex)
@@ -173,3 +189,30 @@ def analyse(system: models.System, ranges: bool = True, progress=None,
         fs.lps += r.lps
         fs.unchecked += r.unchecked
     return fs
+
+
+#: Largest number of disks for which the IPM's checked point is replaced by a closer vertex.
+VERTEX_MAX_P = 3000
+
+
+class _Local(Certificate):
+    """A local certificate (verify.statics.local) as a Certificate, with its disks."""
+
+    def __init__(self, y: np.ndarray, disks: np.ndarray, gap: float, windows: int):
+        super().__init__(y, np.inf, gap, exact=True)
+        self.disks, self.windows = disks, windows
+
+
+def _certificate(prob: StaticProblem) -> Certificate:
+    """Wider windows (verify.statics.local), then the global Farkas LP."""
+    local = scan(prob, start=2 * START_DIAMETERS)
+    if local is not None:
+        return _Local(local.y, local.disks, local.gap, local.windows)
+    return farkas(prob)
+
+
+def _falls(system: models.System, y: np.ndarray, disks: np.ndarray, lps: int) -> ForceSet:
+    """No equilibrium, by an exactly checked certificate moving only `disks`."""
+    return ForceSet(system, False, certificate=y, radius=np.inf, lps=lps, exact=True,
+                    moving=disks)
+
