@@ -30,6 +30,7 @@ from rigidlcp import models
 from rigidlcp.models.lattice import PLANE
 from rigidlcp.models.modes import contact_groups, fig5e_loops, row_modes
 from rigidlcp.verify.ranges.patterns import (
+    WITNESS_TOL,
     Lit,
     Pattern,
     PatternResult,
@@ -39,7 +40,9 @@ from rigidlcp.verify.ranges.patterns import (
     non_sliding,
     sliding,
 )
-from rigidlcp.verify.ranges.steady import formulate
+from rigidlcp.verify.ranges.steady import formulate, state_extreme, state_velocities
+from rigidlcp.verify.ranges.valid_steady import seed_states
+from rigidlcp.verify.ranges.witness import make_witness
 
 #: Seconds per question (a pattern, or its negation): full run, --quick.
 PATTERN_TIME_LIMIT = {False: 60.0, True: 5.0}
@@ -202,19 +205,66 @@ def judge_patterns(name: str, run: models.Run, time_limit: float) -> dict[str, d
         form = formulate(system)
     except Exception as exc:  # NotSteady, NoVelocityBound: the column says why
         return {"error": f"{type(exc).__name__}: {exc}"}
+    known, labels = known_states(form, run)
     out: dict[str, dict] = {}
     for cid, (P, notP, check) in questions(name, system).items():
-        out[cid] = {"P": _ask(form, P, time_limit, check),
+        out[cid] = {"P": _ask(form, P, time_limit, check, known, labels),
                     "not": None if notP is None else _ask(form, notP, time_limit,
-                                                          lambda w, c=check: not c(w))}
+                                                          lambda w, c=check: not c(w), known,
+                                                          labels)}
     return out
 
 
-def _ask(form, P: Pattern, time_limit: float, check) -> PatternResult:
+def describe(system: models.System, w) -> str:
+    """A witness in a few words: mu_g, sliding contacts, first-row modes, residual."""
+    fr = system.mu > 0
+    modes = row_modes(system, _record(w), 0).text()
+    return (f"mu_g {w.mu_g:.7g}, {int(np.sum(w.s[fr] != 0))} of {int(fr.sum())} frictional "
+            f"contacts sliding, first-row modes {modes}, residual {w.residual:.0e}")
+
+
+def known_states(form, run: models.Run | None) -> list:
+    """Checked valid steady states to try before any MILP: the run's own (one time unit after
+    its last event, as verify.ranges.steady_ranges takes it) and the seeds' (the locked array,
+    the rolling checkerboards: valid_steady.seed_states)."""
+    system, out, labels = form.system, [], []
+    if run is not None and run.status == "steady":
+        last, fin = run.records[-1], run.final
+        alpha = make_witness(system, fin.omega, fin.V, last.R, last.S, form.dyn).alpha
+        V = fin.V + system.gamma
+        v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
+        out.append(make_witness(system, fin.omega + alpha, V, np.asarray(last.R, float),
+                                np.asarray(last.S, float), form.dyn, v_scale))
+        labels.append("the run's own steady state")
+    for s in seed_states(form):
+        status, x, _ = state_extreme(form, s, np.zeros(2 * system.c), 1)
+        vel = state_velocities(form, s)
+        if status == "optimal" and vel is not None:
+            out.append(make_witness(system, vel[0], vel[1], x[:system.c], x[system.c:],
+                                    form.dyn))
+            labels.append("a seed state (locked array or rolling checkerboard)")
+    keep = [k for k, w in enumerate(out) if w.residual <= WITNESS_TOL]
+    return [out[k] for k in keep], [labels[k] for k in keep]
+
+
+def _ask(form, P: Pattern, time_limit: float, check, known: list, labels: list
+         ) -> PatternResult:
     try:
-        return find_state(form, P, time_limit=time_limit, check=check)
+        res = find_state(form, P, time_limit=time_limit, check=check, known=known)
     except Exception as exc:  # a failed question is "unknown", never a verdict
         return PatternResult("failed", note=f"{type(exc).__name__}: {exc}")
+    w = res.witness
+    if w is not None:
+        k = next((k for k, x in enumerate(known) if x is w), None)
+        if k is None:
+            known.append(w)
+            labels.append(f"the witness of an earlier question ({res.cuts} cuts)")
+            k = len(known) - 1
+            src = f"a MILP witness ({res.cuts} lazy cuts, {res.seconds:.1f} s)"
+        else:
+            src = labels[k]
+        res.note = f"{src}: {describe(form.system, w)}"
+    return res
 
 
 __all__ = ["questions", "judge_patterns", "PATTERN_TIME_LIMIT"]

@@ -308,14 +308,32 @@ def _witness(ext: Formulation, x: np.ndarray) -> SteadyWitness | None:
     return make_witness(system, omega, V, y[:c], y[c:2 * c], ext.dyn)
 
 
+def _accepts(system: System, pattern: Pattern, wit: SteadyWitness, check) -> str:
+    """"" if the witness is a valid steady state (residual) with P (Pattern.holds and the
+    caller's check), else why not."""
+    if wit.residual > WITNESS_TOL:
+        return f"witness residual {wit.residual:.1e} > {WITNESS_TOL:g}"
+    if not pattern.holds(system, wit):
+        return "P fails on the witness"
+    if check is not None and not check(wit):
+        return "the caller's predicate fails on the witness"
+    return ""
+
+
 def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: float = 60.0,
-               check=None) -> PatternResult:
+               check=None, known: list[SteadyWitness] = ()) -> PatternResult:
     """A valid steady state of `target` (a System, or its Formulation) satisfying `pattern`, or
     a proof that none does (module docstring). check(witness) -> bool: the caller's own test
     of the property on the witness (e.g. the classifier of models.modes); a witness must pass
-    it, steady_check and Pattern.holds."""
+    it, steady_check and Pattern.holds. known: valid steady states met before (a run's own, the
+    seeds', earlier witnesses), tried first: one that passes is the answer, no MILP."""
     t0 = time.perf_counter()
     form = target if isinstance(target, Formulation) else formulate(target)
+    for k, wit in enumerate(known):
+        if not _accepts(form.system, pattern, wit, check):
+            return PatternResult(FOUND, wit, True, 0, time.perf_counter() - t0,
+                                 f"a known valid steady state (#{k} of those given; residual "
+                                 f"{wit.residual:.1e}), no MILP")
     notes: list[str] = []
     for tighten in (False, True):
         if tighten and not any(lit.strict and lit.margin > 0 for lit in pattern.literals()):
@@ -326,11 +344,11 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
         st, x = model.solve(np.zeros(model.n), left) if left > 0 else (TIME_LIMIT, None)
         took = time.perf_counter() - t0
         if st == INFEASIBLE and not tighten:
-            scope = ("every valid steady state" if proved else
-                     "every valid steady state within the force box (bound not proved for P)")
+            scope = ("" if proved else
+                     " within the force box (its bound is not proved for P's R)")
             return PatternResult(INFEASIBLE, None, proved, model.cuts, took,
                                  f"MILP infeasible after {model.cuts} lazy kinematic cut(s): "
-                                 f"no state of {scope} has it")
+                                 f"no valid steady state{scope} has it")
         if st == INFEASIBLE:
             notes.append("infeasible with the strict literals tightened by their margins")
             break
@@ -341,13 +359,9 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
         if wit is None:
             notes.append("the MILP's point gave no witness (velocity LP failed)")
             continue
-        why = ("" if wit.residual <= WITNESS_TOL else
-               f"witness residual {wit.residual:.1e} > {WITNESS_TOL:g}")
-        why = why or ("" if pattern.holds(form.system, wit) else "P fails on the witness")
-        why = why or ("" if check is None or check(wit) else
-                      "the caller's predicate fails on the witness")
+        why = _accepts(form.system, pattern, wit, check)
         if not why:
-            return PatternResult(FOUND, wit, proved, model.cuts, time.perf_counter() - t0,
+            return PatternResult(FOUND, wit, True, model.cuts, time.perf_counter() - t0,
                                  f"checked witness (residual {wit.residual:.1e}, "
                                  f"{model.cuts} cuts" + (", strict literals tightened"
                                                          if tighten else "") + ")")
