@@ -242,7 +242,8 @@ def known_states(form, run: models.Run | None) -> list:
         if status == "optimal" and vel is not None:
             out.append(make_witness(system, vel[0], vel[1], x[:system.c], x[system.c:],
                                     form.dyn))
-            labels.append("a seed state (locked array or rolling checkerboard)")
+            labels.append("the locked array (a seed: omega = 0)" if not np.any(vel[0])
+                          else "a rolling checkerboard (a seed)")
     keep = [k for k, w in enumerate(out) if w.residual <= WITNESS_TOL]
     return [out[k] for k in keep], [labels[k] for k in keep]
 
