@@ -9,8 +9,9 @@ tangential state of a frictional contact ("sl" = y+ + y-: 1 sliding, 0 non-slidi
 verify.ranges.witness too). A clause may be *guarded* by an indicator (a named binary: the
 clause must hold when it is 1; one-way: a 0 says nothing), and `counts` bound linear sums
 of indicators (a number of disks in a mode: exact when the indicators of each disk are
-exclusive and exhaustive, one per mode with sum 1, as mode_claims writes them). Each term of a clause of more than one term gets a binary z_t with
-sum z_t >= 1 (or >= its guard) and its literals relaxed by big-M where z_t = 0; every M comes
+exclusive and exhaustive, one per mode with sum 1, as mode_claims writes them). Each term
+of a clause of more than one term gets a binary z_t with sum z_t >= 1 (or >= its guard) and
+its literals relaxed by big-M where z_t = 0; every M comes
 from the MILP's column box (proved bounds: verify.ranges.bounds, the rotation cap, the
 velocity box), so it loses no point of the box.
 
