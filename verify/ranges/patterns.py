@@ -354,7 +354,8 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
         if st == INFEASIBLE:
             notes.append("infeasible with the strict literals tightened by their margins")
             break
-        if st != OPTIMAL or x is None:
+        if x is None or st not in (OPTIMAL, TIME_LIMIT):  # with no objective, an incumbent
+            # at the time limit whose states the kinematics admit is a point: checked below
             return PatternResult(TIME_LIMIT if st == TIME_LIMIT else "failed", None, proved,
                                  model.cuts, took, f"HiGHS: {st} ({model.cuts} cuts)")
         wit = _witness(ext, x)
