@@ -242,8 +242,10 @@ def known_states(form, run: models.Run | None) -> list:
         if status == "optimal" and vel is not None:
             out.append(make_witness(system, vel[0], vel[1], x[:system.c], x[system.c:],
                                     form.dyn))
-            labels.append("the locked array (a seed: omega = 0)" if not np.any(vel[0])
-                          else "a rolling checkerboard (a seed)")
+            slid = s[(system.lattice.j == PLANE) & (system.mu > 0)]
+            labels.append("the locked array's contact states (a seed: every plane contact "
+                          "sliding, every disk-disk one not)" if np.all(slid != 0)
+                          else "a rolling checkerboard's contact states (a seed)")
     keep = [k for k, w in enumerate(out) if w.residual <= WITNESS_TOL]
     return [out[k] for k in keep], [labels[k] for k in keep]
 
