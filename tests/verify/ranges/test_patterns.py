@@ -69,6 +69,21 @@ def test_single_disk_rolls_or_slides_by_hand(gamma, rolls):
     assert (fast.status == FOUND) != rolls
 
 
+def test_a_strict_literal_at_its_threshold_is_unknown_not_a_verdict():
+    """Single disk, smooth walls: R_P = 1 in every valid steady state (the vertical balance).
+    "R_P >= 1" has a witness; "R_P > 1" is solved closed first (R_P >= 1: feasible, but the
+    witness fails the strict test), then tightened (R_P >= 1 + margin: infeasible), so the
+    answer is "unknown" (only states at the threshold): the closed MILP cannot prove a strict
+    "none". "R_P > 1.1" is infeasible already closed: "none", proved."""
+    s = _disk(0.1)
+    P = _plane(s)
+    _accepted(s, find_state(s, Pattern().all_of([at_least("R", P, 1.0)])))
+    edge = find_state(s, Pattern().all_of([at_least("R", P, 1.0, strict=True, margin=1e-6)]))
+    assert edge.status == "unknown" and edge.witness is None, edge
+    far = find_state(s, Pattern().all_of([at_least("R", P, 1.1, strict=True, margin=1e-6)]))
+    assert far.status == "infeasible" and far.proved, far
+
+
 def test_frictionless_row_every_disk_rolls():
     """rect 3x1, mu_pp = mu_wall = 0: each disk is the single disk (no torque but the
     plane's), so every disk rolls (mode 1: plane non-sliding and transmitting, R_P = 1) in
