@@ -273,7 +273,7 @@ def _fig9(qs: dict, s) -> str:
     if all(_none(r) for r in P):
         return f"holds for none{_scope(P[0]) or _scope(P[1])}: {P[0].note} (either wall disk)"
     return ("unknown (" + ", ".join(r.status if r is not None else "not asked" for r in P)
-            + "): no valid steady state with 4 / 3 / 2 met, none ruled out")
+            + f"): no valid steady state with 4 / 3 / 2 met, none ruled out; {own}")
 
 
 def _dissipation(res: Results, c: Claim) -> str:
