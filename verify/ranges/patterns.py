@@ -346,8 +346,8 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
         st, x = model.solve(np.zeros(model.n), left) if left > 0 else (TIME_LIMIT, None)
         took = time.perf_counter() - t0
         if st == INFEASIBLE and not tighten:
-            scope = ("" if proved else
-                     " within the force box (its bound is not proved for P's R)")
+            scope = ("" if proved else f" within the force box R <= {form.U:.4g} (not "
+                     "proved for the R that P reads)")
             return PatternResult(INFEASIBLE, None, proved, model.cuts, took,
                                  f"MILP infeasible after {model.cuts} lazy kinematic cut(s): "
                                  f"no valid steady state{scope} has it")
