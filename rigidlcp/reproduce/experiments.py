@@ -139,6 +139,10 @@ class Job:
             from .valid_steady import SET_TIME_LIMIT, steady_set
 
             return steady_set(job[2], SET_TIME_LIMIT[self.p != plan(quick=False)])
+        if kind == "patterns":  # the mode claims over all valid steady states
+            from .mode_claims import PATTERN_TIME_LIMIT, judge_patterns
+
+            return judge_patterns(job[1], job[2], PATTERN_TIME_LIMIT[self.p != plan(quick=False)])
         if kind == "formulas":
             from rigidlcp.verify.nullspace.formulas import formula_table
 
@@ -188,6 +192,8 @@ class Results:
     bands: dict[str, list] = field(default_factory=dict)
     #: per STEADY experiment, verify.ranges.SteadyRanges of its first seed's run (or why not)
     steady_sets: dict = field(default_factory=dict)
+    #: per experiment, its mode claims over every valid steady state (mode_claims.py)
+    patterns: dict = field(default_factory=dict)
 
     def seeds(self, name: str) -> list[models.Run]:
         cfg = self.plan[name]
@@ -239,7 +245,8 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
     try:
         for k, out in iter_map(Job(p), checks, jobs=jobs, dask=dask):
             kind, label = checks[k][:2]
-            {"cert": res.certificates, "steady-set": res.steady_sets}.get(
+            {"cert": res.certificates, "steady-set": res.steady_sets,
+             "patterns": res.patterns}.get(
                 kind, res.ts_checks)[label] = out
             if bar is not None:
                 bar.update(1)
@@ -252,6 +259,8 @@ def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
 
 #: The experiments whose steady state (first seed, default selection) is cross-checked.
 STEADY = ("fig7", "fig8", "fig9", "fig10", "fig6", "fig13", "fig13_tri")
+#: The experiments whose mode / contact-state claims are asked of every valid steady state.
+PATTERN_EXPERIMENTS = ("fig8", "fig9", "fig6", "fig13", "fig13_tri")
 #: Sweep points cross-checked by time-stepping, per sweep (indices into its gamma grid).
 SWEEP_POINTS = 5
 
@@ -273,6 +282,8 @@ def check_jobs(p: dict, res: Results) -> list[tuple]:
         run = res.runs.get(name, {}).get((cfg["seeds"][0], cfg["gamma"], SELECT))
         if run is not None:
             out += [("steady-set", name, run), ("ts", name, run), ("cert", name, run)]
+            if name in PATTERN_EXPERIMENTS:
+                out.append(("patterns", name, run))
     for name in SWEEPS:
         cfg = p[name]
         for g in sweep_gammas(cfg):

@@ -13,9 +13,11 @@ property the range computation does not constrain), with the ranges of mu_g.
   band's; m_e is a derivative along a curve, and the curves through the band are many: judged
   on the band's two end curves (valid_steady.end_families) beside the selection's.
 * Sec. IV B: the comparisons between systems, on the end curves of like kind.
-* The mode and contact-state claims (Figs. 6, 8, 9, 13): the range computation does not
-  constrain modes, so such a claim is known to hold for some valid steady state when the run's
-  own state (checked valid) shows it; for all or none it is "not judged".
+* The mode and contact-state claims (Figs. 6, 8, 9, 13): asked of the steady-state MILP as
+  patterns (mode_claims.py, verify.ranges.patterns): "for all" when not-P is infeasible (the
+  lazy kinematic cuts exhausted), "for none" when P is, "for some" with a checked witness of
+  each; a time limit is "unknown (time limit)". Dissipation: only its sign (D is not linear
+  at fixed contact states).
 """
 
 from __future__ import annotations
@@ -205,19 +207,104 @@ def _ivb(res: Results, c: Claim) -> str:
 
 
 def _state_claim(res: Results, c: Claim) -> str:
-    """Mode / contact-state claims: the run's own state is a checked valid steady state."""
+    """Mode / contact-state claims, asked of the steady-state MILP as patterns
+    (mode_claims.py, verify.ranges.patterns): P and not-P, each a checked witness, a proof
+    that there is none, or "unknown (time limit)"."""
     name = c.id.split("-")[0]
     s, why = _set_of(res, name)
     rng = f"valid steady mu_g {fmt_range(s.mu_g)}" if s is not None else why
-    own_ok = s is not None and "mu_g" in s.own
-    if c.id.endswith("any-selection") or c.id in ("fig13-minimum", "fig13-tri-higher"):
-        return ("not judged over the set: a claim about the runs' paths or their dissipation "
-                f"(not linear in the forces), not about one steady state's forces ({rng})")
-    if c.passed and own_ok:
-        return (f"holds for some: at least the run's steady state (checked valid); for all: "
-                f"not judged, the range computation does not constrain modes ({rng})")
-    return (f"unknown: whether some valid steady state has it is not judged (the run's state "
-            f"does not{'' if own_ok else ', or is not checked valid'}) ({rng})")
+    if c.id.endswith("any-selection"):
+        return f"not judged over the set: a claim about the runs' paths ({rng})"
+    if c.id in ("fig13-minimum", "fig13-tri-higher"):
+        return _dissipation(res, c)
+    qs = res.patterns.get(name)
+    if qs is None or "error" in qs:
+        return f"unknown (patterns not asked: {'not computed' if qs is None else qs['error']})"
+    if c.id == "fig9-counts":
+        return _fig9(qs, s) + f" ({rng})"
+    q = qs.get(c.id)
+    if q is None:  # fig6-singular: dim ker M is not a pattern of states and forces
+        own_ok = s is not None and "mu_g" in s.own
+        return ("holds for some (at least the run's steady state, checked valid); for all: "
+                "not judged (not a pattern of contact states and forces)" if c.passed and own_ok
+                else "unknown (not a pattern of contact states and forces)")
+    return _pattern_verdict(q["P"], q["not"]) + f" ({rng})"
+
+
+def _found(r) -> bool:
+    return r is not None and r.status == "feasible"
+
+
+def _none(r) -> bool:
+    return r is not None and r.status == "infeasible"
+
+
+def _scope(r) -> str:
+    return "" if r.proved else " within the force box (its bound is not proved for this R)"
+
+
+def _pattern_verdict(P, N) -> str:
+    """The column's text from the answers for P and for not-P (verify.ranges.patterns)."""
+    if _none(P):
+        return f"holds for none{_scope(P)}: {P.note}"
+    if _found(P) and _none(N):
+        return f"holds for all{_scope(N)}: {N.note}; e.g. {P.note}"
+    if _found(P) and _found(N):
+        return f"holds for some: e.g. {P.note}; not for {N.note}"
+    if _found(P):
+        return (f"holds for some: e.g. {P.note}; for all: unknown ("
+                + (N.status if N is not None else "not asked") + ")")
+    head = f"unknown ({P.status}: whether some valid steady state has it)"
+    if _found(N):
+        return f"{head}; not for all: {N.note}"
+    if _none(N):
+        return f"holds for all{_scope(N)}: {N.note} (yet no witness of it met: {P.status})"
+    return head
+
+
+def _fig9(qs: dict, s) -> str:
+    """fig9-counts: some valid steady state with 4 / 3 / 2, one wall disk left out (either)."""
+    P = [qs.get("fig9-counts/left", {}).get("P"), qs.get("fig9-counts/right", {}).get("P")]
+    hit = next((r for r in P if _found(r)), None)
+    own = ("not for all: the run's own state (checked valid) has other counts"
+           if s is not None and "mu_g" in s.own else "for all: not asked")
+    if hit is not None:
+        return f"holds for some: e.g. {hit.note}; {own}"
+    if all(_none(r) for r in P):
+        return f"holds for none{_scope(P[0]) or _scope(P[1])}: {P[0].note} (either wall disk)"
+    return ("unknown (" + ", ".join(r.status if r is not None else "not asked" for r in P)
+            + f"): no valid steady state with 4 / 3 / 2 met, none ruled out; {own}")
+
+
+def _dissipation(res: Results, c: Claim) -> str:
+    """D = sum mu R |v_t| over sliding contacts is not linear at fixed states (forces times
+    velocities; mode_claims.py): only whether it vanishes is asked."""
+    why = ("D multiplies forces by velocities (not linear at fixed contact states), so its "
+           "range is not computed; judged by its sign (D > 0 iff a frictional contact slides "
+           "with R > 0)")
+    qs = {k: res.patterns.get(k) or {} for k in ("fig13", "fig13_tri")}
+    zero = {k: q.get(f"{k}/D=0", {}).get("P") for k, q in qs.items()}
+    pos = {k: q.get(f"{k}/D>0", {}).get("P") for k, q in qs.items()}
+    if c.id == "fig13-minimum":
+        z = zero["fig13"]
+        tail = (f"a valid steady state with D = 0 exists ({z.note}), so the least steady D "
+                "is 0" if _found(z) else
+                f"D = 0 on some valid steady state: {getattr(z, 'status', 'not asked')}")
+        return f"not judged over the set: a claim about a run's path; {tail}; {why}"
+    # fig13-tri-higher: D_tri > D_rect for some pair iff tri has D > 0 somewhere and rect a
+    # state with less (D = 0); for none iff tri has no D > 0; for all iff rect is always 0
+    # and tri always > 0 (both negations infeasible)
+    if _none(pos["fig13_tri"]):
+        return f"holds for none{_scope(pos['fig13_tri'])}: tri {pos['fig13_tri'].note}; {why}"
+    if _found(pos["fig13_tri"]) and _none(pos["fig13"]) and _none(zero["fig13_tri"]):
+        return (f"holds for all: every tri state dissipates ({zero['fig13_tri'].note}), no "
+                f"rect state does ({pos['fig13'].note}); {why}")
+    if _found(pos["fig13_tri"]) and _found(zero["fig13"]):
+        return (f"holds for some: tri with D > 0, {pos['fig13_tri'].note}; rect with D = 0, "
+                f"{zero['fig13'].note}; {why}")
+    return ("unknown (" + ", ".join(f"{k} {q}: {getattr(r, 'status', 'not asked')}"
+                                    for q, d in (("D>0", pos), ("D=0", zero))
+                                    for k, r in d.items()) + f"); {why}")
 
 
 __all__ = ["over_all", "NA"]

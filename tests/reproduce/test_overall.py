@@ -97,3 +97,75 @@ def test_fig12_inertia_names_the_curves_where_it_holds(fig11_small):
     m_e is a slope along a curve, so "for all" is never claimed."""
     text = over_all(fig11_small, Claim("fig12-inertia", "", "", "", "", True))
     assert text.startswith("holds for some (this toolkit's selection"), text
+
+
+# -- the mode and contact-state claims, asked as patterns (mode_claims.py) ----------------------
+
+
+def _patterns(name: str, system: models.System, seed: int = 0) -> Results:
+    from rigidlcp.reproduce.mode_claims import judge_patterns
+
+    res = Results(plan(quick=True))
+    res.patterns[name] = judge_patterns(name, models.simulate(system, seed=seed), 20.0)
+    return res
+
+
+def test_every_disk_of_a_frictionless_row_rolls_holds_for_all():
+    """rect 3x1, mu_pp = mu_wall = 0, gamma 0.1: each disk is the single disk, which rolls
+    (S_P = gamma / 2 <= mu_P; tests/verify/ranges/test_steady_closed_forms.py), so "every
+    first-row disk in mode 1" holds for every valid steady state: not-P is infeasible."""
+    s = models.System(models.rectangular(3, 1), mu_pp=0.0, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.1)
+    res = _patterns("fig8", s)
+    text = over_all(res, Claim("fig8-row1-mode1", "", "", "", "", True))
+    assert text.startswith("holds for all:"), text
+    assert "infeasible" in text
+
+
+def test_all_non_wall_contacts_non_sliding_holds_for_none_by_kinematics():
+    """rect 2x2 at constant velocity (gamma 0, V0 = 1): non-sliding plane contacts give
+    r omega = -V0 to both first-row disks, a non-sliding lateral contact r omega_0 = -r
+    omega_1: no velocities do both, so no valid steady state has every non-wall contact
+    non-sliding (a kinematic cut proves it); the run's state is a witness of the negation."""
+    s = models.System(models.rectangular(2, 2), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.0, V0=1.0)
+    res = _patterns("fig13", s)
+    text = over_all(res, Claim("fig13-rect-all-ns", "", "", "", "", False))
+    assert text.startswith("holds for none:"), text
+    q = res.patterns["fig13"]["fig13-rect-all-ns"]["P"]
+    assert q.proved and q.cuts >= 1
+
+
+def test_fig9_counts_need_nine_disks():
+    """4 / 3 / 2 counts nine first-row disks besides the wall disk left out: a 4x2 array has
+    three, so the claim holds for no valid steady state (proved: the counts are infeasible)."""
+    s = models.System(models.rectangular(4, 2), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.16)
+    text = over_all(_patterns("fig9", s), Claim("fig9-counts", "", "", "", "", False))
+    assert text.startswith("holds for none:"), text
+
+
+@pytest.mark.parametrize("name, lx, ly, gamma", [("fig8", 4, 2, 0.2), ("fig8", 3, 3, 0.05),
+                                                 ("fig6", 4, 1, 0.05)])
+def test_every_pattern_witness_is_valid_and_has_what_it_claims(name, lx, ly, gamma):
+    """Each witness of a pattern question: a valid steady state (steady_check, called here) on
+    which the claim's own classifier (models.modes, as the report's criterion) gives the
+    answer claimed (P for the claim's witness, not-P for the negation's)."""
+    from rigidlcp.reproduce.mode_claims import questions
+    from rigidlcp.verify.ranges.witness import steady_check
+
+    s = models.System(models.rectangular(lx, ly), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=gamma)
+    res = _patterns(name, s)
+    checks = {cid: q[2] for cid, q in questions(name, s).items()}
+    seen = 0
+    for cid, q in res.patterns[name].items():
+        for side in ("P", "not"):
+            r = q[side]
+            if r is None or r.witness is None:
+                assert r is None or r.status != "feasible"
+                continue
+            w, seen = r.witness, seen + 1
+            assert steady_check(s, w.omega, w.V, w.R, w.S)[0] <= 1e-8, (cid, side)
+            assert checks[cid](w) == (side == "P"), (cid, side, r.note)
+    assert seen >= 1

@@ -269,7 +269,8 @@ def states_of(form: Formulation, y: np.ndarray) -> np.ndarray:
     c, p, F = form.system.c, form.system.p, form.fric.size
     s = np.zeros(c, dtype=int)
     base = 2 * c + 2 * p + 1
-    s[form.fric] = np.where(y[base:base + F] > 0.5, 1, np.where(y[base + F:] > 0.5, -1, 0))
+    yp, ym = y[base:base + F], y[base + F:base + 2 * F]  # columns after them: not states
+    s[form.fric] = np.where(yp > 0.5, 1, np.where(ym > 0.5, -1, 0))
     return s
 
 
