@@ -154,7 +154,8 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
     status, t, z = raw["status"], float(raw["time"]), raw["z"]
     res = scaled = forward = backward = math.nan
     if z.shape == (problem.n,) and np.all(np.isfinite(z)):
-        answer = Solution(z=z, w=np.zeros(0), status=status, method=method, u=raw.get("u"))
+        answer = Solution(z=z, w=np.zeros(0), status=status, method=method, u=raw.get("u"),
+                          basis=raw.get("basis"))
         with np.errstate(all="ignore"):
             cert = certify(problem, answer, tol=tol, uniqueness="none")
         res, scaled = cert.residual, cert.scaled_residual

@@ -93,6 +93,10 @@ def _answer(sol, seconds: float) -> dict:
     return {"kind": "answer", "z": np.asarray(sol.z, dtype=float), "status": sol.status,
             "iterations": int(sol.iterations), "message": sol.message, "time": seconds,
             "u": None if sol.u is None else np.asarray(sol.u, dtype=float),
+            # the method's own final basis: the check bounds the forward error on the method's
+            # pattern, as lcp.solve did (without it, another pattern of a degenerate z may give
+            # a far looser bound and a correct answer judged "uncertified")
+            "basis": None if sol.basis is None else np.asarray(sol.basis, dtype=np.intp),
             "forward_error": getattr(sol, "forward_error",
                                      (sol.info or {}).get("forward_error"))}
 

@@ -322,3 +322,30 @@ def test_an_event_set_says_it_is_harvested_before_the_silent_runs(monkeypatch, t
     err = capsys.readouterr().err.splitlines()
     assert err[0] == (f"bench: set events-rect: the event LCPs of its runs, simulated once "
                       f"into {tmp_path / 'cache'} (about 30 s the first time)")
+
+
+def test_the_judge_bounds_the_forward_error_on_the_methods_own_basis(monkeypatch):
+    """A degenerate z has several patterns; the check must bound the forward error on the
+    basis the method ended on (as lcp.solve did), so the raw answer carries it to the judge:
+    without it a correct answer was judged "uncertified" (newton-min on Fig. 9's events,
+    forward bound 0.02 on another pattern against 5e-15 on its own)."""
+    from rigidlcp.bench import harness
+    from rigidlcp.bench.runners import _solve_here
+
+    rng = np.random.default_rng(3)
+    A = rng.normal(size=(6, 6))
+    P = lcp.LCP(A @ A.T + 0.1 * np.eye(6), rng.normal(size=6), name="p")
+    raw = _solve_here(P, "lemke")
+    assert raw["basis"] is not None
+    np.testing.assert_array_equal(raw["basis"], lcp.solve(P, method="lemke").basis)
+    seen = []
+    real = harness.certify
+
+    def spy(problem, answer, **kw):
+        seen.append(answer.basis)
+        return real(problem, answer, **kw)
+
+    monkeypatch.setattr(harness, "certify", spy)
+    r = harness.judge(P, "lemke", "s", raw, time_limit=10.0, tol=1e-8)
+    assert r.outcome == "solved"
+    np.testing.assert_array_equal(seen[0], raw["basis"])
