@@ -83,11 +83,7 @@ static PyObject *py_solve_eq(PyObject *self, PyObject *args)
     if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
     Work w;
-#if defined(__GNUC__)
-    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
-#else
-    uint64_t stack[STACK_WORDS];
-#endif
+    uint64_t stack[STACK_WORDS] STACK_ALIGNED;
     if (work_init(&w, n, tol, stack) < 0) {
         PyErr_NoMemory();
         goto done;
@@ -133,15 +129,10 @@ static PyObject *py_solve_accept(PyObject *self, PyObject *args)
     long long max_iter;
     (void)self;
     if (!PyArg_ParseTuple(args, "OOdLOO", &oM, &oq, &tol, &max_iter, &oz, &ob)) return NULL;
-    idx n = PyObject_Length(oq);
-    if (n < 1) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
-        return NULL;
-    }
     Py_buffer vM = {0}, vq = {0}, vz = {0}, vb = {0};
     PyObject *result = NULL;
-    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
-    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto done;
+    idx n = problem_data(oM, oq, &vM, &vq);
+    if (n < 0) goto done;
     if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
     long long pivots = 0;
@@ -295,13 +286,8 @@ static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t
     if (PyErr_Occurred()) return NULL;
     Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0}, vb = {0};
     PyObject *result = NULL;
-    idx n = PyObject_Length(args[1]);
-    if (n < 1) {
-        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
-        return NULL;
-    }
-    if (get_buffer(args[1], &vq, "q", 'd', n, 0) < 0) return NULL;
-    if (get_buffer(args[0], &vM, "M", 'd', n * n, 0) < 0) goto done;
+    idx n = problem_data(args[0], args[1], &vM, &vq);
+    if (n < 0) goto done;
     if (get_buffer(args[4], &vz, "z", 'd', n, 0) < 0) goto done;
     if (get_buffer(args[5], &vw, "w", 'd', n, 0) < 0) goto done;
     if (get_buffer(args[6], &vb, "basis", 'q', n, 0) < 0) goto done;

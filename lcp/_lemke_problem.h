@@ -214,6 +214,11 @@ typedef struct {
 
 #define STACK_WORDS 2048 /* 16 kB: enough for n <= 28 */
 #define ALIGN_WORDS 8    /* 64 bytes */
+#if defined(__GNUC__)
+#define STACK_ALIGNED __attribute__((aligned(64))) /* of a stack block: uint64_t b[STACK_WORDS] */
+#else
+#define STACK_ALIGNED
+#endif
 
 static void work_free(Work *w) { free(w->heap); }
 
@@ -296,11 +301,7 @@ static int solve_and_accept(idx n, const double *M, const double *q, double tol,
                             idx *nb, int *acode, double res[3])
 {
     Work w;
-#if defined(__GNUC__)
-    uint64_t stack[STACK_WORDS] __attribute__((aligned(64)));
-#else
-    uint64_t stack[STACK_WORDS];
-#endif
+    uint64_t stack[STACK_WORDS] STACK_ALIGNED;
     double bound[3] = {0.0, 0.0, 0.0};
     *pivots = 0;
     *nb = 0;

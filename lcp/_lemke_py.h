@@ -1,5 +1,5 @@
 /* The Python side of one dictionary (included by lcp/_lemke_c.c): the buffer checks of the
- * arguments (get_buffer, opt_vector, release) and the entry points of lcp/_lemke_kernel.py and
+ * arguments (get_buffer, opt_vector, release, problem_data) and the entry points of lcp/_lemke_kernel.py and
  * lcp.LCP that work on one dictionary or on the data as given: run, setup, check, plain. The
  * includer includes <Python.h>, <float.h>, <math.h>, acceptance/_accuracy_core.h
  * (abs_max_finite) and _lemke_run.h. */
@@ -261,6 +261,22 @@ static int opt_vector(PyObject *obj, Py_buffer *view, const char *name, idx n, c
 static void release(Py_buffer *v)
 {
     if (v->obj) PyBuffer_Release(v);
+}
+
+/* The data of one problem for solve_accept and solve_fast: n = len(q) >= 1, then q (n float64)
+ * and M (n x n float64, C-contiguous), in this order. Returns n, or -1 with the error set (vq
+ * and vM, zeroed by the caller, are released by it with `release`: one not acquired stays
+ * empty). solve_eq checks r and c between the length and the buffers, so it keeps its own. */
+static idx problem_data(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+{
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return -1;
+    }
+    if (get_buffer(oq, vq, "q", 'd', n, 0) < 0) return -1;
+    if (get_buffer(oM, vM, "M", 'd', n * n, 0) < 0) return -1;
+    return n;
 }
 
 #endif /* RIGIDLCP_LEMKE_PY_H */
