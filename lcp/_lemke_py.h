@@ -1,0 +1,282 @@
+/* The Python side of one dictionary (included by lcp/_lemke_c.c): the buffer checks of the
+ * arguments (get_buffer, opt_vector, release, problem_data) and the entry points of lcp/_lemke_kernel.py and
+ * lcp.LCP that work on one dictionary or on the data as given: run, setup, check, plain. The
+ * includer includes <Python.h>, <float.h>, <math.h>, acceptance/_accuracy_core.h
+ * (abs_max_finite) and _lemke_run.h. */
+#ifndef RIGIDLCP_LEMKE_PY_H
+#define RIGIDLCP_LEMKE_PY_H
+
+/* ------------------------------------------------------------------ Python binding */
+static int get_buffer(PyObject *obj, Py_buffer *view, const char *name, char kind, idx size,
+                      int fortran)
+{
+    int flags = PyBUF_WRITABLE | PyBUF_FORMAT | (fortran ? PyBUF_F_CONTIGUOUS : PyBUF_C_CONTIGUOUS);
+    if (PyObject_GetBuffer(obj, view, flags) < 0) return -1;
+    const char *f = view->format ? view->format : "B";
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+    int ok = view->itemsize == 8 &&
+             (kind == 'd' ? (f[0] == 'd' && f[1] == 0)
+                          : ((f[0] == 'l' || f[0] == 'q') && f[1] == 0));
+    if (!ok || view->len / 8 != size) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd %s values", name, size,
+                     kind == 'd' ? "float64" : "int64");
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *py_run(PyObject *self, PyObject *args)
+{
+    PyObject *oT, *ob, *onb, *orow, *oslot, *otrace;
+    double tol;
+    long long max_iter;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOdLO", &oT, &ob, &onb, &orow, &oslot, &tol, &max_iter,
+                          &otrace))
+        return NULL;
+    Py_buffer vb, vnb, vrow, vslot, vT, vtr;
+    idx n = PyObject_Length(ob);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "basic: empty");
+        return NULL;
+    }
+    if (get_buffer(ob, &vb, "basic", 'q', n, 0) < 0) return NULL;
+    if (get_buffer(onb, &vnb, "nonbasic", 'q', n + 1, 0) < 0) goto fail1;
+    if (get_buffer(orow, &vrow, "row_of", 'q', 2 * n + 1, 0) < 0) goto fail2;
+    if (get_buffer(oslot, &vslot, "slot_of", 'q', 2 * n + 1, 0) < 0) goto fail3;
+    if (get_buffer(oT, &vT, "T", 'd', n * (n + 2), 1) < 0) goto fail4;
+    idx trace_len = 0;
+    int have_trace = otrace != Py_None;
+    if (have_trace) {
+        if (PyObject_GetBuffer(otrace, &vtr, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) goto fail5;
+        trace_len = vtr.len / 16;
+    }
+    Lemke L;
+    L.n = n;
+    L.ld = n;
+    L.T = (double *)vT.buf;
+    L.basic = (int64_t *)vb.buf;
+    L.nonbasic = (int64_t *)vnb.buf;
+    L.row_of = (int64_t *)vrow.buf;
+    L.slot_of = (int64_t *)vslot.buf;
+    L.tol = tol;
+    L.rows = (idx *)malloc(4 * n * sizeof(idx));
+    L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
+    L.V = (double *)malloc((size_t)n * n * sizeof(double));
+    long long pivots = 0;
+    idx s = 0;
+    int64_t entering = -1;
+    int code = -1;
+    if (L.rows && L.alpha && L.V) {
+        L.cand = L.rows + n;
+        L.wj = L.rows + 2 * n;
+        L.pos = L.rows + 3 * n;
+        L.theta = L.alpha + n;
+        L.col = L.alpha + 2 * n;
+        L.row = L.alpha + 3 * n;
+        Py_BEGIN_ALLOW_THREADS
+        code = run(&L, max_iter, have_trace ? (int64_t *)vtr.buf : NULL, trace_len, &pivots,
+                   &s, &entering);
+        Py_END_ALLOW_THREADS
+    }
+    free(L.rows);
+    free(L.alpha);
+    free(L.V);
+    if (have_trace) PyBuffer_Release(&vtr);
+    PyBuffer_Release(&vT);
+    PyBuffer_Release(&vslot);
+    PyBuffer_Release(&vrow);
+    PyBuffer_Release(&vnb);
+    PyBuffer_Release(&vb);
+    if (code < 0) return PyErr_NoMemory();
+    return Py_BuildValue("iLnL", code, pivots, s, (long long)entering);
+fail5:
+    PyBuffer_Release(&vT);
+fail4:
+    PyBuffer_Release(&vslot);
+fail3:
+    PyBuffer_Release(&vrow);
+fail2:
+    PyBuffer_Release(&vnb);
+fail1:
+    PyBuffer_Release(&vb);
+    return NULL;
+}
+
+static void fill(idx n, double *T, const double *M, const double *q, const double *d,
+                 double *out_mu, double *out_nu, double *out_delta)
+{
+    double mu = 0.0, nu = 0.0, delta = -1.0 / 0.0;
+    for (idx k = 0; k < n * n; k++) {
+        double a = M[k] < 0 ? -M[k] : M[k];
+        if (a > mu) mu = a;
+    }
+    if (mu == 0.0) mu = 1.0;
+    for (idx i = 0; i < n; i++) {
+        double a = q[i] < 0 ? -q[i] : q[i];
+        if (a > nu) nu = a;
+        if (d[i] > delta) delta = d[i];
+    }
+    for (idx i = 0; i < n; i++)
+        for (idx j = 0; j < n; j++) T[i + n * j] = M[i * n + j] / mu;
+    for (idx i = 0; i < n; i++) {
+        T[i + n * n] = d[i] / delta;
+        T[i + n * (n + 1)] = q[i] / nu;
+    }
+    *out_mu = mu;
+    *out_nu = nu;
+    *out_delta = delta;
+}
+
+/* setup(T, M, q, d) -> (mu, nu, delta): T[:, :n] = M / mu, T[:, n] = d / delta,
+ * T[:, n + 1] = q / nu with mu = max|M| (1 if M = 0), nu = max|q|, delta = max d; as numpy's
+ * true divisions in `_Lemke.__init__`. M is read C-contiguous, T written column-major. */
+static PyObject *py_setup(PyObject *self, PyObject *args)
+{
+    PyObject *oT, *oM, *oq, *od;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOO", &oT, &oM, &oq, &od)) return NULL;
+    Py_buffer vq, vd, vM, vT;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(od, &vd, "d", 'd', n, 0) < 0) goto f1;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) goto f2;
+    if (get_buffer(oT, &vT, "T", 'd', n * (n + 2), 1) < 0) goto f3;
+    double mu, nu, delta;
+    fill(n, (double *)vT.buf, (const double *)vM.buf, (const double *)vq.buf,
+         (const double *)vd.buf, &mu, &nu, &delta);
+    PyBuffer_Release(&vT);
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vd);
+    PyBuffer_Release(&vq);
+    return Py_BuildValue("ddd", mu, nu, delta);
+f3:
+    PyBuffer_Release(&vM);
+f2:
+    PyBuffer_Release(&vd);
+f1:
+    PyBuffer_Release(&vq);
+    return NULL;
+}
+
+/* check(M, q) -> (finite, qmin): are all entries of M and q finite, and min q. */
+static PyObject *py_check(PyObject *self, PyObject *args)
+{
+    PyObject *oM, *oq;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OO", &oM, &oq)) return NULL;
+    Py_buffer vq, vM;
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return NULL;
+    }
+    if (get_buffer(oq, &vq, "q", 'd', n, 0) < 0) return NULL;
+    if (get_buffer(oM, &vM, "M", 'd', n * n, 0) < 0) {
+        PyBuffer_Release(&vq);
+        return NULL;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    double qmin = q[0];
+    int finite = 1; /* branch-free and independent per entry (vectorized): |x| <= DBL_MAX is
+                     * false for inf and NaN (a sum of x - x was one serial chain of adds) */
+    for (idx k = 0; k < n * n; k++) finite &= fabs(M[k]) <= DBL_MAX;
+    for (idx i = 0; i < n; i++) {
+        finite &= fabs(q[i]) <= DBL_MAX;
+        qmin = q[i] < qmin ? q[i] : qmin;
+    }
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    return Py_BuildValue("Od", finite ? Py_True : Py_False, qmin);
+}
+
+/* The format of a buffer of native float64 values ("d", with the native byte order mark or
+ * none)? */
+static int native_double(const Py_buffer *v)
+{
+    const char *f = v->format ? v->format : "B";
+#if PY_BIG_ENDIAN
+    if (*f == '>' || *f == '!' || *f == '=' || *f == '@') f++;
+#else
+    if (*f == '<' || *f == '=' || *f == '@') f++;
+#endif
+    return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
+}
+
+/* plain(M, q) -> bool: lcp.LCP's quick route -- is q a C-contiguous native float64 vector of
+ * n >= 1 entries and M a C-contiguous native float64 n x n matrix, all entries finite? (Then
+ * M and q need no conversion, only the copies.) False for anything else, never an error: the
+ * general validation runs and names the problem. One call for the dtype, shape, order and
+ * finiteness tests. */
+static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "plain(M, q): two arguments");
+        return NULL;
+    }
+    Py_buffer vq, vM;
+    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
+    if (PyObject_GetBuffer(args[1], &vq, flags) < 0) {
+        PyErr_Clear();
+        Py_RETURN_FALSE;
+    }
+    if (PyObject_GetBuffer(args[0], &vM, flags) < 0) {
+        PyErr_Clear();
+        PyBuffer_Release(&vq);
+        Py_RETURN_FALSE;
+    }
+    idx n = vq.ndim == 1 ? vq.shape[0] : 0;
+    int ok = n >= 1 && native_double(&vq) && native_double(&vM) && vM.ndim == 2 &&
+             vM.shape[0] == n && vM.shape[1] == n;
+    if (ok) {
+        const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
+        int finite = abs_max_finite(M, n * n, &top);
+        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
+        ok = finite;
+    }
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    if (ok) Py_RETURN_TRUE;
+    Py_RETURN_FALSE;
+}
+
+/* An optional float64 vector of length n (None: NULL). */
+static int opt_vector(PyObject *obj, Py_buffer *view, const char *name, idx n, const double **out)
+{
+    *out = NULL;
+    view->obj = NULL;
+    if (obj == Py_None) return 0;
+    if (get_buffer(obj, view, name, 'd', n, 0) < 0) return -1;
+    *out = (const double *)view->buf;
+    return 0;
+}
+
+static void release(Py_buffer *v)
+{
+    if (v->obj) PyBuffer_Release(v);
+}
+
+/* The data of one problem for solve_accept and solve_fast: n = len(q) >= 1, then q (n float64)
+ * and M (n x n float64, C-contiguous), in this order. Returns n, or -1 with the error set (vq
+ * and vM, zeroed by the caller, are released by it with `release`: one not acquired stays
+ * empty). solve_eq checks r and c between the length and the buffers, so it keeps its own. */
+static idx problem_data(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+{
+    idx n = PyObject_Length(oq);
+    if (n < 1) {
+        if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
+        return -1;
+    }
+    if (get_buffer(oq, vq, "q", 'd', n, 0) < 0) return -1;
+    if (get_buffer(oM, vM, "M", 'd', n * n, 0) < 0) return -1;
+    return n;
+}
+
+#endif /* RIGIDLCP_LEMKE_PY_H */
