@@ -66,6 +66,8 @@ def cmd_forceset(args: argparse.Namespace) -> int:
     from rigidlcp.models.packing_io import read_disks, read_packing
     from rigidlcp.models.system import System
 
+    if args.jobs < 1:  # the options first: a bad one is named before the file is read
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     gap_tol = GAP_TOL if args.gap_tol is None else args.gap_tol
     left, right = _wall(args.left), _wall(args.right)
     disks = read_disks(args.file)
@@ -75,8 +77,6 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         raise Overlap(f"{exc}; --gap-tol G accepts overlaps up to G x radius", exc.i, exc.j,
                       exc.overlap) from None
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
-    if args.jobs < 1:
-        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
     if args.samples and not args.out:

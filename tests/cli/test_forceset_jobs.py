@@ -44,3 +44,9 @@ def test_forceset_refuses_jobs_below_one(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--jobs must be >= 1, got 0" in err and err.count("\n") == 1
     assert not out.exists()
+
+
+def test_forceset_names_bad_jobs_before_reading_the_file(tmp_path, capsys):
+    assert main(["forceset", str(tmp_path / "missing.csv"), "--jobs", "-1"]) == 2
+    err = capsys.readouterr().err
+    assert "--jobs must be >= 1, got -1" in err and err.count("\n") == 1
