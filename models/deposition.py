@@ -261,14 +261,6 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / math.hypot(v[0], v[1])
 
 
-def _support_forces(n1: np.ndarray, n2: np.ndarray) -> tuple[float, float]:
-    """R1, R2 with R1 n1 + R2 n2 = (0, 1) (unit weight), n: from the support to the disk."""
-    det = n1[0] * n2[1] - n1[1] * n2[0]
-    if abs(det) < 1e-15:
-        return -1.0, -1.0
-    return -n2[0] / det, n1[0] / det
-
-
 def _circle_hits(a: np.ndarray, D: float, b: np.ndarray, E: float, direction: float):
     """Angles theta (from the vertical, towards `direction`) of the points a + D (dir sin,
     cos) at distance E from b."""
