@@ -33,6 +33,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -134,7 +135,8 @@ class ForceSet:
         return out
 
 
-def analyse(system: models.System, ranges: bool = True, progress=None,
+def analyse(system: models.System, ranges: bool = True,
+            progress: Callable[[int, int, str], None] | None = None,
             jobs: int = 1) -> ForceSet:
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
     progress(done, total, stage): called as the LPs of the ranges are solved; jobs: worker

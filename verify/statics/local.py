@@ -26,6 +26,7 @@ finds none proves nothing (the loss of equilibrium may be global): the caller go
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -177,7 +178,7 @@ def windows(prob: StaticProblem, side: float) -> list[np.ndarray]:
 
 def scan(prob: StaticProblem, start: float = START_DIAMETERS,
          max_disks: int = MAX_WINDOW_DISKS, levels: int | None = None,
-         progress=None) -> LocalCertificate | None:
+         progress: Callable[[int, float], None] | None = None) -> LocalCertificate | None:
     """The first exactly checked local certificate found in the windows (module docstring),
     or None (no claim). start: the first side in largest diameters; levels: how many sides
     (None: until a window holds max_disks disks or the whole packing); progress(windows
