@@ -147,10 +147,12 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         print("no equilibrium: Farkas certificate checked " + (
             "in exact rational arithmetic" if fs.exact else
             f"(no admissible forces with sum R < {fs.radius:.3g})"))
-        if fs.moving is not None:
+        if fs.moving is not None and fs.moving.size < lat.p:
             shown = ", ".join(str(int(k)) for k in fs.moving[:20])
             more = f" and {fs.moving.size - 20} more" if fs.moving.size > 20 else ""
             print(f"it moves only disks {shown}{more} (the others held fixed)")
+        elif fs.moving is not None:
+            print(f"it moves every disk ({lat.p})")
         return 0
     print(f"equilibrium exists (checked: balance residual {fs.residuals[0]:.2e}, laws "
           f"{fs.residuals[1]:.2e}); dimension of the admissible set: {fs.dimension}"
