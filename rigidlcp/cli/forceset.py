@@ -20,9 +20,13 @@ def register(sub) -> None:
         "dimension, ranges)",
         description="The set of contact forces that hold a packing at rest under gravity "
         "with Signorini and Coulomb's laws: whether it is empty (a checked equilibrium, or a "
-        "checked Farkas certificate), its dimension (of its affine hull), the range of every "
-        "R and S (linear programs, HiGHS), the contacts that can slide against 2M - 3N.")
-    p.add_argument("file", help="packing file: .csv / .npz (x, y, r [, m, I]) or LAMMPS dump")
+        "checked Farkas certificate, first sought as one moving a small cluster of disks with "
+        "the others fixed, checked exactly: farkas_disks in the JSON), its dimension (of its "
+        "affine hull), the range of every R and S (linear programs, HiGHS; each end checked "
+        "in the set and certified by the LP's duals, a failed check counted in "
+        "unchecked_optima), the contacts that can slide against 2M - 3N.")
+    p.add_argument("file", help="packing file: .csv / .npz (x, y, r [, m, I]) or LAMMPS dump "
+                   "(x, y, radius or diameter [, mass]; its BOX BOUNDS give the walls)")
     for name in ("mu_pp", "mu_plane", "mu_wall"):
         p.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
                        help=f"friction coefficient (default {DEFAULT_MU[name]})")
@@ -43,7 +47,8 @@ def register(sub) -> None:
     p.add_argument("--cap", type=float, default=None, help="bound sum R <= CAP (needed "
                    "to sample an unbounded set of forces, e.g. walls that can pinch the pile)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sampler (default 0)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--json", action="store_true", help="print one JSON object (its keys: "
+                   "docs/packings.md, 'The JSON')")
     p.add_argument("--out", metavar="DIR", help="write forceset.json and forceset.png here")
     p.add_argument("--force", action="store_true", help="overwrite files in --out")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
