@@ -31,6 +31,9 @@ from .packing import GAP_TOL, packing
 _TOL = 1e-12  # relative: force signs and angles compared with this margin
 #: supports within this gap (times r) of a resting position are refined onto (_Pile.polish)
 POLISH_REACH = 1e-6
+#: radii whose masses r^2 and inertias r^4 / 2 are normal floats (outside, they overflow or
+#: underflow: `pack --radii 1:1e300` warned of an overflow, then refused the inertia)
+R_LIMITS = (1e-76, 1e76)
 
 
 class _Grid:
@@ -258,14 +261,6 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / math.hypot(v[0], v[1])
 
 
-def _support_forces(n1: np.ndarray, n2: np.ndarray) -> tuple[float, float]:
-    """R1, R2 with R1 n1 + R2 n2 = (0, 1) (unit weight), n: from the support to the disk."""
-    det = n1[0] * n2[1] - n1[1] * n2[0]
-    if abs(det) < 1e-15:
-        return -1.0, -1.0
-    return -n2[0] / det, n1[0] / det
-
-
 def _circle_hits(a: np.ndarray, D: float, b: np.ndarray, E: float, direction: float):
     """Angles theta (from the vertical, towards `direction`) of the points a + D (dir sin,
     cos) at distance E from b."""
@@ -287,6 +282,9 @@ def _radii(n: int, radii: tuple[float, float], rng: np.random.Generator) -> np.n
     a, b = (float(v) for v in radii)
     if not (math.isfinite(a) and math.isfinite(b) and 0 < a <= b):
         raise InvalidSystem(f"radii must be MIN:MAX with 0 < MIN <= MAX, got {a}:{b}")
+    if not (R_LIMITS[0] <= a and b <= R_LIMITS[1]):  # m = r^2, I = m r^2 / 2 must be normal
+        raise InvalidSystem(f"radii must lie in [{R_LIMITS[0]:.0e}, {R_LIMITS[1]:.0e}] (the "
+                            f"inertia r^4 / 2 a normal float), got {a:g}:{b:g}")
     return np.full(n, a) if a == b else rng.uniform(a, b, n)
 
 

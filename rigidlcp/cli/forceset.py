@@ -20,9 +20,13 @@ def register(sub) -> None:
         "dimension, ranges)",
         description="The set of contact forces that hold a packing at rest under gravity "
         "with Signorini and Coulomb's laws: whether it is empty (a checked equilibrium, or a "
-        "checked Farkas certificate), its dimension (of its affine hull), the range of every "
-        "R and S (linear programs, HiGHS), the contacts that can slide against 2M - 3N.")
-    p.add_argument("file", help="packing file: .csv / .npz (x, y, r [, m, I]) or LAMMPS dump")
+        "checked Farkas certificate, first sought as one moving a small cluster of disks with "
+        "the others fixed, checked exactly: farkas_disks in the JSON), its dimension (of its "
+        "affine hull), the range of every R and S (linear programs, HiGHS; each end checked "
+        "in the set and certified by the LP's duals, a failed check counted in "
+        "unchecked_optima), the contacts that can slide against 2M - 3N.")
+    p.add_argument("file", help="packing file: .csv / .npz (x, y, r [, m, I]) or LAMMPS dump "
+                   "(x, y, radius or diameter [, mass]; its BOX BOUNDS give the walls)")
     for name in ("mu_pp", "mu_plane", "mu_wall"):
         p.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
                        help=f"friction coefficient (default {DEFAULT_MU[name]})")
@@ -43,7 +47,8 @@ def register(sub) -> None:
     p.add_argument("--cap", type=float, default=None, help="bound sum R <= CAP (needed "
                    "to sample an unbounded set of forces, e.g. walls that can pinch the pile)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sampler (default 0)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--json", action="store_true", help="print one JSON object (its keys: "
+                   "docs/packings.md, 'The JSON')")
     p.add_argument("--out", metavar="DIR", help="write forceset.json and forceset.png here")
     p.add_argument("--force", action="store_true", help="overwrite files in --out")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -66,6 +71,8 @@ def cmd_forceset(args: argparse.Namespace) -> int:
     from rigidlcp.models.packing_io import read_disks, read_packing
     from rigidlcp.models.system import System
 
+    if args.jobs < 1:  # the options first: a bad one is named before the file is read
+        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     gap_tol = GAP_TOL if args.gap_tol is None else args.gap_tol
     left, right = _wall(args.left), _wall(args.right)
     disks = read_disks(args.file)
@@ -75,8 +82,6 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         raise Overlap(f"{exc}; --gap-tol G accepts overlaps up to G x radius", exc.i, exc.j,
                       exc.overlap) from None
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
-    if args.jobs < 1:
-        raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
     if args.samples and not args.out:
@@ -147,10 +152,12 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         print("no equilibrium: Farkas certificate checked " + (
             "in exact rational arithmetic" if fs.exact else
             f"(no admissible forces with sum R < {fs.radius:.3g})"))
-        if fs.moving is not None:
+        if fs.moving is not None and fs.moving.size < lat.p:
             shown = ", ".join(str(int(k)) for k in fs.moving[:20])
             more = f" and {fs.moving.size - 20} more" if fs.moving.size > 20 else ""
             print(f"it moves only disks {shown}{more} (the others held fixed)")
+        elif fs.moving is not None:
+            print(f"it moves every disk ({lat.p})")
         return 0
     print(f"equilibrium exists (checked: balance residual {fs.residuals[0]:.2e}, laws "
           f"{fs.residuals[1]:.2e}); dimension of the admissible set: {fs.dimension}"

@@ -36,7 +36,8 @@ def register(sub) -> None:
                    help="number of disks to deposit (required unless --array)")
     p.add_argument("--seed", type=seed, default=0, help="seed of the radii and drop points")
     p.add_argument("--radii", type=radii, default=(1.0, 1.0), metavar="MIN:MAX",
-                   help="radii uniform in [MIN, MAX] (default 1:1, monodisperse)")
+                   help="radii uniform in [MIN, MAX] (default 1:1, monodisperse; within "
+                   "[1e-76, 1e76], where the inertia r^4 / 2 is a normal float)")
     p.add_argument("--width", type=float, default=None,
                    help="box width (default 2 mean(r) round(sqrt(N)))")
     p.add_argument("--vacancies", type=float, default=0.0, metavar="F",

@@ -17,8 +17,9 @@ def register(sub) -> None:
         "over every valid steady state of its system (docs/mechanics.md, 'Valid steady "
         "states'), over every contact-state set the kinematics admit, each end with a "
         "witness state checked against the laws; beside it, the range over the run's own "
-        "contact states. An end stopped by --time-limit is reported as 'time limit', never as "
-        "a bound.")
+        "contact states. An end stopped by --time-limit is reported as 'time limit' with the "
+        "value met, never as the end itself; where a case split on the plane contacts proves "
+        "a bound on it (verify.ranges.cap_split), the bound is added ('bounds' in the JSON).")
     p.add_argument("run", help="a run file (RUN.npz, with its RUN.json)")
     p.add_argument("--observables", choices=("mu_g", "alpha", "all"), default="alpha",
                    help="mu_g only; mu_g and every angular acceleration (default); also "

@@ -40,9 +40,14 @@ from rigidlcp.verify.ranges.patterns import (
     non_sliding,
     sliding,
 )
-from rigidlcp.verify.ranges.steady import formulate, state_extreme, state_velocities
+from rigidlcp.verify.ranges.steady import (
+    Formulation,
+    formulate,
+    state_extreme,
+    state_velocities,
+)
 from rigidlcp.verify.ranges.valid_steady import seed_states
-from rigidlcp.verify.ranges.witness import make_witness
+from rigidlcp.verify.ranges.witness import SteadyWitness, make_witness
 
 #: Seconds per question (a pattern, or its negation): full run, --quick.
 PATTERN_TIME_LIMIT = {False: 60.0, True: 5.0}
@@ -215,7 +220,7 @@ def judge_patterns(name: str, run: models.Run, time_limit: float) -> dict[str, d
     return out
 
 
-def describe(system: models.System, w) -> str:
+def describe(system: models.System, w: SteadyWitness) -> str:
     """A witness in a few words: mu_g, sliding contacts, first-row modes, residual."""
     fr = system.mu > 0
     modes = row_modes(system, _record(w), 0).text()
@@ -223,10 +228,11 @@ def describe(system: models.System, w) -> str:
             f"contacts sliding, first-row modes {modes}, residual {w.residual:.0e}")
 
 
-def known_states(form, run: models.Run | None) -> list:
-    """Checked valid steady states to try before any MILP: the run's own (one time unit after
-    its last event, as verify.ranges.steady_ranges takes it) and the seeds' (the locked array,
-    the rolling checkerboards: valid_steady.seed_states)."""
+def known_states(form: Formulation, run: models.Run | None
+                 ) -> tuple[list[SteadyWitness], list[str]]:
+    """Checked valid steady states to try before any MILP, and a label of each: the run's own
+    (one time unit after its last event, as verify.ranges.steady_ranges takes it) and the
+    seeds' (the locked array, the rolling checkerboards: valid_steady.seed_states)."""
     system, out, labels = form.system, [], []
     if run is not None and run.status == "steady":
         last, fin = run.records[-1], run.final

@@ -44,3 +44,24 @@ def test_forceset_refuses_jobs_below_one(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "--jobs must be >= 1, got 0" in err and err.count("\n") == 1
     assert not out.exists()
+
+
+def test_forceset_names_bad_jobs_before_reading_the_file(tmp_path, capsys):
+    assert main(["forceset", str(tmp_path / "missing.csv"), "--jobs", "-1"]) == 2
+    err = capsys.readouterr().err
+    assert "--jobs must be >= 1, got -1" in err and err.count("\n") == 1
+
+
+def test_forceset_names_the_disks_a_local_certificate_moves(tmp_path, capsys):
+    """A disk on a frictionless disk at 60 degrees, no walls: both fall (a local certificate
+    moving both, checked exactly); the text says so without 'the others held fixed'."""
+    f = tmp_path / "fall.csv"
+    f.write_text("x,y,r\n1,1,1\n2,2.7320508075688772,1\n")
+    base = ["forceset", str(f), "--left", "none", "--right", "none", "--mu-pp", "0",
+            "--mu-plane", "0"]
+    assert main(base + ["--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["exists"] is False and d["farkas_exact"] is True and d["farkas_disks"] == [0, 1]
+    assert main(base) == 0
+    out = capsys.readouterr().out
+    assert "it moves every disk (2)" in out and "held fixed" not in out

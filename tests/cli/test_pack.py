@@ -32,13 +32,16 @@ def test_pack_writes_a_packing(tmp_path, capsys):
     (["--n", "5", "--radii", "1:x"], "expected MIN:MAX"),
     (["--n", "5", "--width", "1"], "width must be >= the largest diameter"),
     (["--n", "5", "--vacancies", "1.5"], "--vacancies must be in"),
+    (["--n", "5", "--radii", "1:1e300"], "radii must lie in"),  # r^4 / 2 overflows
+    (["--n", "5", "--radii", "1e-100:1e-100"], "radii must lie in"),  # r^4 / 2 is 0
 ])
 def test_pack_refusals_leave_nothing(tmp_path, capsys, args, message):
     out = tmp_path / "p.csv"
     with pytest.raises(SystemExit) if "MIN:MAX" in message else nullcontext():
         code = main(["pack", *args, "--out", str(out)])
         assert code == 2
-    assert message in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert message in err and err.count("\n") == 1
     assert not out.exists()
 
 

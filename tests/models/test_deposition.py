@@ -65,6 +65,12 @@ def test_narrow_box_and_bad_arguments():
         deposit(5, radii=(1.0, 1.0), width=1.5)
     with pytest.raises(models.InvalidSystem, match="radii"):
         deposit(5, radii=(2.0, 1.0))
+    for radii in ((1.0, 1e300), (1e80, 1e80), (1e-100, 1e-100), (1e-300, 1.0)):
+        with pytest.raises(models.InvalidSystem, match="inertia r"):  # before any disk falls
+            deposit(5, radii=radii)
+    for radii in ((1e76, 1e76), (1e-76, 1e-76)):  # the ends: masses and inertias normal
+        lat = deposit(5, seed=1, radii=radii)
+        assert np.all(np.isfinite(lat.inertias)) and np.all(lat.inertias > 0)
     with pytest.raises(models.InvalidSystem, match="n must be"):
         deposit(0)
 

@@ -38,6 +38,7 @@ answer is "unknown" (only states at the threshold were found).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -80,18 +81,22 @@ class Lit:
 
 
 def sliding(a: int) -> Lit:
+    """Contact a slides (its state indicator sl_a = 1)."""
     return Lit((("sl", int(a), 1.0),), lo=1.0)
 
 
 def non_sliding(a: int) -> Lit:
+    """Contact a does not slide (sl_a = 0)."""
     return Lit((("sl", int(a), 1.0),), hi=0.0)
 
 
 def at_least(kind: str, idx: int, t: float, strict: bool = False, margin: float = 0.0) -> Lit:
+    """The column kind[idx] (KINDS) >= t (> t when strict)."""
     return Lit(((kind, int(idx), 1.0),), lo=float(t), strict=strict, margin=margin)
 
 
 def at_most(kind: str, idx: int, t: float, strict: bool = False, margin: float = 0.0) -> Lit:
+    """The column kind[idx] (KINDS) <= t (< t when strict)."""
     return Lit(((kind, int(idx), 1.0),), hi=float(t), strict=strict, margin=margin)
 
 
@@ -323,7 +328,8 @@ def _accepts(system: System, pattern: Pattern, wit: SteadyWitness, check) -> str
 
 
 def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: float = 60.0,
-               check=None, known: list[SteadyWitness] = ()) -> PatternResult:
+               check: Callable[[SteadyWitness], bool] | None = None,
+               known: list[SteadyWitness] = ()) -> PatternResult:
     """A valid steady state of `target` (a System, or its Formulation) satisfying `pattern`, or
     a proof that none does (module docstring). check(witness) -> bool: the caller's own test
     of the property on the witness (e.g. the classifier of models.modes); a witness must pass

@@ -19,12 +19,14 @@ LPs with the same checks: the ends agree with jobs = 1 to the LPs' tolerance (te
 from __future__ import annotations
 
 import multiprocessing
+from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 
 import numpy as np
 
 from rigidlcp import models
+from rigidlcp.lcp.errors import InvalidInput
 
 from .hull import ZERO
 from .model import DualForceLP, ForceLP, StaticProblem
@@ -87,8 +89,9 @@ def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
     return 2 * len(todo) + 2 * sum(1 for a in todo if prob.mu[a] > 0 and not implicit[a])
 
 
-def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str], contacts,
-              wit: Witnesses, step=None) -> tuple[np.ndarray, np.ndarray, int, int]:
+def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str],
+              contacts: np.ndarray, wit: Witnesses, step: Callable[[int], None] | None = None
+              ) -> tuple[np.ndarray, np.ndarray, int, int]:
     """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S), LPs solved,
     ends that failed their check; wit is updated with every checked optimum. step(n): called
     with the number of ends settled (by LP or filter) after each contact."""
@@ -145,7 +148,7 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
 
 
 def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.ndarray,
-               seen: np.ndarray, contacts) -> tuple[np.ndarray, int]:
+               seen: np.ndarray, contacts: np.ndarray) -> tuple[np.ndarray, int, int]:
     """Whether S = +-mu R with R > 0 is attainable at each of `contacts` (forceset's
     docstring), the LPs solved and their optima that failed a check (in P, and certified by
     their duals on the face: a "no" rests on that bound); hi_R: (c,) max R; seen: (c,)
@@ -180,12 +183,13 @@ def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.n
 
 
 def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
-                   witness: np.ndarray, progress=None, jobs: int = 1) -> Ranges:
+                   witness: np.ndarray,
+                   progress: Callable[[int, int, str], None] | None = None,
+                   jobs: int = 1) -> Ranges:
     """The ranges of every R and S and the sliding contacts (module docstring). witness: a
     checked point of P; lp: a ForceLP of P (built here if None; unused when jobs > 1);
     progress(done, total, "ranges") as the ends are settled."""
-    if jobs < 1:
-        raise ValueError(f"jobs must be >= 1, got {jobs}")
+    check_jobs(jobs)
     c = prob.c
     total, done = lp_count(prob, implicit), 0
 
@@ -203,6 +207,12 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
     lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step)
     sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
     return Ranges(lo, hi, sliding, lps + more, unchecked + bad)
+
+
+def check_jobs(jobs: int) -> None:
+    """Refuse a number of worker processes that is not an integer >= 1 (InvalidInput)."""
+    if isinstance(jobs, bool) or not isinstance(jobs, (int, np.integer)) or jobs < 1:
+        raise InvalidInput(f"jobs must be an integer >= 1, got {jobs!r}")
 
 
 _WORKER: dict = {}

@@ -170,14 +170,16 @@ def _polish(C: sp.csr_matrix, y: np.ndarray) -> np.ndarray:
     return y
 
 
-def _q(x: float):
+def rational(x: float):
+    """x exactly, as a python-flint fmpq (every float is a fraction)."""
     from flint import fmpq  # a dependency (pyproject); imported on first use
 
     f = Fraction(float(x))
     return fmpq(f.numerator, f.denominator)
 
 
-def _small(x: float):
+def small_rational(x: float):
+    """The fraction nearest x with a denominator <= 10^6 (a start for free unknowns)."""
     from flint import fmpq
 
     f = Fraction(float(x)).limit_denominator(10**6)
@@ -188,28 +190,44 @@ def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e
                       ) -> Certificate | None:
     """A rational y near the float y with the nearly active cone rows exactly active, checked
     exactly: C y <= 0 and b . y < 0 for the stored (float) H, b, mu (module docstring)."""
-    from flint import fmpq, fmpq_mat
+    from flint import fmpq
 
     c, mu, m = prob.c, prob.mu, prob.A.shape[0]
     H = sp.coo_matrix(prob.A.T)
     Hq = [[fmpq(0)] * m for _ in range(2 * c)]
     for i, j, v in zip(H.row, H.col, H.data):
-        Hq[int(i)][int(j)] = _q(v)
+        Hq[int(i)][int(j)] = rational(v)
     rows = []  # C exactly: -H_n + mu H_t, then -H_n - mu H_t where mu > 0
     for a in range(c):
-        mq = _q(mu[a])
+        mq = rational(mu[a])
         rows.append([-hn + mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
     for a in np.flatnonzero(mu > 0):
-        mq = _q(mu[a])
+        mq = rational(mu[a])
         rows.append([-hn - mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
-    bq = [_q(v) for v in prob.b]
+    bq = [rational(v) for v in prob.b]
     y = np.asarray(y, dtype=float) / float(np.max(np.abs(y)))
     g = cone_rows(prob) @ y
-    J = np.flatnonzero(g > -active_tol)
-    start = [_small(v) for v in y]
+    found = first_exact(rows, bq, np.flatnonzero(g > -active_tol),
+                        [small_rational(v) for v in y])
+    if found is None:
+        return None
+    cand, work = found
+    yf = np.array([int(v.p) / int(v.q) for v in cand])
+    top = float(np.max(np.abs(yf)))
+    return Certificate(yf / top, np.inf, -(int(work.p) / int(work.q)) / top, exact=True)
+
+
+def first_exact(rows: list[list], bq: list, J: np.ndarray, start: list
+                ) -> tuple[list, object] | None:
+    """The first of two rational candidates, the y with the cone rows J exactly active and
+    its free unknowns at `start` (`_solve_homogeneous`), then `start` itself, that is a
+    Farkas certificate exactly: b . y < 0 and row . y <= 0 for every row (C y <= 0). (y, b . y)
+    as python-flint fmpq's, or None when neither passes."""
+    from flint import fmpq, fmpq_mat
+
     cands = [start]
     if J.size:
-        A = fmpq_mat(len(J), m, [v for j in J for v in rows[int(j)]])
+        A = fmpq_mat(len(J), len(start), [v for j in J for v in rows[int(j)]])
         cands.insert(0, _solve_homogeneous(A, start))
     for cand in cands:
         if cand is None:
@@ -218,10 +236,7 @@ def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e
         if work >= 0:
             continue
         if all(sum((r * yi for r, yi in zip(row, cand)), fmpq(0)) <= 0 for row in rows):
-            yf = np.array([int(v.p) / int(v.q) for v in cand])
-            top = float(np.max(np.abs(yf)))
-            return Certificate(yf / top, np.inf, -(int(work.p) / int(work.q)) / top,
-                               exact=True)
+            return cand, work
     return None
 
 

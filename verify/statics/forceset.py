@@ -33,13 +33,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rigidlcp import models
 
-from .contact_ranges import contact_ranges
+from .contact_ranges import check_jobs, contact_ranges
 from .farkas import Certificate, farkas
 from .hull import dimension, implicit_equalities
 from .local import START_DIAMETERS, scan
@@ -134,11 +135,13 @@ class ForceSet:
         return out
 
 
-def analyse(system: models.System, ranges: bool = True, progress=None,
+def analyse(system: models.System, ranges: bool = True,
+            progress: Callable[[int, int, str], None] | None = None,
             jobs: int = 1) -> ForceSet:
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
     progress(done, total, stage): called as the LPs of the ranges are solved; jobs: worker
     processes for the range LPs (verify.statics.contact_ranges; 1: in this process)."""
+    check_jobs(jobs)  # before any LP
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
     # deposited piles lose their equilibrium locally: small windows first (a few LPs per

@@ -26,6 +26,7 @@ finds none proves nothing (the loss of equilibrium may be global): the caller go
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -34,7 +35,7 @@ import scipy.sparse as sp
 
 from rigidlcp.lcp.quiet import new_highs
 
-from .farkas import cone_rows
+from .farkas import cone_rows, first_exact, rational, small_rational
 from .model import StaticProblem
 
 #: First window side, in largest diameters (the 11 disks of the 3000-disk pile's global
@@ -112,29 +113,13 @@ def window_lp(cone: _Cone, D: np.ndarray) -> tuple[float, np.ndarray | None]:
         h.getSolution().col_value, dtype=float)
 
 
-def _q(x: float):
-    from flint import fmpq  # a dependency (pyproject)
-
-    f = Fraction(float(x))
-    return fmpq(f.numerator, f.denominator)
-
-
-def _small(x: float):
-    from flint import fmpq
-
-    f = Fraction(float(x)).limit_denominator(10**6)
-    return fmpq(f.numerator, f.denominator)
-
-
 def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
                 active_tol: float = 1e-9) -> dict | None:
     """A rational y on the disks D near yD (3|D|: u, v, w blocks), the cone rows yD makes
     nearly active made exactly active, checked exactly: C_D y <= 0 and b_D . y < 0 for the
     stored H, b, mu (module docstring). {column of the full y: Fraction} on D's columns, or
     None when the check fails."""
-    from flint import fmpq, fmpq_mat
-
-    from .farkas import _solve_homogeneous
+    from flint import fmpq
 
     cone = _Cone(prob)
     rows, cols = cone.rows_of(D), cone.cols_of(D)
@@ -146,36 +131,26 @@ def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
     for r in rows:
         a = int(cone.contact[r])
         sign = 1 if r < c else -1
-        mq = _q(mu[a]) * sign
+        mq = rational(mu[a]) * sign
         row = [fmpq(0)] * n
         for k, coef in ((a, fmpq(-1)), (c + a, mq)):
             lo, hi = H.indptr[k], H.indptr[k + 1]
             for col, val in zip(H.indices[lo:hi], H.data[lo:hi]):
                 s = where.get(int(col))
                 if s is not None:
-                    row[s] += coef * _q(val)
+                    row[s] += coef * rational(val)
         exact_rows.append(row)
-    bq = [_q(v) for v in prob.b[cols]]
+    bq = [rational(v) for v in prob.b[cols]]
     scale = float(np.max(np.abs(yD), initial=0.0))
     if scale == 0:
         return None
     yD = yD / scale
     g = cone.C[rows][:, cols] @ yD
-    J = np.flatnonzero(g > -active_tol)
-    start = [_small(v) for v in yD]
-    cands = [start]
-    if J.size:
-        A = fmpq_mat(len(J), n, [v for j in J for v in exact_rows[int(j)]])
-        cands.insert(0, _solve_homogeneous(A, start))
-    for cand in cands:
-        if cand is None:
-            continue
-        work = sum((bi * yi for bi, yi in zip(bq, cand)), fmpq(0))
-        if work >= 0:
-            continue
-        if all(sum((r * yi for r, yi in zip(row, cand)), fmpq(0)) <= 0 for row in exact_rows):
-            return {int(k): Fraction(int(v.p), int(v.q)) for k, v in zip(cols, cand)}
-    return None
+    found = first_exact(exact_rows, bq, np.flatnonzero(g > -active_tol),
+                        [small_rational(v) for v in yD])
+    if found is None:
+        return None
+    return {int(k): Fraction(int(v.p), int(v.q)) for k, v in zip(cols, found[0])}
 
 
 def windows(prob: StaticProblem, side: float) -> list[np.ndarray]:
@@ -203,7 +178,7 @@ def windows(prob: StaticProblem, side: float) -> list[np.ndarray]:
 
 def scan(prob: StaticProblem, start: float = START_DIAMETERS,
          max_disks: int = MAX_WINDOW_DISKS, levels: int | None = None,
-         progress=None) -> LocalCertificate | None:
+         progress: Callable[[int, float], None] | None = None) -> LocalCertificate | None:
     """The first exactly checked local certificate found in the windows (module docstring),
     or None (no claim). start: the first side in largest diameters; levels: how many sides
     (None: until a window holds max_disks disks or the whole packing); progress(windows

@@ -176,3 +176,15 @@ def test_analyse_gives_the_ranges_of_the_primal_simplex_loop(n, seed, mu):
     assert unchecked == 0 and fs.unchecked == 0
     _same(fs.lo, want_lo, scale)
     _same(fs.hi, want_hi, scale)
+
+
+@pytest.mark.parametrize("jobs", [0, -1, 1.5, True, "2"])
+def test_bad_jobs_refused_before_any_lp(jobs):
+    """A number of workers that is not an integer >= 1 is refused by name (InvalidInput,
+    still a ValueError) before any LP, also where the ranges would not be computed."""
+    from rigidlcp.lcp.errors import InvalidInput
+
+    system = models.System(deposit(4, seed=1, radii=(0.8, 1.2), width=4.0))
+    for ranges in (True, False):
+        with pytest.raises(InvalidInput, match="jobs must be an integer >= 1"):
+            analyse(system, ranges=ranges, jobs=jobs)
