@@ -216,13 +216,19 @@ class DualForceLP:
         self.h, self.nw = h, nw
         self.rows = np.arange(nw, dtype=np.int32)
         self.lower = np.full(nw, -highspy.kHighsInf)
+        self.upper = np.zeros(nw)  # the rows' upper bounds as passed (row_upper_ above)
         self.last = self  # which LP gave the last answer
 
     def solve(self, cost: np.ndarray) -> tuple[str, np.ndarray | None]:
         """As ForceLP.solve."""
         h, st = self.h, self.hs.HighsModelStatus
-        h.changeRowsBounds(self.nw, self.rows, self.lower,
-                           self.primal.TT @ np.asarray(cost, dtype=float))
+        upper = self.primal.TT @ np.asarray(cost, dtype=float)
+        if hasattr(h, "changeRowsBounds"):
+            h.changeRowsBounds(self.nw, self.rows, self.lower, upper)
+        else:  # highspy 1.10 (the lowest pyproject allows): one row at a time, changed rows only
+            for i in np.flatnonzero(upper != self.upper):
+                h.changeRowBounds(int(i), -self.hs.kHighsInf, float(upper[i]))
+        self.upper = upper
         h.run()
         if h.getModelStatus() == st.kOptimal:
             self.last = self
