@@ -10,19 +10,61 @@
 /* ------------------------------------------------------------------ one whole problem */
 #include "_balanced.h" /* balanced_units, pow2_near: shared with solvers/_pivot_c.c */
 
-/* T = [M~ / mu, d / delta, q~ / nu] (as `fill`) for the equilibrated data M~ = (M r) c and
- * q~ = q r, rounded as numpy rounds scaling.py's M * r[:, None] * c[None, :] and q * r; r and c
- * are the arrays r, c or, when NULL, the numbers rs, cs; d NULL means ones. Also max|M| and
- * max|q| of the data given. Returns NOT_FINITE when M~ or q~ is not finite, else 0. */
+/* The scales of a filled dictionary (fill_scaled): mu, nu, delta as in `fill`, min q~, max|M|
+ * and max|q| of the data given. */
 typedef struct {
     double mu, nu, delta, qmin, mmax, qmax;
 } Scales;
 
+/* The q~ column of T (unscaled by nu yet): q~ = q r (r NULL: q rs), and nu = max|q~|, qmin =
+ * min q~, qmax = max|q| into S. Returns whether every q~ is finite. */
+static int q_column(idx n, idx ld, double *T, const double *q, const double *r, double rs,
+                    Scales *S)
+{
+    double nu = 0.0, qmax = 0.0, qmin = DBL_MAX;
+    int finite = 1;
+    for (idx i = 0; i < n; i++) {
+        double v = q[i] * (r ? r[i] : rs), a = fabs(v), aq = fabs(q[i]);
+        finite &= a <= DBL_MAX;
+        nu = a > nu ? a : nu;
+        qmin = v < qmin ? v : qmin;
+        qmax = aq > qmax ? aq : qmax;
+        T[i + ld * (n + 1)] = v;
+    }
+    S->nu = nu;
+    S->qmin = qmin;
+    S->qmax = qmax;
+    return finite;
+}
+
+/* The covering column d / delta (d NULL: ones; delta = max d) and q~ / nu (S->nu from
+ * q_column), and the rest of S: the common end of fill_scaled and fill_units_avx2. */
+static void covering_column(idx n, idx ld, double *T, const double *d, double mu, double mmax,
+                            Scales *S)
+{
+    double delta = -1.0 / 0.0, nu = S->nu;
+    for (idx i = 0; i < n; i++) {
+        double di = d ? d[i] : 1.0;
+        if (di > delta) delta = di;
+    }
+    for (idx i = 0; i < n; i++) {
+        T[i + ld * n] = (d ? d[i] : 1.0) / delta;
+        T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
+    }
+    S->mu = mu;
+    S->delta = delta;
+    S->mmax = mmax;
+}
+
+/* T = [M~ / mu, d / delta, q~ / nu] (as `fill`) for the equilibrated data M~ = (M r) c and
+ * q~ = q r, rounded as numpy rounds scaling.py's M * r[:, None] * c[None, :] and q * r; r and c
+ * are the arrays r, c or, when NULL, the numbers rs, cs; d NULL means ones. Also max|M| and
+ * max|q| of the data given. Returns NOT_FINITE when M~ or q~ is not finite, else 0. */
 static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *q,
                        const double *d, const double *r, const double *c, double rs, double cs,
                        Scales *S)
 {
-    double mu = 0.0, nu = 0.0, mmax = 0.0, qmax = 0.0, qmin = DBL_MAX;
+    double mu = 0.0, mmax = 0.0;
     int finite = 1; /* branch-free, as in balanced_units */
     for (idx i = 0; i < n; i++) {
         double ri = r ? r[i] : rs;
@@ -36,33 +78,12 @@ static int fill_scaled(idx n, idx ld, double *T, const double *M, const double *
             T[i + ld * j] = v;
         }
     }
-    for (idx i = 0; i < n; i++) {
-        double v = q[i] * (r ? r[i] : rs), a = fabs(v), aq = fabs(q[i]);
-        finite &= a <= DBL_MAX;
-        nu = a > nu ? a : nu;
-        qmin = v < qmin ? v : qmin;
-        qmax = aq > qmax ? aq : qmax;
-        T[i + ld * (n + 1)] = v;
-    }
+    finite &= q_column(n, ld, T, q, r, rs, S);
     if (!finite) return NOT_FINITE;
     if (mu == 0.0) mu = 1.0;
-    double delta = -1.0 / 0.0;
-    for (idx i = 0; i < n; i++) {
-        double di = d ? d[i] : 1.0;
-        if (di > delta) delta = di;
-    }
     for (idx j = 0; j < n; j++)
         for (idx i = 0; i < n; i++) T[i + ld * j] = T[i + ld * j] / mu;
-    for (idx i = 0; i < n; i++) {
-        T[i + ld * n] = (d ? d[i] : 1.0) / delta;
-        T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
-    }
-    S->mu = mu;
-    S->nu = nu;
-    S->delta = delta;
-    S->qmin = qmin;
-    S->mmax = mmax;
-    S->qmax = qmax;
+    covering_column(n, ld, T, d, mu, mmax, S);
     return 0;
 }
 
@@ -105,32 +126,8 @@ __attribute__((target("avx2"))) static int fill_units_avx2(idx n, idx ld, double
     }
     for (; i < n; i++)
         for (idx j = 0; j < n; j++) T[i + ld * j] = ((M[i * n + j] * rs) * cs) / mu;
-    double nu = 0.0, qmax = 0.0, qmin = DBL_MAX;
-    int finite = 1;
-    for (idx i = 0; i < n; i++) {
-        double v = q[i] * rs, a = fabs(v), aq = fabs(q[i]);
-        finite &= a <= DBL_MAX;
-        nu = a > nu ? a : nu;
-        qmin = v < qmin ? v : qmin;
-        qmax = aq > qmax ? aq : qmax;
-        T[i + ld * (n + 1)] = v;
-    }
-    if (!finite) return NOT_FINITE;
-    double delta = -1.0 / 0.0;
-    for (idx i = 0; i < n; i++) {
-        double di = d ? d[i] : 1.0;
-        if (di > delta) delta = di;
-    }
-    for (idx i = 0; i < n; i++) {
-        T[i + ld * n] = (d ? d[i] : 1.0) / delta;
-        T[i + ld * (n + 1)] = T[i + ld * (n + 1)] / nu;
-    }
-    S->mu = mu;
-    S->nu = nu;
-    S->delta = delta;
-    S->qmin = qmin;
-    S->mmax = top;
-    S->qmax = qmax;
+    if (!q_column(n, ld, T, q, NULL, rs, S)) return NOT_FINITE;
+    covering_column(n, ld, T, d, mu, top, S);
     return 0;
 }
 #endif
