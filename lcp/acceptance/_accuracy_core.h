@@ -174,12 +174,7 @@ static double abs_inv_norm(idx m, const double *A, const idx *perm, const double
 static double skeel_bound(idx m, const double *A, const idx *perm, const double *b, double *x)
 {
     memcpy(x, b, (size_t)m * sizeof(double));
-    for (idx k = 0; k < m; k++)
-        if (perm[k] != k) {
-            double t = x[k];
-            x[k] = x[perm[k]];
-            x[perm[k]] = t;
-        }
+    permute(m, perm, x);
     /* C(L)^-1: x[i] += |A[i, j]| x[j] for j = 0, ..., i - 1 in this order; four rows at once
      * as lu_solve's L (the same numbers, sooner) */
     idx i = 0;

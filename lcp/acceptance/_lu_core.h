@@ -70,16 +70,23 @@ static int lu(idx m, double *A, idx *perm)
     return (m > 0 && !(umin > (double)m * DBL_EPSILON * umax)) ? -1 : 0;
 }
 
+/* x <- P x for the row interchanges `perm` of `lu` (x[k] and x[perm[k]] swapped for k = 0, 1,
+ * ..., m - 1 in this order): the first step of a solve with the factors. */
+static void permute(idx m, const idx *perm, double *x)
+{
+    for (idx k = 0; k < m; k++)
+        if (perm[k] != k) {
+            double t = x[k];
+            x[k] = x[perm[k]];
+            x[perm[k]] = t;
+        }
+}
+
 /* x <- K^-1 x (trans = 0) or K^-T x (trans = 1) from the LU of `lu`. */
 static void lu_solve(idx m, const double *A, const idx *perm, double *x, int trans)
 {
     if (!trans) {
-        for (idx k = 0; k < m; k++)
-            if (perm[k] != k) {
-                double t = x[k];
-                x[k] = x[perm[k]];
-                x[perm[k]] = t;
-            }
+        permute(m, perm, x);
         /* L (unit): x[i] -= A[i, j] x[j] for j = 0, 1, ..., i - 1 in this order; four rows
          * at once, each row's subtractions in that same order (the same numbers, sooner) */
         idx i = 0;
