@@ -1,5 +1,5 @@
 /* The Python side of one dictionary (included by lcp/_lemke_c.c): the buffer checks of the
- * arguments (get_buffer, opt_vector, release, problem_data) and the entry points of lcp/_lemke_kernel.py and
+ * arguments (opt_vector, release, problem_data; get_buffer from _buffer.h) and the entry points of lcp/_lemke_kernel.py and
  * lcp.LCP that work on one dictionary or on the data as given: run, setup, check, plain. The
  * includer includes <Python.h>, <float.h>, <math.h>, acceptance/_accuracy_core.h
  * (abs_max_finite) and _lemke_run.h. */
@@ -7,24 +7,7 @@
 #define RIGIDLCP_LEMKE_PY_H
 
 /* ------------------------------------------------------------------ Python binding */
-static int get_buffer(PyObject *obj, Py_buffer *view, const char *name, char kind, idx size,
-                      int fortran)
-{
-    int flags = PyBUF_WRITABLE | PyBUF_FORMAT | (fortran ? PyBUF_F_CONTIGUOUS : PyBUF_C_CONTIGUOUS);
-    if (PyObject_GetBuffer(obj, view, flags) < 0) return -1;
-    const char *f = view->format ? view->format : "B";
-    if (*f == '<' || *f == '=' || *f == '@') f++;
-    int ok = view->itemsize == 8 &&
-             (kind == 'd' ? (f[0] == 'd' && f[1] == 0)
-                          : ((f[0] == 'l' || f[0] == 'q') && f[1] == 0));
-    if (!ok || view->len / 8 != size) {
-        PyErr_Format(PyExc_ValueError, "%s: expected %zd %s values", name, size,
-                     kind == 'd' ? "float64" : "int64");
-        PyBuffer_Release(view);
-        return -1;
-    }
-    return 0;
-}
+#include "_buffer.h" /* get_buffer: shared with solvers/_pivot_c.c */
 
 static PyObject *py_run(PyObject *self, PyObject *args)
 {

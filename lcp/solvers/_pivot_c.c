@@ -235,22 +235,7 @@ static int block_loop(const Ctx *C, Basis *B, Basis *trial, const double *absM, 
     }
 }
 
-static int get_buffer(PyObject *obj, Py_buffer *view, const char *name, char kind, idx size)
-{
-    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0)
-        return -1;
-    const char *f = view->format ? view->format : "B";
-    if (*f == '<' || *f == '=' || *f == '@') f++;
-    int ok = view->itemsize == 8 && (kind == 'd' ? (f[0] == 'd' && f[1] == 0)
-                                                 : ((f[0] == 'l' || f[0] == 'q') && f[1] == 0));
-    if (!ok || view->len / 8 != size) {
-        PyErr_Format(PyExc_ValueError, "%s: expected %zd %s values", name, size,
-                     kind == 'd' ? "float64" : "int64");
-        PyBuffer_Release(view);
-        return -1;
-    }
-    return 0;
-}
+#include "../_buffer.h" /* get_buffer: shared with _lemke_c.c */
 
 static int get_input(PyObject *obj, Py_buffer *view, const char *name, idx size)
 {
@@ -386,8 +371,8 @@ static PyObject *py_solve(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_ValueError, "M, q: arrays");
         goto done;
     }
-    if (get_buffer(oz, &vz, "z", 'd', n) < 0) goto done;
-    if (get_buffer(ob, &vb, "basis", 'q', n) < 0) goto done;
+    if (get_buffer(oz, &vz, "z", 'd', n, 0) < 0) goto done;
+    if (get_buffer(ob, &vb, "basis", 'q', n, 0) < 0) goto done;
     long long it = 0, flips = 0;
     idx nb = 0;
     double bound[3] = {0.0, 0.0, 0.0};
@@ -429,7 +414,7 @@ static PyObject *py_matvec(PyObject *self, PyObject *args)
         release(&vA);
         return NULL;
     }
-    if (get_buffer(oy, &vy, "y", 'd', n) < 0) {
+    if (get_buffer(oy, &vy, "y", 'd', n, 0) < 0) {
         release(&vx);
         release(&vA);
         return NULL;
