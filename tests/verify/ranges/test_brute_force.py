@@ -15,65 +15,21 @@ import pytest
 from scipy.optimize import linprog
 
 from rigidlcp import lcp, models
-from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.lattice import PLANE
 from rigidlcp.verify.ranges import event_ranges, steady_ranges
 from rigidlcp.verify.ranges.event import event_observables
 
 
-def _steady_brute(system: models.System, sense: int) -> tuple[str, float]:
-    """("optimal", value) / ("unbounded", inf) of sense * mu_g over every valid steady state."""
-    dyn = Dynamics(system)
-    c, p, mu = system.c, system.p, system.mu
-    H = dyn.H.toarray()
-    Minv, f = dyn.Minv, dyn.f
-    acc = Minv[:, None] * H.T  # nu' = acc @ x + Minv f
-    a_rel = H @ acc  # a = a_rel x + H Minv f + u_obs'
-    a0 = H @ (Minv * f) + dyn.u_obs_dot
-    Tw = H[c:, 2 * p:]  # v_t = Tw omega + TV V
-    TV = dyn.u_obs(1.0)[c:]
-    fr = np.flatnonzero(mu > 0)
+def _steady_brute(state_lps, system: models.System, sense: int) -> tuple[str, float]:
+    """("optimal", value) / ("unbounded", inf) of sense * mu_g over every valid steady state:
+    the least of the force LPs of every state set the velocities admit (conftest)."""
+    c = system.c
     g = np.zeros(2 * c)
     g[c + np.flatnonzero(system.lattice.j == PLANE)] = 1.0 / (system.total_mass * system.g)
     best = None
-    for states in itertools.product((1, -1, 0), repeat=fr.size):
-        s = np.zeros(c, dtype=int)
-        s[fr] = states
-        # velocities: s v_t >= 1 (sliding), v_t = 0 (non-sliding); V free (gamma != 0)
-        sl, ns = fr[s[fr] != 0], fr[s[fr] == 0]
-        T = np.column_stack([Tw, TV])
-        kin = linprog(np.zeros(p + 1), A_ub=-(s[sl][:, None] * T[sl]) if sl.size else None,
-                      b_ub=-np.ones(sl.size) if sl.size else None,
-                      A_eq=T[ns] if ns.size else None, b_eq=np.zeros(ns.size) if ns.size else None,
-                      bounds=[(None, None)] * (p + 1), method="highs")
-        if kin.status != 0:
-            continue
-        # forces: no translation, a_n = 0, Coulomb, the states' laws
-        eq = [acc[:2 * p], a_rel[:c]]
-        eq_b = [-(Minv * f)[:2 * p], -a0[:c]]
-        ub, ub_b = [], []
-        for al in range(c):
-            if mu[al] == 0:
-                continue
-            row = np.zeros(2 * c)
-            if s[al] != 0:
-                row[c + al], row[al] = 1.0, s[al] * mu[al]
-                eq.append(row[None])
-                eq_b.append([0.0])
-                ub.append(-s[al] * a_rel[c + al])
-                ub_b.append(s[al] * a0[c + al])
-            else:
-                eq.append(a_rel[c + al][None])
-                eq_b.append([-a0[c + al]])
-                for sg in (1, -1):
-                    row = np.zeros(2 * c)
-                    row[c + al], row[al] = sg, -mu[al]
-                    ub.append(row)
-                    ub_b.append(0.0)
-        bounds = [(0, None)] * c + [(None, None) if m > 0 else (0, 0) for m in mu]
-        r = linprog(sense * g, A_ub=np.array(ub) if ub else None, b_ub=ub_b if ub else None,
-                    A_eq=np.vstack(eq), b_eq=np.concatenate(eq_b), bounds=bounds,
-                    method="highs", options={"primal_feasibility_tolerance": 1e-10})
+    for _, lp in state_lps(system):
+        r = linprog(sense * g, **lp, method="highs",
+                    options={"primal_feasibility_tolerance": 1e-10})
         if r.status == 3:
             return "unbounded", np.inf
         if r.status == 0 and (best is None or r.fun < best):
@@ -87,12 +43,12 @@ def _steady_brute(system: models.System, sense: int) -> tuple[str, float]:
     (2, 0.3, 0.1, 0.0, 0.15),
     (3, 0.05, 0.1, 0.0, 0.02),
 ])
-def test_steady_mu_g_range_equals_enumeration(lx, mu_pp, mu_plane, mu_wall, gamma):
+def test_steady_mu_g_range_equals_enumeration(state_lps, lx, mu_pp, mu_plane, mu_wall, gamma):
     s = models.System(models.rectangular(lx, 1), mu_pp=mu_pp, mu_plane=mu_plane,
                       mu_wall=mu_wall, gamma=gamma)
     res = steady_ranges(s, time_limit=30)
     for end, sense in ((res.mu_g.lo, 1), (res.mu_g.hi, -1)):
-        status, value = _steady_brute(s, sense)
+        status, value = _steady_brute(state_lps, s, sense)
         assert end.status == status
         if status == "optimal":
             assert end.value == pytest.approx(value, abs=1e-9)

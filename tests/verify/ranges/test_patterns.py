@@ -6,8 +6,6 @@ each)."""
 
 from __future__ import annotations
 
-import itertools
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -15,7 +13,6 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from rigidlcp import models
-from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.lattice import PLANE
 from rigidlcp.verify.ranges.patterns import (
     FOUND,
@@ -125,52 +122,11 @@ def test_rough_walls_answers_within_the_box_only():
 # -- brute force: every tangential state set of a small array -----------------------------------
 
 
-def _admitted(system: models.System) -> list[np.ndarray]:
+def _admitted(state_lps, system: models.System) -> list[np.ndarray]:
     """Every state set in {+1, -1, 0}^F that some valid steady state has: velocities with
-    those signs (V free) and forces with the laws (docs/mechanics.md), LPs built here."""
-    dyn = Dynamics(system)
-    c, p, mu = system.c, system.p, system.mu
-    H = dyn.H.toarray()
-    acc = dyn.Minv[:, None] * H.T
-    a_rel, a0 = H @ acc, H @ (dyn.Minv * dyn.f) + dyn.u_obs_dot
-    T = np.column_stack([H[c:, 2 * p:], dyn.u_obs(1.0)[c:]])
-    fr = np.flatnonzero(mu > 0)
-    out = []
-    for states in itertools.product((1, -1, 0), repeat=fr.size):
-        s = np.zeros(c, dtype=int)
-        s[fr] = states
-        sl, ns = fr[s[fr] != 0], fr[s[fr] == 0]
-        kin = linprog(np.zeros(p + 1), A_ub=-(s[sl][:, None] * T[sl]) if sl.size else None,
-                      b_ub=-np.ones(sl.size) if sl.size else None,
-                      A_eq=T[ns] if ns.size else None, b_eq=np.zeros(ns.size) if ns.size else None,
-                      bounds=[(None, None)] * (p + 1), method="highs")
-        if kin.status != 0:
-            continue
-        eq, eq_b = [acc[:2 * p], a_rel[:c]], [-(dyn.Minv * dyn.f)[:2 * p], -a0[:c]]
-        ub, ub_b = [], []
-        for al in fr:
-            row = np.zeros(2 * c)
-            if s[al]:
-                row[c + al], row[al] = 1.0, s[al] * mu[al]
-                eq += [row[None]]
-                eq_b += [[0.0]]
-                ub.append(-s[al] * a_rel[c + al])
-                ub_b.append(s[al] * a0[c + al])
-            else:
-                eq += [a_rel[c + al][None]]
-                eq_b += [[-a0[c + al]]]
-                for sg in (1, -1):
-                    row = np.zeros(2 * c)
-                    row[c + al], row[al] = sg, -mu[al]
-                    ub.append(row)
-                    ub_b.append(0.0)
-        bounds = [(0, None)] * c + [(None, None) if m > 0 else (0, 0) for m in mu]
-        f = linprog(np.zeros(2 * c), A_ub=np.array(ub) if ub else None, b_ub=ub_b or None,
-                    A_eq=np.vstack(eq), b_eq=np.concatenate(eq_b), bounds=bounds,
-                    method="highs")
-        if f.status in (0, 3):
-            out.append(s)
-    return out
+    those signs (V free) and forces with the laws (docs/mechanics.md; conftest's LPs)."""
+    return [s for s, lp in state_lps(system)
+            if linprog(np.zeros(2 * system.c), **lp, method="highs").status in (0, 3)]
 
 
 SYSTEMS = [((2, 2), dict(mu_pp=0.1, mu_plane=0.2, gamma=0.1)),
@@ -178,22 +134,22 @@ SYSTEMS = [((2, 2), dict(mu_pp=0.1, mu_plane=0.2, gamma=0.1)),
 _CACHE: dict[int, tuple] = {}
 
 
-def _system(k: int):
+def _system(state_lps, k: int):
     if k not in _CACHE:
         size, mu = SYSTEMS[k]
         s = models.System(models.rectangular(*size), mu_wall=0.0, **mu)
-        _CACHE[k] = (s, _admitted(s))
+        _CACHE[k] = (s, _admitted(state_lps, s))
     return _CACHE[k]
 
 
 @pytest.mark.slow
 @settings(max_examples=12, deadline=None)
 @given(k=st.integers(0, len(SYSTEMS) - 1), data=st.data())
-def test_state_patterns_agree_with_brute_force(k, data):
+def test_state_patterns_agree_with_brute_force(state_lps, k, data):
     """A random pattern of states (some contacts fixed to a state, one "some of these slide"
     clause): feasible iff some admitted state set matches it; every witness is valid
     (steady_check) and has the states asked."""
-    s, admitted = _system(k)
+    s, admitted = _system(state_lps, k)
     fr = [int(a) for a in np.flatnonzero(s.mu > 0)]
     fixed = data.draw(st.dictionaries(st.sampled_from(fr), st.sampled_from((1, -1, 0)),
                                       max_size=3))

@@ -1,0 +1,67 @@
+"""The brute force over tangential state sets that test_brute_force and test_patterns share,
+written independently of the code under test (docs/mechanics.md's definition, LPs built
+here): a fixture, since test modules do not import each other."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from rigidlcp import models
+from rigidlcp.models.dynamics import Dynamics
+
+
+def state_set_lps(system: models.System):
+    """For every state set s in {+1, -1, 0}^F (F: the frictional contacts) that velocities admit
+    (s v_t >= 1 sliding, v_t = 0 non-sliding, V free: gamma != 0), the force LP of its valid
+    steady states: (s, dict of linprog's A_ub, b_ub, A_eq, b_eq, bounds over x = [R; S]) with
+    no translation, a_n = 0, Coulomb and the states' laws."""
+    dyn = Dynamics(system)
+    c, p, mu = system.c, system.p, system.mu
+    H = dyn.H.toarray()
+    Minv, f = dyn.Minv, dyn.f
+    acc = Minv[:, None] * H.T  # nu' = acc @ x + Minv f
+    a_rel = H @ acc  # a = a_rel x + H Minv f + u_obs'
+    a0 = H @ (Minv * f) + dyn.u_obs_dot
+    T = np.column_stack([H[c:, 2 * p:], dyn.u_obs(1.0)[c:]])  # v_t = T [omega; V]
+    fr = np.flatnonzero(mu > 0)
+    bounds = [(0, None)] * c + [(None, None) if m > 0 else (0, 0) for m in mu]
+    for states in itertools.product((1, -1, 0), repeat=fr.size):
+        s = np.zeros(c, dtype=int)
+        s[fr] = states
+        sl, ns = fr[s[fr] != 0], fr[s[fr] == 0]
+        kin = linprog(np.zeros(p + 1), A_ub=-(s[sl][:, None] * T[sl]) if sl.size else None,
+                      b_ub=-np.ones(sl.size) if sl.size else None,
+                      A_eq=T[ns] if ns.size else None, b_eq=np.zeros(ns.size) if ns.size else None,
+                      bounds=[(None, None)] * (p + 1), method="highs")
+        if kin.status != 0:
+            continue
+        eq, eq_b = [acc[:2 * p], a_rel[:c]], [-(Minv * f)[:2 * p], -a0[:c]]
+        ub, ub_b = [], []
+        for al in fr:
+            row = np.zeros(2 * c)
+            if s[al]:
+                row[c + al], row[al] = 1.0, s[al] * mu[al]
+                eq.append(row[None])
+                eq_b.append([0.0])
+                ub.append(-s[al] * a_rel[c + al])
+                ub_b.append(s[al] * a0[c + al])
+            else:
+                eq.append(a_rel[c + al][None])
+                eq_b.append([-a0[c + al]])
+                for sg in (1, -1):
+                    row = np.zeros(2 * c)
+                    row[c + al], row[al] = sg, -mu[al]
+                    ub.append(row)
+                    ub_b.append(0.0)
+        yield s, dict(A_ub=np.array(ub) if ub else None, b_ub=ub_b if ub else None,
+                      A_eq=np.vstack(eq), b_eq=np.concatenate(eq_b), bounds=bounds)
+
+
+@pytest.fixture(scope="session")
+def state_lps():
+    """state_set_lps, for the tests."""
+    return state_set_lps
