@@ -219,6 +219,7 @@ def cmd_simulate(args) -> int:
               f"{summary['regime_note']}", file=sys.stderr)
     if run.status == "detachment" and run.final is not None:
         summary["detachment_check"] = detachment_check(system, run.final)
+    summary["selection"] = args.select
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
@@ -234,7 +235,8 @@ def cmd_simulate(args) -> int:
         if run.records:
             last = run.last
             counts = state_counts(system, last)
-            rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{summary['mu_g']:.6f}"),
+            rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{summary['mu_g']:.6f}"
+                      + selection_note(args.select, run.status, args.out)),
                      ("F_g", f"{summary['F_g']:.6f}"),
                      ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"),
                      ("dD/dt", f"{summary['dissipation_rate_slope']:.6g}"),
@@ -252,6 +254,15 @@ def cmd_simulate(args) -> int:
         for k, v in rows:
             print(f"  {k:<{width}}  {v}")
     return 0 if run.status in ("steady", "time_limit", "event_limit") else 1
+
+
+def selection_note(rule: str, status: str, out: str | None) -> str:
+    """What mu_g is: one point of a set where an event's solution is not unique, picked by the
+    selection rule; for a steady run, where its range over all valid steady states is."""
+    if status != "steady":
+        return f"  (selection {rule})"
+    return (f"  (one valid steady state, selection {rule}; over all of them: "
+            f"rigidlcp ranges {out or 'RUN.npz'})")
 
 
 def title(lat) -> str:

@@ -15,6 +15,9 @@ def test_simulate_then_plot(tmp_path, capsys):
                  "--out", str(out), "--no-progress"])
     text = capsys.readouterr().out
     assert code == 0 and "steady" in text and "mu_g" in text
+    # mu_g is named as one point of the set, with the rule and where its range is
+    assert f"one valid steady state, selection face-min-norm; over all of them: rigidlcp " \
+        f"ranges {out}" in text
     run = load_run(out)
     assert run.steady and run.n_events > 1
     code = main(["plot", str(out), "--out", str(tmp_path / "fig")])
@@ -29,7 +32,7 @@ def test_simulate_json_and_dump(tmp_path, capsys):
                  "--max-events", "3", "--json", "--no-progress",
                  "--dump-problems", str(tmp_path / "dump")])
     summary = json.loads(capsys.readouterr().out)
-    assert code == 0 and summary["events"] == 3
+    assert code == 0 and summary["events"] == 3 and summary["selection"] == "face-min-norm"
     assert len(list((tmp_path / "dump").glob("event_*.npz"))) == 3
 
 
