@@ -27,11 +27,15 @@ from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .kinematics import realizable
+from .proportional import exact
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
-from .steady import Formulation, states_of
+from .steady import Formulation, states_of, velocity_box
 
 #: Contact-state sets kept as seeds (MilpModel.add_seed).
 MAX_SEEDS = 10
+#: "lazy-a_t": a_t counts as 0 within this times max(|gamma|, g) (a larger set of contacts
+#: asked only makes the check stricter; its cuts stay valid).
+AT_ZERO = 1e-7
 
 
 def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,
@@ -82,17 +86,26 @@ class MilpModel:
     velocities do not admit is cut off (the states of its negative cycle cannot all hold) and
     the MILP solved again, until the optimum's states are admitted: then it is the optimum
     over every valid steady state. "big-M": the velocity rows stay (module steady).
-    "proportional": no velocity column and no velocity row (verify.ranges.proportional: where
-    `proportional.exact` holds, the forces of this MILP are those of every valid steady
-    state, a point's velocities are (alpha, gamma) t, so no cut is needed); columns and
-    points keep the Formulation's layout outside (the velocity entries 0)."""
+    "lazy-a_t": as "lazy", but a point's states are checked only on the contacts with a_t =
+    0 there, V free (exact where proportional.exact holds and gamma != 0: with (omega, V) =
+    (alpha, gamma) t + (omega', V') and t large, a contact with a_t != 0 slides the way it
+    accelerates whatever (omega', V'), which need only give the states with a_t = 0;
+    docs/mechanics.md). "proportional": no velocity column and no velocity row
+    (verify.ranges.proportional: where `proportional.exact` holds, the forces of this MILP
+    are those of every valid steady state, a point's velocities are (alpha, gamma) t, so no
+    cut is needed); columns and points keep the Formulation's layout outside (the velocity
+    entries 0)."""
 
     def __init__(self, form: Formulation, kinematics: str = "lazy"):
         import highspy
 
-        if kinematics not in ("lazy", "big-M", "proportional"):
-            raise ValueError("kinematics must be 'lazy', 'big-M' or 'proportional', got "
-                             f"{kinematics!r}")
+        if kinematics not in ("lazy", "lazy-a_t", "big-M", "proportional"):
+            raise ValueError("kinematics must be 'lazy', 'lazy-a_t', 'big-M' or "
+                             f"'proportional', got {kinematics!r}")
+        self.at_only = kinematics == "lazy-a_t"
+        if self.at_only and not (form.system.gamma != 0 and exact(form)):
+            raise ValueError("kinematics 'lazy-a_t' needs gamma != 0 and V = gamma t admitted")
+        kinematics = "lazy" if self.at_only else kinematics
         c, p = form.system.c, form.system.p
         self.proportional = kinematics == "proportional"
         self.n = form.A.shape[1]  # the Formulation's layout (costs, points, starts)
@@ -202,12 +215,24 @@ class MilpModel:
             if x is None:
                 return st, None
             s = states_of(self.form, x)
-            ok, info = realizable(self.form, s)
+            ok, info = realizable(self.form, s, *self._asked(x))
             if ok:
                 return st, x
             self.cut(s, info)
             if st != OPTIMAL:
                 return st, None
+
+    def _asked(self, x: np.ndarray) -> tuple[np.ndarray | None, bool]:
+        """(contacts whose states the velocities must give, V free) at the point x: all and
+        V as the formulation's, or ("lazy-a_t") those with |a_t| <= AT_ZERO max(|gamma|, g),
+        V free."""
+        if not self.at_only:
+            return None, False
+        f = self.form
+        c, p = f.system.c, f.system.p
+        T_u, T_V, _ = velocity_box(f.dyn)
+        at = T_u @ x[2 * c:2 * c + p] + T_V * f.system.gamma
+        return np.abs(at) <= AT_ZERO * max(abs(f.system.gamma), f.system.g), True
 
     def _solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
                ) -> tuple[str, np.ndarray | None]:

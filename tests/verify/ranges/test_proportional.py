@@ -270,3 +270,52 @@ def test_every_point_of_Q_is_a_valid_steady_state(gamma, mu_pp, mu_plane, lx):
         alpha = _alpha_rows(s) @ r.x
         v_scale = max(float(np.sqrt(s.g * s.lattice.radius)), gamma)
         assert steady_check(s, alpha, gamma, R, S, None, v_scale)[0] <= 1e-8
+
+
+# -- pattern questions: states checked only where a_t = 0 ------------------------------------
+
+
+def _admitted(state_lps, system: models.System) -> list[np.ndarray]:
+    """Every state set some valid steady state has (conftest's velocity and force LPs)."""
+    return [s for s, lp in state_lps(system)
+            if linprog(np.zeros(2 * system.c), **lp, method="highs").status in (0, 3)]
+
+
+@pytest.mark.parametrize("size, mu, gamma", [((2, 2), (0.1, 0.2), 0.1),
+                                             ((3, 1), (0.3, 0.1), -0.05)])
+def test_patterns_checked_where_a_t_is_zero_equal_brute_force(state_lps, size, mu, gamma):
+    """find_state with the kinematics asked only on the contacts with a_t = 0 ("lazy-a_t")
+    answers as the brute force over every admitted state set, and as the full lazy check,
+    for every contact fixed to each state and for deterministic pairs of fixed contacts."""
+    from rigidlcp.verify.ranges.patterns import FOUND, Lit, Pattern, find_state, non_sliding
+
+    s = models.System(models.rectangular(*size), mu_pp=mu[0], mu_plane=mu[1], mu_wall=0.0,
+                      gamma=gamma)
+    admitted = _admitted(state_lps, s)
+    fr = [int(a) for a in np.flatnonzero(s.mu > 0)]
+    rng = np.random.default_rng(7)
+    asks = [{a: v} for a in fr for v in (1, -1, 0)]
+    asks += [dict(zip(rng.choice(fr, 2, replace=False).tolist(),
+                      rng.choice([1, -1, 0], 2).tolist())) for _ in range(8)]
+    form = formulate(s)
+    for fixed in asks:
+        P = Pattern()
+        for a, v in fixed.items():
+            P.all_of([Lit((({1: "y+", -1: "y-"}[v], a, 1.0),), lo=1.0)] if v else
+                     [non_sliding(a)])
+        want = any(all(t[a] == v for a, v in fixed.items()) for t in admitted)
+        for kin in ("lazy-a_t", "lazy"):
+            res = find_state(form, P, time_limit=30, kinematics=kin)
+            assert res.status == (FOUND if want else "infeasible"), (fixed, kin, res)
+            if want:
+                assert res.witness.residual <= 1e-8
+                assert all(res.witness.s[a] == v for a, v in fixed.items())
+
+
+def test_lazy_a_t_refused_where_not_exact():
+    from rigidlcp.verify.ranges.milp import MilpModel
+
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.0, V0=1.0)
+    with pytest.raises(ValueError, match="lazy-a_t"):
+        MilpModel(formulate(s), "lazy-a_t")
