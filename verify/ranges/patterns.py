@@ -51,10 +51,8 @@ from .milp import MilpModel
 from .proportional import exact as proportional_exact
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
 from .steady import Formulation, formulate, state_velocities, states_of
-from .witness import SteadyWitness, make_witness
+from .witness import WITNESS_TOL, SteadyWitness, make_witness
 
-#: A witness is accepted when its independent residual is at most this (as steady_ranges).
-WITNESS_TOL = 1e-8
 FOUND = "feasible"
 KINDS = ("R", "S", "ra", "sl", "y+", "y-")
 
@@ -349,6 +347,9 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
     if kinematics == "auto":
         kinematics = ("lazy-a_t" if form.system.gamma != 0 and proportional_exact(form)
                       else "lazy")
+    elif kinematics == "proportional":  # its binaries are a_t's signs, not contact states
+        raise ValueError("find_state asks contact states: kinematics 'lazy-a_t', 'lazy' or "
+                         "'big-M', not 'proportional'")
     for tighten in (False, True):
         if tighten and not any(lit.strict and lit.margin > 0 for lit in pattern.literals()):
             break

@@ -2,9 +2,11 @@
 observable) over every valid steady state of a system (verify.ranges.steady), each end with a
 witness state checked against the laws by verify.ranges.witness.steady_check.
 
-An end is found by the MILP of verify.ranges.steady; its contact states are then fixed and the
-extreme recomputed by a linear program over the forces of those states, without the force box
-(the witness), and the velocities by a second one. The MILP's own point is never the witness.
+An end is found by the MILP of verify.ranges.steady (by default without velocities:
+verify.ranges.proportional); its states are then fixed and the extreme recomputed by a linear
+program over the forces of those states, without the force box (the witness), which moves at
+(omega, V) = (alpha, gamma) t (where that reduction is not exact: velocities by a second linear
+program). The MILP's own point is never the witness.
 """
 
 from __future__ import annotations
