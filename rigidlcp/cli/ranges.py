@@ -1,7 +1,7 @@
-"""`rigidlcp ranges RUN.npz [--json]`: the range of mu_g (and of every angular acceleration, R,
-S) over every valid steady state of a steady run's system (rigidlcp.verify.ranges), with a
-witness state at each end, beside the run's own value and the range over its own contact
-states."""
+"""`rigidlcp ranges RUN.npz [--json] [--deep S]`: the range of mu_g (and of every angular
+acceleration, R, S) over every valid steady state of a steady run's system
+(rigidlcp.verify.ranges), with a witness state at each end, beside the run's own value and the
+range over its own contact states."""
 
 from __future__ import annotations
 
@@ -19,7 +19,9 @@ def register(sub) -> None:
         "witness state checked against the laws; beside it, the range over the run's own "
         "contact states. An end stopped by --time-limit is reported as 'time limit' with the "
         "value met, never as the end itself; where a case split on the plane contacts proves "
-        "a bound on it (verify.ranges.cap_split), the bound is added ('bounds' in the JSON).")
+        "a bound on it (verify.ranges.cap_split; with --deep S also the case split on the "
+        "disks' cap states, verify.ranges.disk_split, S seconds per open end), the bound is "
+        "added ('bounds' in the JSON).")
     p.add_argument("run", help="a run file (RUN.npz, with its RUN.json)")
     p.add_argument("--observables", choices=("mu_g", "alpha", "all"), default="alpha",
                    help="mu_g only; mu_g and every angular acceleration (default); also "
@@ -28,6 +30,9 @@ def register(sub) -> None:
                    help="seconds of MILP per end (default 10)")
     p.add_argument("--box", type=float, default=None,
                    help="force box R <= BOX when no bound is proved (default 10 m_g g)")
+    p.add_argument("--deep", type=float, default=None, metavar="S",
+                   help="also the case split on the disks' cap states (verify.ranges."
+                   "disk_split), S seconds per end left open: a better proved bound")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.set_defaults(func=cmd_ranges)
 
@@ -42,6 +47,8 @@ def cmd_ranges(args: argparse.Namespace) -> int:
         raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
     if args.box is not None and not args.box > 0:
         raise ValueError(f"--box must be > 0, got {args.box}")
+    if args.deep is not None and not 0 < args.deep < float("inf"):
+        raise ValueError(f"--deep must be a number of seconds > 0, got {args.deep}")
     run = load_run(args.run)
     if run.status != "steady":  # the library's refusal offers a Python-only way out
         raise InvalidInput(f"{args.run}: the run ended {run.status!r} ({run.message}), not in "
@@ -52,7 +59,7 @@ def cmd_ranges(args: argparse.Namespace) -> int:
         _warn_long(run.system, args)  # else refused in one line below, without the note
     try:
         result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
-                               box=args.box)
+                               box=args.box, split=True if args.deep is None else args.deep)
     except NoVelocityBound as exc:
         raise NoVelocityBound(f"{args.run}: {unit_forms_note(run.system.lattice)} ({exc})"
                               ) from None

@@ -51,7 +51,27 @@ def test_table(runs, capsys):
     assert "mu_g" in out and "own states" in out
 
 
-@pytest.mark.parametrize("case", ["missing", "not_steady", "other_kind", "bad_limit"])
+def test_deep_runs_the_disk_split_on_an_open_end(runs, capsys):
+    """--deep S: the minimum of mu_g, left open by a MILP stopped at once (time limit 1e-9 s:
+    only the cap split's bound without --deep), is decided by disk_split's case split: the
+    value of the MILP given its time."""
+    _, _, path, _ = runs
+    base = ["ranges", str(path), "--observables", "mu_g", "--json"]
+    assert main(base) == 0
+    full = json.loads(capsys.readouterr().out)["steady"]
+    assert main(base + ["--time-limit", "1e-9"]) == 0
+    open_ = json.loads(capsys.readouterr().out)["steady"]
+    assert open_["status"]["mu_g"][0] == "time limit" and open_["mu_g"][0] is None
+    assert open_["bounds"]["mu_g"][0] < full["mu_g"][0]
+    assert main(base + ["--time-limit", "1e-9", "--deep", "5"]) == 0
+    deep = json.loads(capsys.readouterr().out)["steady"]
+    assert deep["status"]["mu_g"][0] == "optimal"
+    assert deep["mu_g"][0] == pytest.approx(full["mu_g"][0], abs=1e-9)
+    assert deep["bounds"]["mu_g"][0] == deep["mu_g"][0]
+
+
+@pytest.mark.parametrize("case", ["missing", "not_steady", "other_kind", "bad_limit",
+                                  "deep_zero", "deep_nan"])
 def test_bad_input_one_line_exit_2(runs, case, tmp_path, capsys):
     _, _, path, short = runs
     other = tmp_path / "x.npz"
@@ -59,7 +79,9 @@ def test_bad_input_one_line_exit_2(runs, case, tmp_path, capsys):
     argv = {"missing": ["ranges", str(tmp_path / "none.npz")],
             "not_steady": ["ranges", str(short)],
             "other_kind": ["ranges", str(other)],
-            "bad_limit": ["ranges", str(path), "--time-limit", "0"]}[case]
+            "bad_limit": ["ranges", str(path), "--time-limit", "0"],
+            "deep_zero": ["ranges", str(path), "--deep", "0"],
+            "deep_nan": ["ranges", str(path), "--deep", "nan"]}[case]
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("rigidlcp ranges: error:") and "\n" not in err

@@ -20,9 +20,11 @@ import numpy as np
 from .steady import Formulation, velocity_box
 
 
-def _edges(form: Formulation, s: np.ndarray) -> list[tuple[int, int, float, int]]:
+def _edges(form: Formulation, s: np.ndarray, only: np.ndarray | None = None,
+           V_free: bool = False) -> list[tuple[int, int, float, int]]:
     """(from, to, weight, contact or -1) of the doubled graph; node 2k is +x_k, 2k+1 is -x_k
-    (k = p for V)."""
+    (k = p for V). only: the contacts whose states are asked (mask; default all); V_free: no
+    condition on V."""
     T_u, T_V, _ = velocity_box(form.dyn)
     T = np.column_stack([T_u, T_V])
     p = form.system.p
@@ -42,7 +44,7 @@ def _edges(form: Formulation, s: np.ndarray) -> list[tuple[int, int, float, int]
 
     for al in form.fric:
         terms = [(int(k), float(T[al, k])) for k in np.flatnonzero(T[al])]
-        if not terms:
+        if not terms or (only is not None and not only[al]):
             continue
         neg = [(k, -a) for k, a in terms]
         if s[al] > 0:  # v >= 1: -v <= -1
@@ -52,7 +54,9 @@ def _edges(form: Formulation, s: np.ndarray) -> list[tuple[int, int, float, int]
         else:  # v = 0
             add(terms, 0.0, int(al))
             add(neg, 0.0, int(al))
-    if form.V_mode == "zero":
+    if V_free:
+        pass
+    elif form.V_mode == "zero":
         add([(p, 1.0)], 0.0, -1)
         add([(p, -1.0)], 0.0, -1)
     elif form.V_mode == "positive":
@@ -62,11 +66,14 @@ def _edges(form: Formulation, s: np.ndarray) -> list[tuple[int, int, float, int]
     return out
 
 
-def realizable(form: Formulation, s: np.ndarray) -> tuple[bool, np.ndarray | list[int]]:
+def realizable(form: Formulation, s: np.ndarray, only: np.ndarray | None = None,
+               V_free: bool = False) -> tuple[bool, np.ndarray | list[int]]:
     """(True, x = (r omega, V)) with the signs s, or (False, the contacts of a negative cycle:
-    their states admit no velocities together). Bellman-Ford on the doubled graph."""
+    their states admit no velocities together). Bellman-Ford on the doubled graph. only (a
+    mask of contacts) and V_free: ask the signs on those contacts only, V free (a negative
+    cycle of the smaller system is one of the whole: its cut stays valid)."""
     n = 2 * (form.system.p + 1)
-    edges = _edges(form, s)
+    edges = _edges(form, s, only, V_free)
     if not edges:
         return True, np.zeros(n // 2)
     src = np.array([e[0] for e in edges])

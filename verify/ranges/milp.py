@@ -27,11 +27,15 @@ from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .kinematics import realizable
+from .proportional import exact
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
-from .steady import Formulation, states_of
+from .steady import Formulation, states_of, velocity_box
 
 #: Contact-state sets kept as seeds (MilpModel.add_seed).
 MAX_SEEDS = 10
+#: "lazy-a_t": a_t counts as 0 within this times max(|gamma|, g) (a larger set of contacts
+#: asked only makes the check stricter; its cuts stay valid).
+AT_ZERO = 1e-7
 
 
 def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,
@@ -81,16 +85,41 @@ class MilpModel:
     each optimum's contact states are checked by verify.ranges.kinematics; a set the
     velocities do not admit is cut off (the states of its negative cycle cannot all hold) and
     the MILP solved again, until the optimum's states are admitted: then it is the optimum
-    over every valid steady state. "big-M": the velocity rows stay (module steady)."""
+    over every valid steady state. "big-M": the velocity rows stay (module steady).
+    "lazy-a_t": as "lazy", but a point's states are checked only on the contacts with a_t =
+    0 there, V free (exact where proportional.exact holds and gamma != 0: with (omega, V) =
+    (alpha, gamma) t + (omega', V') and t large, a contact with a_t != 0 slides the way it
+    accelerates whatever (omega', V'), which need only give the states with a_t = 0;
+    docs/mechanics.md). "proportional": no velocity column and no velocity row
+    (verify.ranges.proportional: where `proportional.exact` holds, the forces of this MILP
+    are those of every valid steady state, a point's velocities are (alpha, gamma) t, so no
+    cut is needed); columns and points keep the Formulation's layout outside (the velocity
+    entries 0)."""
 
     def __init__(self, form: Formulation, kinematics: str = "lazy"):
         import highspy
 
-        if kinematics not in ("lazy", "big-M"):
-            raise ValueError(f"kinematics must be 'lazy' or 'big-M', got {kinematics!r}")
-        A = sp.csc_matrix(form.A)
-        self.A, self.form, self.lazy = sp.csr_matrix(form.A), form, kinematics == "lazy"
-        self.hs, self.n = highspy, A.shape[1]
+        if kinematics not in ("lazy", "lazy-a_t", "big-M", "proportional"):
+            raise ValueError("kinematics must be 'lazy', 'lazy-a_t', 'big-M' or "
+                             f"'proportional', got {kinematics!r}")
+        self.at_only = kinematics == "lazy-a_t"
+        if self.at_only and not (form.system.gamma != 0 and exact(form)):
+            raise ValueError("kinematics 'lazy-a_t' needs gamma != 0 and V = gamma t admitted")
+        kinematics = "lazy" if self.at_only else kinematics
+        c, p = form.system.c, form.system.p
+        self.proportional = kinematics == "proportional"
+        self.n = form.A.shape[1]  # the Formulation's layout (costs, points, starts)
+        keep_rows = np.ones(form.A.shape[0], dtype=bool)
+        self.keep = np.ones(self.n, dtype=bool)
+        if self.proportional:  # drop u = r omega, V and the rows of v_t
+            keep_rows[form.v_rows[0]:form.v_rows[1]] = False
+            self.keep[2 * c + p:2 * c + 2 * p + 1] = False
+        A = sp.csc_matrix(form.A[np.flatnonzero(keep_rows)][:, np.flatnonzero(self.keep)])
+        self.lo, self.hi = form.lo[keep_rows], form.hi[keep_rows]
+        self.lb, self.ub = form.lb[self.keep], form.ub[self.keep]
+        integrality = form.integrality[self.keep]
+        self.A, self.form, self.lazy = sp.csr_matrix(A), form, kinematics == "lazy"
+        self.hs = highspy
         self.cuts = 0
         F = form.fric.size
         self.base = 2 * form.system.c + 2 * form.system.p + 1  # y+ at base + k, y- base + F + k
@@ -101,17 +130,17 @@ class MilpModel:
             lp = highspy.HighsLp()
             lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
             lp.col_cost_ = np.zeros(A.shape[1])
-            lp.col_lower_, lp.col_upper_ = form.lb, form.ub
-            lo = np.array(form.lo, float)
+            lp.col_lower_, lp.col_upper_ = self.lb, self.ub
+            lo = np.array(self.lo, float)
             if integer and self.lazy:
                 lo[form.v_rows[0]:form.v_rows[1]] = -np.inf
-            lp.row_lower_, lp.row_upper_ = lo, form.hi
+            lp.row_lower_, lp.row_upper_ = lo, self.hi
             lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
             lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
                 A.indptr, A.indices, A.data)
             if integer:
                 lp.integrality_ = [highspy.HighsVarType.kInteger if v else
-                                   highspy.HighsVarType.kContinuous for v in form.integrality]
+                                   highspy.HighsVarType.kContinuous for v in integrality]
             h = new_highs(mip_rel_gap=0.0, mip_abs_gap=1e-13, mip_feasibility_tolerance=1e-9,
                           primal_feasibility_tolerance=1e-9, dual_feasibility_tolerance=1e-9)
             h.passModel(lp)
@@ -120,6 +149,7 @@ class MilpModel:
         self.h, self.lp = model(True), model(False)
         self.starts: list[np.ndarray] = []
         self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
+        self.V_ref: float | None = None  # proportional witnesses' V (if of gamma's sign)
 
     def add_seed(self, s: np.ndarray) -> None:
         """Keep s among the (at most MAX_SEEDS, newest kept) seed state sets."""
@@ -131,7 +161,9 @@ class MilpModel:
         """A certified lower bound of cost.x over the MILP (module docstring); -inf if the
         relaxation fails."""
         h, hs = self.lp, self.hs
-        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        cost = np.asarray(cost, float)[self.keep]
+        m = cost.size
+        h.changeColsCost(m, np.arange(m, dtype=np.int32), cost)
         with quiet_highs():
             h.run()
         if h.getModelStatus() != hs.HighsModelStatus.kOptimal:
@@ -141,9 +173,14 @@ class MilpModel:
             if h.getModelStatus() != hs.HighsModelStatus.kOptimal:
                 return -np.inf
         y = np.asarray(h.getSolution().row_dual, float)
-        f = self.form
-        return max(lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, y),
-                   lagrangian_bound(cost, self.A, f.lo, f.hi, f.lb, f.ub, -y))
+        return max(lagrangian_bound(cost, self.A, self.lo, self.hi, self.lb, self.ub, y),
+                   lagrangian_bound(cost, self.A, self.lo, self.hi, self.lb, self.ub, -y))
+
+    def _full(self, x: np.ndarray) -> np.ndarray:
+        """A point of the model in the Formulation's layout (dropped columns 0)."""
+        out = np.zeros(self.n)
+        out[self.keep] = x
+        return out
 
     def cut(self, s: np.ndarray, contacts: list[int]) -> None:
         """Forbid the states s on `contacts` together: sum of their indicators <= |C| - 1
@@ -167,7 +204,7 @@ class MilpModel:
         """("optimal" | "time limit" | "infeasible" | "failed", the MILP's point or None);
         extra: MIP starts for this objective only. Lazy: the point's contact states are
         admitted by the velocities (else it is None)."""
-        if not self.lazy:
+        if not self.lazy:  # big-M: the velocities are in; proportional: none needed
             return self._solve(cost, time_limit, extra)
         t0 = time.perf_counter()
         while True:
@@ -178,31 +215,44 @@ class MilpModel:
             if x is None:
                 return st, None
             s = states_of(self.form, x)
-            ok, info = realizable(self.form, s)
+            ok, info = realizable(self.form, s, *self._asked(x))
             if ok:
                 return st, x
             self.cut(s, info)
             if st != OPTIMAL:
                 return st, None
 
+    def _asked(self, x: np.ndarray) -> tuple[np.ndarray | None, bool]:
+        """(contacts whose states the velocities must give, V free) at the point x: all and
+        V as the formulation's, or ("lazy-a_t") those with |a_t| <= AT_ZERO max(|gamma|, g),
+        V free."""
+        if not self.at_only:
+            return None, False
+        f = self.form
+        c, p = f.system.c, f.system.p
+        T_u, T_V, _ = velocity_box(f.dyn)
+        at = T_u @ x[2 * c:2 * c + p] + T_V * f.system.gamma
+        return np.abs(at) <= AT_ZERO * max(abs(f.system.gamma), f.system.g), True
+
     def _solve(self, cost: np.ndarray, time_limit: float, extra: list[np.ndarray] = ()
                ) -> tuple[str, np.ndarray | None]:
         h, hs = self.h, self.hs
         h.clearSolver()
-        h.changeColsCost(self.n, np.arange(self.n, dtype=np.int32), cost)
+        cost = np.asarray(cost, float)[self.keep]
+        h.changeColsCost(cost.size, np.arange(cost.size, dtype=np.int32), cost)
         h.setOptionValue("time_limit", float(time_limit))
         starts = [*self.starts, *extra]
         # the best valid state as the MIP start (a later setSolution replaces an earlier one)
-        for x in sorted(starts, key=lambda x: float(cost @ x))[:1]:
+        for x in sorted(starts, key=lambda x: float(cost @ x[self.keep]))[:1]:
             sol = hs.HighsSolution()
-            sol.col_value = list(x)
+            sol.col_value = list(x[self.keep])
             sol.value_valid = True
             h.setSolution(sol)
         with quiet_highs():
             h.run()
         st = h.getModelStatus()
         has_x = h.getInfo().primal_solution_status == 2
-        x = np.asarray(h.getSolution().col_value) if has_x else None
+        x = self._full(np.asarray(h.getSolution().col_value)) if has_x else None
         if st == hs.HighsModelStatus.kOptimal:
             return OPTIMAL, x
         if st == hs.HighsModelStatus.kInfeasible:

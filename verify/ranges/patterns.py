@@ -48,12 +48,11 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 from rigidlcp.models.system import System
 
 from .milp import MilpModel
+from .proportional import exact as proportional_exact
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
 from .steady import Formulation, formulate, state_velocities, states_of
-from .witness import SteadyWitness, make_witness
+from .witness import WITNESS_TOL, SteadyWitness, make_witness
 
-#: A witness is accepted when its independent residual is at most this (as steady_ranges).
-WITNESS_TOL = 1e-8
 FOUND = "feasible"
 KINDS = ("R", "S", "ra", "sl", "y+", "y-")
 
@@ -329,12 +328,14 @@ def _accepts(system: System, pattern: Pattern, wit: SteadyWitness, check) -> str
 
 def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: float = 60.0,
                check: Callable[[SteadyWitness], bool] | None = None,
-               known: list[SteadyWitness] = ()) -> PatternResult:
+               known: list[SteadyWitness] = (), kinematics: str = "auto") -> PatternResult:
     """A valid steady state of `target` (a System, or its Formulation) satisfying `pattern`, or
     a proof that none does (module docstring). check(witness) -> bool: the caller's own test
     of the property on the witness (e.g. the classifier of models.modes); a witness must pass
     it, steady_check and Pattern.holds. known: valid steady states met before (a run's own, the
-    seeds', earlier witnesses), tried first: one that passes is the answer, no MILP."""
+    seeds', earlier witnesses), tried first: one that passes is the answer, no MILP.
+    kinematics: MilpModel's; "auto" is "lazy-a_t" (states checked on the contacts with a_t =
+    0 only) where that is exact (gamma != 0, V = gamma t admitted), else "lazy"."""
     t0 = time.perf_counter()
     form = target if isinstance(target, Formulation) else formulate(target)
     for k, wit in enumerate(known):
@@ -343,11 +344,17 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
                                  f"a known valid steady state (#{k} of those given; residual "
                                  f"{wit.residual:.1e}), no MILP")
     notes: list[str] = []
+    if kinematics == "auto":
+        kinematics = ("lazy-a_t" if form.system.gamma != 0 and proportional_exact(form)
+                      else "lazy")
+    elif kinematics == "proportional":  # its binaries are a_t's signs, not contact states
+        raise ValueError("find_state asks contact states: kinematics 'lazy-a_t', 'lazy' or "
+                         "'big-M', not 'proportional'")
     for tighten in (False, True):
         if tighten and not any(lit.strict and lit.margin > 0 for lit in pattern.literals()):
             break
         ext, proved = _extend(form, pattern, tighten)
-        model = MilpModel(ext)
+        model = MilpModel(ext, kinematics)
         left = time_limit - (time.perf_counter() - t0)
         st, x = model.solve(np.zeros(model.n), left) if left > 0 else (TIME_LIMIT, None)
         took = time.perf_counter() - t0

@@ -95,6 +95,9 @@ def split_bound(model: MilpModel, cost: np.ndarray, target: float, time_limit: f
                 tol: float = 1e-9) -> SplitBound:
     """A proved lower bound of cost . x over the MILP of `model` (module docstring): cases are
     split until each is bounded at >= target - tol, is empty, or the time limit is reached."""
+    if model.proportional:  # its HiGHS columns are not the Formulation's
+        raise ValueError("split_bound needs a MilpModel with the velocity columns ('lazy' or "
+                         "'big-M'), not 'proportional'")
     t0 = time.perf_counter()
     lat = model.form.system.lattice
     plane = {k for k, a in enumerate(model.form.fric) if int(lat.j[a]) == PLANE}

@@ -2,9 +2,11 @@
 observable) over every valid steady state of a system (verify.ranges.steady), each end with a
 witness state checked against the laws by verify.ranges.witness.steady_check.
 
-An end is found by the MILP of verify.ranges.steady; its contact states are then fixed and the
-extreme recomputed by a linear program over the forces of those states, without the force box
-(the witness), and the velocities by a second one. The MILP's own point is never the witness.
+An end is found by the MILP of verify.ranges.steady (by default without velocities:
+verify.ranges.proportional); its states are then fixed and the extreme recomputed by a linear
+program over the forces of those states, without the force box (the witness), which moves at
+(omega, V) = (alpha, gamma) t (where that reduction is not exact: velocities by a second linear
+program). The MILP's own point is never the witness.
 """
 
 from __future__ import annotations
@@ -21,20 +23,21 @@ from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
 from .observables import check_observable, steady_observables
+from .proportional import exact as proportional_exact
+from .proportional import velocities as proportional_velocities
+from .proportional import velocity_scale
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range, end_cell, width_text
+from .seeds import seed_starts, seed_states
 from .steady import (
     Formulation,
     NotSteady,
     formulate,
-    least_R,
     state_extreme,
     state_velocities,
     states_of,
 )
-from .witness import make_witness, steady_check
+from .witness import WITNESS_TOL, make_witness, steady_check
 
-#: A witness is accepted when its independent residual is at most this.
-WITNESS_TOL = 1e-8
 #: A witness attains a certified bound when within this (relative to max(1, |bound|)).
 ATTAIN_TOL = 1e-9
 
@@ -145,16 +148,19 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None, kinematics: str = "lazy", split: bool | float = True
+                  V_mode: str | None = None, kinematics: str = "auto", split: bool | float = True
                   ) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
     also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
-    box: the force box when no bound is proved. kinematics: "lazy" (velocities checked on
-    each optimum, verify.ranges.milp) or "big-M" (in the MILP). split: an end left at the
-    time limit gets a proved bound by verify.ranges.cap_split where it applies (a number s:
-    also disk_split's, s seconds per end). Raises NotSteady (none valid, run not steady)."""
+    box: the force box when no bound is proved. kinematics: "auto" ("proportional" where
+    verify.ranges.proportional.exact holds, else "lazy"), "proportional" (no velocities in
+    the MILP; witnesses move at (alpha, gamma) t, t = 1 or the run's V / gamma), "lazy"
+    (velocities checked on each optimum, verify.ranges.milp) or "big-M" (in the MILP).
+    split: an end left at the time limit gets a proved bound by verify.ranges.cap_split where
+    it applies (a number s: also disk_split's, s seconds per end). Raises NotSteady (none
+    valid, run not steady)."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -174,7 +180,13 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         obs[str(name)] = check_observable(str(name), L, 2 * system.c)
     unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
+    if kinematics == "auto":
+        kinematics = "proportional" if proportional_exact(form) else "lazy"
+    elif kinematics == "proportional" and not proportional_exact(form):
+        raise ValueError(f"kinematics 'proportional' is not exact here (gamma "
+                         f"{system.gamma:g}, V {form.V_mode}): use 'lazy' or 'big-M'")
     model = MilpModel(form, kinematics)
+    model.V_ref = None if start is None else float(start[3])
     if start is not None:
         model.starts.append(form.start(*start))
         model.add_seed(start[4])
@@ -240,7 +252,7 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     bound = model.relaxation_bound(cost)
     tol = ATTAIN_TOL * max(1.0, abs(bound)) if np.isfinite(bound) else 0.0
     xm, mstat, how = None, None, ""
-    pools = [lambda: model.starts, lambda: _seed_starts(form, model, L, sense)]
+    pools = [lambda: model.starts, lambda: seed_starts(form, model, L, sense)]
     found: list[np.ndarray] = []
     for k, pool in enumerate(pools[:2 if seeds else 1]):
         cands = pool()
@@ -265,15 +277,20 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
                    seconds=time.perf_counter() - t0, note=f"HiGHS: {mstat}, no point")
     s = states_of(form, xm)
     status, x, ray = state_extreme(form, s, L, sense)
-    vel = state_velocities(form, s)
+    if x is None:
+        x = xm[:2 * c]
+    v_scale = 0.0
+    if model.proportional:  # (omega, V) = (alpha, gamma) t (verify.ranges.proportional)
+        vel = proportional_velocities(form, x[:c], x[c:], model.V_ref)
+        v_scale = velocity_scale(form, vel[1])
+    else:
+        vel = state_velocities(form, s)
     if vel is None:  # the LP disagrees: the shortest-path velocities, else the MILP's
         r = form.system.lattice.radius
         ok, xv = realizable(form, s)
         xv = xv if ok else xm[2 * c + p:2 * c + 2 * p + 1]
         vel = (np.asarray(xv[:p]) / r, float(xv[p]))
-    if x is None:
-        x = xm[:2 * c]
-    wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn)
+    wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn, v_scale)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
               seconds=time.perf_counter() - t0, note=how)
     if wit.residual > WITNESS_TOL:
@@ -284,7 +301,7 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
         end.status, end.best, end.value = TIME_LIMIT, float(L @ x), None
         return end
     if status == UNBOUNDED:
-        end = _check_ray(form, end, wit, ray, L, sense)
+        end = _check_ray(form, end, wit, ray, L, sense, moving=model.proportional)
     elif status == INFEASIBLE:
         end.status, end.value = "failed", None
         end.note = "the contact states of the MILP's point admit no force (rounding)"
@@ -302,85 +319,11 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     return end
 
 
-def _two_colouring(system: System) -> np.ndarray | None:
-    """sigma = +-1 per disk with sigma_i = -sigma_j across every disk-disk contact, or None
-    (the contact graph is not bipartite)."""
-    lat, p = system.lattice, system.p
-    nbr: list[list[int]] = [[] for _ in range(p)]
-    for i, j in zip(lat.i, lat.j):
-        if 0 <= i < p and 0 <= j < p:
-            nbr[int(i)].append(int(j))
-            nbr[int(j)].append(int(i))
-    sigma = np.zeros(p)
-    for root in range(p):
-        if sigma[root]:
-            continue
-        sigma[root], stack = 1.0, [root]
-        while stack:
-            i = stack.pop()
-            for j in nbr[i]:
-                if not sigma[j]:
-                    sigma[j] = -sigma[i]
-                    stack.append(j)
-                elif sigma[j] == sigma[i]:
-                    return None
-    return sigma
-
-
-def seed_states(form: Formulation) -> list[np.ndarray]:
-    """Contact-state sets of simple velocities, tried at every end (each kept when its
-    velocities and some forces exist): V = +1 and -1 (V free) or V of the run's sign, with
-    no rotation (omega = 0: every disk-disk contact non-sliding, every frictional contact with
-    the plane sliding the same way: the locked array), and, where the disk-disk contacts
-    2-colour the disks, the rolling checkerboards r omega_i = +-sigma_i V (every disk-disk
-    contact non-sliding, the first-row disks of one colour rolling: Fig. 9's least mu_g
-    met, 0.1050919, is one)."""
-    system, dyn = form.system, form.dyn
-    Vs = {"free": (1.0, -1.0), "zero": (0.0,), "positive": (1.0,),
-          "negative": (-1.0,)}[form.V_mode]
-    sigma = _two_colouring(system)
-    spins = [np.zeros(system.p)] + ([] if sigma is None else [sigma, -sigma])
-    out: list[np.ndarray] = []
-    zero = np.zeros(2 * system.c)
-    for V in Vs:
-        for spin in spins:
-            u = spin * V
-            if V == 0 and np.any(u):
-                continue
-            vt = dyn.velocities(u / system.lattice.radius, V)[system.c:]
-            s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
-            if any(np.array_equal(s, t) for t in out):
-                continue
-            if (state_velocities(form, s) is not None
-                    and state_extreme(form, s, zero, 1)[0] == OPTIMAL):
-                out.append(s)
-    return out
-
-
-def _seed_starts(form: Formulation, model: MilpModel, L: np.ndarray, sense: int
-                 ) -> list[np.ndarray]:
-    """MIP starts for one end: the extreme of L over each seed state set (a linear program),
-    where it is finite and its witness passes steady_check."""
-    c, out = form.system.c, []
-    for s in model.seeds:
-        status, x, _ = state_extreme(form, s, L, sense)
-        vel = state_velocities(form, s)
-        if status != OPTIMAL or vel is None:
-            continue
-        R, S = x[:c], x[c:]
-        if form.R_hi is not None and np.any(R > form.R_hi):
-            R = least_R(form, s, S)  # same S and states, R within the proved bounds
-            if R is None or np.any(R > form.R_hi):
-                continue
-        if steady_check(form.system, vel[0], vel[1], R, S, form.dyn)[0] <= WITNESS_TOL:
-            out.append(form.start(R, S, vel[0], vel[1], s))
-    return out
-
-
 def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
-               v_scale: float = 0.0) -> End:
+               v_scale: float = 0.0, moving: bool = False) -> End:
     """End "unbounded" if x + t d stays a valid steady state for a large t and L d has the
-    right sign; otherwise "failed" with the reason."""
+    right sign; otherwise "failed" with the reason. moving: the velocities are those of
+    x + t d (verify.ranges.proportional), else the witness's."""
     c = form.system.c
     if ray is None or not sense * float(L @ ray) < 0:
         end.status, end.value = "failed", None
@@ -389,7 +332,11 @@ def _check_ray(form: Formulation, end: End, wit, ray, L: np.ndarray, sense: int,
     x = np.concatenate([wit.R, wit.S])
     t = 1e3 * max(1.0, float(np.max(np.abs(x))))
     y = x + t * ray
-    res, _ = steady_check(form.system, wit.omega, wit.V, y[:c], y[c:], form.dyn, v_scale)
+    omega, V = wit.omega, wit.V
+    if moving:
+        omega, V = proportional_velocities(form, y[:c], y[c:], wit.V)
+        v_scale = velocity_scale(form, V)
+    res, _ = steady_check(form.system, omega, V, y[:c], y[c:], form.dyn, v_scale)
     if res > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"the ray did not pass the check (residual {res:.1e} at t = {t:.3g})"

@@ -24,6 +24,9 @@ from rigidlcp.models.system import System
 
 from ..steadiness import from_velocities
 
+#: A witness is accepted when its independent residual is at most this.
+WITNESS_TOL = 1e-8
+
 
 @dataclass
 class SteadyWitness:
