@@ -89,7 +89,9 @@ def solve_lemke(problem) -> Solution | None:
     """`lcp.solve(problem, "lemke")` for an lcp.LCP when its first attempt is accepted (the
     Solution the general path would return), else None (see the module docstring)."""
     M, q = problem.M, problem.q
-    if not (type(M) is np.ndarray and type(q) is np.ndarray and applies()):
+    info = registry._REGISTRY.get("lemke")  # applies(), written out (the call's glue)
+    if not (type(M) is np.ndarray and type(q) is np.ndarray and info is not None
+            and info.func is _lemke and info.equilibrate and _kernel._use):
         return None
     n = q.size
     max_iter = 1000 + 100 * n  # lemke()'s default
