@@ -31,6 +31,7 @@
  *                     scaled dictionary (+ AVX2 pass over M), solve_problem, the work array,
  *                     the acceptance of the answer
  *   _lemke_measure.h  the acceptance measure: abs_row_sums, lcp_measure, lcp_measure_batch
+ *   _lemke_solution.h solve_lcp: solve_fast's work, the verdict and the Solution in one call
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -47,6 +48,7 @@ typedef Py_ssize_t idx;
 #include "_lemke_py.h"
 #include "_lemke_problem.h"
 #include "_lemke_measure.h"
+#include "_lemke_solution.h" /* solve_setup, solve_lcp: solve_fast and its Solution */
 
 /* solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one LCP
  * as lcp.solve gives it to lemke() by default, on its equilibrated data: r = c = None for the
@@ -337,6 +339,12 @@ static PyMethodDef methods[] = {
     {"solve_fast", (PyCFunction)(void (*)(void))py_solve_fast, METH_FASTCALL,
      "solve_fast(M, q, tol, max_iter, z, w, basis, dot, upto) -> (code, pivots, nbasis, acode, "
      "berr, ferr, refined, raw, scaled): solve_accept, then w = dot(M, z, w) and the measure."},
+    {"solve_lcp", (PyCFunction)(void (*)(void))py_solve_lcp, METH_FASTCALL,
+     "solve_lcp(M, q, tol, max_iter, upto) -> Solution, or solve_fast's numbers and (z, w, "
+     "basis): see lcp/_lemke_solution.h."},
+    {"solve_setup", py_solve_setup, METH_VARARGS,
+     "solve_setup(dot, empty, intp, new, Solution, q_nonnegative, TOL, FERR_TOL): solve_lcp's "
+     "Python objects."},
     {"solve_eq", py_solve_eq, METH_VARARGS,
      "solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one "
      "LCP by Lemke on its equilibrated data."},

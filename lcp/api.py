@@ -75,11 +75,14 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     Bad input raises `InvalidProblem`; a method that refuses the problem raises `NotApplicable`;
     a method that fails returns a Solution whose status says how, with its evidence in `info`.
     """
-    if (type(problem) is LCP and method in _FAST_METHODS and not options
-            and (equilibrate is None or equilibrate is True) and fallback is False):
-        sol = _fast(method)(problem)  # the same answer, when the first attempt is accepted
-        if sol is not None:
-            return sol
+    if (type(problem) is LCP and not options and fallback is False
+            and (equilibrate is None or equilibrate is True)):
+        fast = _FAST if method == "lemke" and _FAST is not None else (
+            _fast(method) if method in _FAST_METHODS else None)
+        if fast is not None:
+            sol = fast(problem)  # the same answer, when the first attempt is accepted
+            if sol is not None:
+                return sol
     friction = not isinstance(problem, (LCP, MLCP))
     if friction:  # imported only then: lcp.friction loads scipy.sparse
         from .problems.friction import FrictionContact2D

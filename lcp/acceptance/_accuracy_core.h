@@ -13,6 +13,8 @@ static inline double dmax(double a, double b) { return a > b ? a : b; }
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 #define MAX_M 400
 #define STEPS 5
+/* assess_one's work block on the stack up to this many doubles (16 kB: m up to about 25) */
+#define ASSESS_STACK 2048
 
 /* Are all n entries of a finite? Then *mx = max |a_i| (from the value on entry). Four lanes
  * wide where the CPU has AVX2 (the maximum of finite numbers does not depend on the order). */
@@ -316,19 +318,24 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     }
     if (!isfinite(norm)) return 1;
     double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
-    char *mark = (char *)calloc((size_t)n, 1);
-    if (!mark) return 1;
+    /* one block for the work below: 3 m^2 + 6 m + 1 doubles (K, its LU, Hager's scratch, the
+     * vectors), perm and the sorted pattern (m + 1 entries of 8 bytes each) and the marks (n
+     * bytes); on the stack when it fits (no allocation for small problems) */
+    size_t nd = (size_t)3 * m * m + 6 * (size_t)m + 1, words = nd + 2 * ((size_t)m + 1) +
+                                                            ((size_t)n + 7) / 8;
+    double stackbuf[ASSESS_STACK];
+    double *buf = words <= ASSESS_STACK ? stackbuf : (double *)malloc(words * sizeof(double));
+    if (!buf) return 1;
+    idx *perm = (idx *)(buf + nd);  /* each in its own words (8 bytes, 8-aligned) */
+    int64_t *sorted = (int64_t *)(buf + nd + m + 1);
+    char *mark = (char *)(buf + nd + 2 * (m + 1));
+    memset(mark, 0, (size_t)n);
     for (idx i = 0; i < m; i++) {
         if (a[i] < 0 || a[i] >= n || mark[a[i]]) {
-            free(mark);
+            if (buf != stackbuf) free(buf);
             return 1;
         }
         mark[a[i]] = 1;
-    }
-    int64_t *sorted = (int64_t *)malloc(((size_t)m + 1) * sizeof(int64_t));
-    if (!sorted) {
-        free(mark);
-        return 1;
     }
     for (idx i = 0, k = 0; i < n; i++)
         if (mark[i]) sorted[k++] = i;
@@ -336,15 +343,6 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     double berr = -1.0;  /* of z as given: computed only when needed (below) */
     double ferr = 0.0;
     int refined = 0;
-    double *buf = (double *)malloc(((size_t)3 * m * m + 6 * (size_t)m + 1) * sizeof(double));
-    idx *perm = (idx *)malloc(((size_t)m + 1) * sizeof(idx));
-    if (!buf || !perm) {
-        free(buf);
-        free(perm);
-        free(mark);
-        free(sorted);
-        return 1;
-    }
     double *K = buf, *A = K + m * m, *inv = A + m * m, *kp = inv + m * m, *y = kp + m,
            *r = y + m, *d = r + m, *g = d + m, *rows = g + m;
     for (idx i = 0; i < m; i++) {
@@ -422,10 +420,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             memcpy(out, z, (size_t)n * sizeof(double));
         }
     }
-    free(buf);
-    free(perm);
-    free(mark);
-    free(sorted);
+    if (buf != stackbuf) free(buf);
     res[0] = berr;
     res[1] = ferr;
     res[2] = refined;

@@ -14,7 +14,9 @@ with the same roundings, and the check of `lcp.accuracy.judge_lcp`, the verdict
 `lcp.residual.lcp_measure`). For a balanced M (`ruiz` then makes no sweep and only changes the
 unit of q) one C call (`_lemke_c.solve_fast`) does the equilibration, the pivots, z back,
 judge_lcp's `assess_lcp` (lcp/acceptance/_accuracy_core.h, the code of the C `assess`), M z by
-numpy's own BLAS call (np.dot(M, z, w), called from C) and the rest of lcp.residual's measure.
+numpy's own BLAS call (np.dot(M, z, w), called from C) and the rest of lcp.residual's measure;
+when the verdict is "accepted" the same call (`_lemke_c.solve_lcp`, lcp/_lemke_solution.h)
+also builds the Solution, else it hands its numbers back to the steps below.
 Otherwise `ruiz` runs in numpy,
 its factors are passed to `_lemke_kernel.solve_eq`, and `judge_lcp` checks the answer. So it
 returns the same Solution (z, w, pivots, basis, residuals, message, info) as the general path,
@@ -65,39 +67,58 @@ _measure = _kernel._lemke_c.lcp_measure if _kernel.COMPILED else None
 _solve_fast = _kernel._lemke_c.solve_fast if _solve_accept is not None else None
 _empty, _intp, _dot = np.empty, np.intp, np.dot
 _upto = _kernel.sums_verified_upto
+#: `_solve_fast`, the verdict below and `solved_lcp`'s Solution in one call (lcp/_lemke_c.c:
+#: solve_lcp, lcp/_lemke_solution.h): the Solution when accepted, else the numbers of
+#: `_solve_fast` and its arrays for the steps below
+_solve_lcp = _kernel._lemke_c.solve_lcp if _solve_fast is not None else None
+
+
+def _setup(tol: float = TOL, ferr_tol: float = FERR_TOL) -> None:
+    """Give `_solve_lcp` the objects it builds with and the verdict's tolerances (lcp.residual's
+    TOL for the scaled residual and the backward error, lcp.accuracy's FERR_TOL for the forward
+    bound; tests pass others to check the verdict, then call it again with the defaults)."""
+    _kernel._lemke_c.solve_setup(np.dot, np.empty, np.intp, object.__new__, Solution,
+                                 _Q_NONNEGATIVE, tol, ferr_tol)
+
+
+if _solve_lcp is not None:
+    _setup()
 
 
 def solve_lemke(problem) -> Solution | None:
     """`lcp.solve(problem, "lemke")` for an lcp.LCP when its first attempt is accepted (the
     Solution the general path would return), else None (see the module docstring)."""
     M, q = problem.M, problem.q
-    if not (type(M) is np.ndarray and type(q) is np.ndarray and applies()):
+    info = registry._REGISTRY.get("lemke")  # applies(), written out (the call's glue)
+    if not (type(M) is np.ndarray and type(q) is np.ndarray and info is not None
+            and info.func is _lemke and info.equilibrate and _kernel._use):
         return None
     n = q.size
     max_iter = 1000 + 100 * n  # lemke()'s default
-    if _solve_fast is None:
+    if _solve_lcp is None:
         if not (M.dtype is _F64 and q.dtype is _F64 and q.ndim == 1 and M.shape == (n, n)):
             return None
         return _solve_ruiz(M, q, n, max_iter, _empty(n), _empty(n, dtype=_intp),
                            balanced=True)
-    z, w, basis = _empty(n), _empty(n), _empty(n, dtype=_intp)
     try:  # C-contiguous native float64 M (n x n) and q (n), finite (else ValueError or
-        # BufferError): the solve, `assess_lcp`'s C steps, M z and the measure in one call
-        # (lcp/_lemke_c.c: solve_fast)
-        code, pivots, m, acode, berr, ferr, refined, raw, scaled = _solve_fast(
-            M, q, DEFAULT_TOL, max_iter, z, w, basis, _dot, _upto())
+        # BufferError): the solve, `assess_lcp`'s C steps, M z, the measure and, when the
+        # verdict below is "accepted", the Solution, in one call (lcp/_lemke_solution.h)
+        out = _solve_lcp(M, q, DEFAULT_TOL, max_iter, _upto())
+        if type(out) is not tuple:
+            return out
+        code, pivots, m, acode, berr, ferr, refined, raw, scaled, z, w, basis = out
         if code == _kernel.NEEDS_RUIZ:
-            return _solve_ruiz(M, q, n, max_iter, z, basis)
+            return _solve_ruiz(M, q, n, max_iter, z, _empty(n, dtype=_intp))
     except (ValueError, BufferError, TypeError):  # e.g. Fortran order, read-only, q 0-d
         return None
     if code != _kernel.SOLVED or acode < 0:  # not solved, or numbers the check could overflow
         return None
-    basis = basis[:m]
     if acode:  # not handled in C (e.g. a singular pattern): judge_lcp's numpy steps
         return _judged(M, q, z, basis, pivots)
-    # judge_lcp's verdict after `assess_lcp` (done in C above): z is the answer (polished when
-    # refined), then lcp.residual's measure (w = M z + q and the numbers in C, unless n exceeds
-    # the row length whose sums C is known to round as numpy does, or a number overflowed)
+    # judge_lcp's verdict after `assess_lcp` (done in C above), when C did not give it: z is
+    # the answer (polished when refined), then lcp.residual's measure (w = M z + q and the
+    # numbers in C, unless n exceeds the row length whose sums C is known to round as numpy
+    # does, or a number overflowed)
     if raw != raw:  # NaN: not measured in C; measured by numpy (lcp_measure recomputes w)
         w, raw, scaled, _, _ = lcp_measure(M, q, z)
     if not (scaled <= TOL and berr <= TOL and ferr <= FERR_TOL):

@@ -3,7 +3,8 @@ lcp/solvers/fast_lemke.py): the solve, its acceptance, numpy's M z and the measu
 call give what the separate calls give (solve_accept, then M.dot(z) and lcp_measure), bit for
 bit, on random, badly scaled, degenerate, infeasible and ill-conditioned problems, across the
 sizes where the C code changes its buffers; and the verdict on its numbers rejects an answer
-that fails any part of the acceptance (the general path then answers)."""
+that fails any part of the acceptance (the general path then answers), in the Python and in C
+(solve_lcp, which also builds the Solution)."""
 
 from __future__ import annotations
 
@@ -142,27 +143,64 @@ def test_a_failed_measure_is_never_solved(monkeypatch, slot, value):
     """Whatever number of the acceptance fails -- backward error (slot 4), forward bound (5),
     scaled residual (8) -- or is not a number, solve_lemke declines (None) and the general
     path judges the answer itself. (raw NaN, slot 7, means "not measured in C": numpy
-    measures, and the answer is the general path's.)"""
+    measures, and the answer is the general path's.) The Python's verdict, on the numbers
+    solve_lcp hands back (its own verdict switched off: no tolerance passes; the C verdict is
+    test_the_c_verdict_is_the_pythons)."""
     rng = np.random.default_rng(7)
     A = rng.standard_normal((6, 6))
     P = lcp.LCP(A @ A.T + np.eye(6), rng.standard_normal(6))
     assert fast_lemke.solve_lemke(P) is not None
-    real = fast_lemke._solve_fast
+    real = fast_lemke._solve_lcp
 
     def tampered(*args):
         out = list(real(*args))
         out[slot] = value
         return tuple(out)
 
-    monkeypatch.setattr(fast_lemke, "_solve_fast", tampered)
-    if slot == 7:
-        sol = fast_lemke.solve_lemke(P)
-        assert sol is not None
-        assert_same_answer(P)
-    else:
-        assert fast_lemke.solve_lemke(P) is None
+    monkeypatch.setattr(fast_lemke, "_solve_lcp", tampered)
+    try:
+        fast_lemke._setup(-1.0, -1.0)  # solve_lcp hands its numbers back, never a Solution
+        if slot == 7:
+            sol = fast_lemke.solve_lemke(P)
+            assert sol is not None
+            assert_same_answer(P)
+        else:
+            assert fast_lemke.solve_lemke(P) is None
+    finally:
+        fast_lemke._setup()
     sol = lcp.solve(P)
     assert sol.status == "solved" and residual.check(P, sol.z).accepted
+
+
+@compiled
+@pytest.mark.parametrize("seed", range(4))
+def test_the_c_verdict_is_the_pythons(seed):
+    """solve_lcp builds the Solution exactly when the Python's verdict on its numbers is
+    "accepted" (scaled <= TOL, berr <= TOL, ferr <= FERR_TOL): with each tolerance set at the
+    number it judges (accepted: <=) and one ulp below it (declined: the numbers handed back),
+    and the Solution then field for field the general path's."""
+    rng = np.random.default_rng(seed)
+    n = 4 + 7 * seed
+    A = rng.standard_normal((n, n))
+    P = lcp.LCP(A @ A.T + 0.1 * np.eye(n), rng.standard_normal(n))
+    args = (P.M, P.q, fast_lemke.DEFAULT_TOL, 1000 + 100 * n, kernel.sums_verified_upto())
+    try:
+        fast_lemke._setup(-1.0, -1.0)
+        code, _, _, acode, berr, ferr, _, raw, scaled, *_ = fast_lemke._solve_lcp(*args)
+        assert code == kernel.SOLVED and acode == 0 and raw == raw
+        tol, ftol = max(berr, scaled), ferr
+        for t, f, accepted in ((tol, ftol, True), (np.nextafter(tol, -1), ftol, False),
+                               (tol, np.nextafter(ftol, -1), False), (np.nan, ftol, False),
+                               (tol, np.nan, False)):
+            fast_lemke._setup(t, f)
+            out = fast_lemke._solve_lcp(*args)
+            assert (type(out) is not tuple) == accepted, (t, f)
+            if accepted:
+                assert out.backward_error == berr and out.forward_error == ferr
+                assert out.scaled_residual == scaled and out.residual == raw
+    finally:
+        fast_lemke._setup()
+    assert_same_answer(P)
 
 
 @compiled

@@ -1,0 +1,180 @@
+/* lcp.solve's common call, its Solution built here (lcp/solvers/fast_lemke.py: solve_lemke):
+ * `solve_fast`'s work -- the solve, the acceptance of lcp/acceptance/accuracy.py's
+ * `assess_lcp`, numpy's M z and lcp.residual's measure -- then the verdict `solve_lemke`
+ * gives (scaled <= TOL, berr <= TOL, ferr <= FERR_TOL) and the Solution object
+ * lcp.problems.solution.solved_lcp builds (the same fields, the same dict, in the same order),
+ * with no Python between. What the Python did around `solve_fast` (three np.empty, the basis
+ * slice, the tuple, the tests, the info dict, solved_lcp's call) was a third of the call at
+ * n = 10; the numbers are the same (the same C steps in the same order).
+ *
+ *   solve_setup(dot, empty, intp, new, Solution, q_nonnegative, TOL, FERR_TOL): the Python
+ *     objects these calls use (numpy.dot, numpy.empty, numpy.intp, object.__new__, the class,
+ *     lemke()'s message for q >= 0, the tolerances), held for the module's life.
+ *   solve_lcp(M, q, tol, max_iter, upto) -> a Solution (solved and accepted), or
+ *     (code, pivots, nbasis, acode, berr, ferr, refined, raw, scaled, z, w, basis): the
+ *     numbers of `solve_fast` and its arrays (basis of length nbasis) for the Python to
+ *     finish (not solved, not assessed here, not measured here, or not accepted).
+ * The includer includes _lemke_py.h, _lemke_problem.h and _lemke_measure.h first. */
+#ifndef RIGIDLCP_LEMKE_SOLUTION_H
+#define RIGIDLCP_LEMKE_SOLUTION_H
+
+static PyObject *s_dot, *s_empty, *s_intp, *s_new, *s_cls, *s_msg, *s_empty_str;
+static double s_tol = -1.0, s_ferr_tol = -1.0; /* negative until solve_setup: nothing passes */
+/* the Solution's fields, in lcp.problems.solution.Solution's order, and the info keys */
+static const char *const s_names[14] = {
+    "z", "w", "status", "method", "iterations", "residual", "eq_residual", "scaled_residual",
+    "basis", "u", "message", "info", "backward_error", "forward_error"};
+static PyObject *s_keys[14], *s_solved, *s_lemke, *s_zero, *s_equilibrated, *s_polished;
+
+static PyObject *py_solve_setup(PyObject *self, PyObject *args)
+{
+    PyObject *dot, *empty, *intp, *new_, *cls, *msg;
+    double tol, ferr_tol;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "OOOOOUdd", &dot, &empty, &intp, &new_, &cls, &msg, &tol,
+                          &ferr_tol))
+        return NULL;
+    if (!s_keys[0]) {
+        for (int k = 0; k < 14; k++)
+            if (!(s_keys[k] = PyUnicode_InternFromString(s_names[k]))) return NULL;
+        if (!(s_solved = PyUnicode_InternFromString("solved")) ||
+            !(s_lemke = PyUnicode_InternFromString("lemke")) ||
+            !(s_equilibrated = PyUnicode_InternFromString("equilibrated")) ||
+            !(s_polished = PyUnicode_InternFromString("polished")) ||
+            !(s_empty_str = PyUnicode_FromString("")) || !(s_zero = PyFloat_FromDouble(0.0)))
+            return NULL;
+    }
+    PyObject **slots[6] = {&s_dot, &s_empty, &s_intp, &s_new, &s_cls, &s_msg};
+    PyObject *given[6] = {dot, empty, intp, new_, cls, msg};
+    for (int k = 0; k < 6; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
+    }
+    s_tol = tol;
+    s_ferr_tol = ferr_tol;
+    Py_RETURN_NONE;
+}
+
+/* A new numpy array of n entries: numpy.empty(n) or numpy.empty(n, numpy.intp). */
+static PyObject *new_array(idx n, int integer)
+{
+    PyObject *size = PyLong_FromSsize_t(n);
+    if (!size) return NULL;
+    PyObject *call[2] = {size, s_intp};
+    PyObject *out = PyObject_Vectorcall(s_empty, call, integer ? 2 : 1, NULL);
+    Py_DECREF(size);
+    return out;
+}
+
+/* solved_lcp(z, w, "lemke", pivots, raw, scaled, basis, message, info, berr, ferr) */
+static PyObject *solution(PyObject *z, PyObject *w, long long pivots, double raw, double scaled,
+                          PyObject *basis, int refined, double berr, double ferr)
+{
+    PyObject *info = PyDict_New(), *d = PyDict_New(), *sol = NULL;
+    PyObject *v[14] = {NULL};
+    if (!info || !d) goto fail;
+    if (PyDict_SetItem(info, s_equilibrated, Py_True) < 0 ||
+        (refined && PyDict_SetItem(info, s_polished, Py_True) < 0))
+        goto fail;
+    v[0] = z, v[1] = w, v[2] = s_solved, v[3] = s_lemke;
+    v[4] = PyLong_FromLongLong(pivots);
+    v[5] = PyFloat_FromDouble(raw);
+    v[6] = s_zero;
+    v[7] = PyFloat_FromDouble(scaled);
+    v[8] = basis, v[9] = Py_None, v[10] = pivots ? s_empty_str : s_msg, v[11] = info;
+    v[12] = PyFloat_FromDouble(berr);
+    v[13] = PyFloat_FromDouble(ferr);
+    int ok = v[4] && v[5] && v[7] && v[12] && v[13];
+    for (int k = 0; ok && k < 14; k++) ok = PyDict_SetItem(d, s_keys[k], v[k]) == 0;
+    if (ok) sol = PyObject_CallOneArg(s_new, s_cls); /* object.__new__(Solution) */
+    if (sol && PyObject_GenericSetDict(sol, d, NULL) < 0) Py_CLEAR(sol);
+    Py_XDECREF(v[4]);
+    Py_XDECREF(v[5]);
+    Py_XDECREF(v[7]);
+    Py_XDECREF(v[12]);
+    Py_XDECREF(v[13]);
+fail:
+    Py_XDECREF(info);
+    Py_XDECREF(d);
+    return sol;
+}
+
+static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "solve_lcp: five arguments");
+        return NULL;
+    }
+    if (!s_cls) {
+        PyErr_SetString(PyExc_RuntimeError, "solve_lcp: solve_setup was not called");
+        return NULL;
+    }
+    double tol = PyFloat_AsDouble(args[2]);
+    long long max_iter = PyLong_AsLongLong(args[3]);
+    idx upto = PyLong_AsSsize_t(args[4]);
+    if (PyErr_Occurred()) return NULL;
+    Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0};
+    PyObject *result = NULL, *z = NULL, *w = NULL, *basis = NULL;
+    int64_t bbuf[64], *b = NULL;
+    idx n = problem_data(args[0], args[1], &vM, &vq);
+    if (n < 0) goto done;
+    if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
+        PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
+        goto done;
+    }
+    if (!(z = new_array(n, 0)) || !(w = new_array(n, 0))) goto done;
+    if (get_buffer(z, &vz, "z", 'd', n, 0) < 0 || get_buffer(w, &vw, "w", 'd', n, 0) < 0)
+        goto done;
+    b = n <= 64 ? bbuf : (int64_t *)malloc((size_t)n * sizeof(int64_t));
+    if (!b) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    double *zd = (double *)vz.buf, *wd = (double *)vw.buf;
+    long long pivots = 0;
+    double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
+    idx nb = 0;
+    int code, acode = 1;
+    Py_BEGIN_ALLOW_THREADS
+    code = solve_and_accept(n, M, q, tol, max_iter, zd, b, &pivots, &nb, &acode, res);
+    Py_END_ALLOW_THREADS
+    if (code < 0) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    if (code == 0 && acode == 0) {
+        PyObject *call[3] = {args[0], z, w};
+        PyObject *out = PyObject_Vectorcall(s_dot, call, 3, NULL); /* dot(M, z, w) */
+        if (!out) goto done;
+        Py_DECREF(out);
+        if (n <= upto && measure_one(n, M, q, zd, wd, got) < 0) got[0] = got[1] = NAN;
+    }
+    if (!(basis = new_array(nb, 1))) goto done;
+    if (nb) {
+        Py_buffer vb = {0};
+        if (get_buffer(basis, &vb, "basis", 'q', nb, 0) < 0) goto done;
+        memcpy(vb.buf, b, (size_t)nb * sizeof(int64_t));
+        PyBuffer_Release(&vb);
+    }
+    int refined = (int)res[2];
+    /* solve_lemke's verdict (NaN fails every test: then the Python measures or refuses) */
+    if (code == 0 && acode == 0 && got[1] <= s_tol && res[0] <= s_tol && res[1] <= s_ferr_tol)
+        result = solution(z, w, pivots, got[0], got[1], basis, refined, res[0], res[1]);
+    else
+        result = Py_BuildValue("iLniddiddOOO", code, pivots, nb, acode, res[0], res[1], refined,
+                               got[0], got[1], z, w, basis);
+done:
+    if (b && b != bbuf) free(b);
+    release(&vw);
+    release(&vz);
+    release(&vM);
+    release(&vq);
+    Py_XDECREF(z);
+    Py_XDECREF(w);
+    Py_XDECREF(basis);
+    return result;
+}
+
+#endif /* RIGIDLCP_LEMKE_SOLUTION_H */
