@@ -310,6 +310,28 @@ def test_infeasible_psd_example():
     assert sol.info["copositive_plus"] is True
 
 
+def assert_exact_solution_near(M: np.ndarray, q: np.ndarray, sol) -> None:
+    """The float data (M, q), read as rationals, have an exact solution z* on sol's basis P
+    (M_PP z*_P = -q_P, z* >= 0, w* = M z* + q >= 0 off P), and |sol.z - z*|_inf is within the
+    forward error bound sol reports (relative to |z*|_inf)."""
+    from flint import fmpq, fmpq_mat
+
+    n, P = len(q), [int(i) for i in sol.basis]
+    MQ = [[fmpq(*float(v).as_integer_ratio()) for v in row] for row in M]
+    qQ = [fmpq(*float(v).as_integer_ratio()) for v in q]
+    zQ = [fmpq(0)] * n
+    if P:
+        A = fmpq_mat(len(P), len(P), [MQ[i][j] for i in P for j in P])
+        y = A.solve(fmpq_mat(len(P), 1, [-qQ[i] for i in P]))
+        for k, i in enumerate(P):
+            zQ[i] = y[k, 0]
+    wQ = [sum((MQ[i][j] * zQ[j] for j in range(n)), fmpq(0)) + qQ[i] for i in range(n)]
+    assert all(v >= 0 for v in zQ) and all(wQ[i] >= 0 for i in range(n) if i not in P)
+    z_star = np.array([float(v) for v in zQ])
+    err = float(np.max(np.abs(sol.z - z_star)))
+    assert err <= sol.forward_error * float(np.max(np.abs(z_star))), err
+
+
 def copositive_plus_infeasible(n: int, seed: int):
     """M = P S P + P K P (S PSD, K skew, P the projector orthogonal to y >= 0) is
     copositive-plus with M^T y = 0; q^T y < 0 then makes {z >= 0: M z + q >= 0} empty."""
@@ -330,13 +352,28 @@ def test_infeasible_copositive_plus_lcps_end_infeasible(n, seed):
     """Lemke's theorem holds in exact arithmetic. In floating point M^T y = 0 only to rounding
     (~1e-17), so the data are infeasible only within |z| ~ gap / 1e-17: "infeasible" is claimed
     when the certificate's radius clears lcp.farkas.RADIUS, else the status stays "ray", or
-    "failed" when Lemke's own (looser) check had claimed it (honest). Never "solved"."""
+    "failed" when Lemke's own (looser) check had claimed it (honest). "solved" only where the
+    float data, read exactly, do have a solution (their rounding can make M_PP nonsingular: n 2,
+    seed 27723, det 2.1e-22, z ~ 2.8e21, which the exact rerun finds): checked in rationals."""
     M, q = copositive_plus_infeasible(n, seed)
     sol = lcp.solve(lcp.LCP(M, q), method="lemke")
+    if sol.status == "solved":
+        assert_exact_solution_near(M, q, sol)
+        return
     assert sol.status in ("infeasible", "ray", "failed"), sol.message
     assert sol.info["copositive_plus"] is True
     if sol.status == "infeasible":
         assert sol.info["farkas_radius"] >= 0.1 / np.finfo(float).eps
+
+
+def test_copositive_plus_data_that_rounding_made_solvable():
+    """n 2, seed 27723 (a deep-profile example): the rounded data have det M = 2.1e-22 > 0 and
+    an exact solution z* ~ (2.8e21, 6.1e19) >= 0; "solved" is then right, checked in rationals
+    (the float w = M z + q is ~1786 from cancellation against |M| |z| ~ 1e21)."""
+    M, q = copositive_plus_infeasible(2, 27723)
+    sol = lcp.solve(lcp.LCP(M, q), method="lemke")
+    assert sol.status == "solved", sol.message
+    assert_exact_solution_near(M, q, sol)
 
 
 def test_many_copositive_plus_infeasible_lcps_get_a_certificate():
