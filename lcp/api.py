@@ -18,7 +18,7 @@ from .acceptance.residual import TOL
 from .acceptance.trust import Run, solve_checked
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
-from .registry import ACCEPTS, MethodInfo, check_options, lookup, register
+from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup, register
 from .solvers import BUILTIN as _BUILTIN
 
 __all__ = ["solve", "get_method", "methods", "register", "MethodInfo", "ACCEPTS",
@@ -48,7 +48,8 @@ def get_method(name: str) -> MethodInfo:
         info = lookup(name)
     if info is None:
         raise InvalidProblem(
-            f"unknown method {name!r}; available: {', '.join(sorted(registry._REGISTRY))}"
+            f"unknown method {name!r}{did_you_mean(name, registry._REGISTRY)}; available: "
+            f"{', '.join(sorted(registry._REGISTRY))}"
         )
     return info
 

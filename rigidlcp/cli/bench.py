@@ -76,6 +76,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, check_methods, read_csv
     from rigidlcp.bench.peers import PEERS, peer_available
     from rigidlcp.bench.problem_sets import SETS, get_set, list_sets
+    from rigidlcp.lcp.registry import did_you_mean
 
     siconos = None if args.no_siconos else SiconosRunner()
     try:
@@ -119,8 +120,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
             params["per_size"] = args.per_size
         specs = [s.strip() for s in args.sets.split(",") if s.strip()]
         unknown = [s for s in specs if s not in SETS and not os.path.isdir(s)]
+        files = [s for s in unknown if os.path.isfile(s)]
+        if files:  # one problem file: a set is a folder of them
+            raise ValueError(f"--set {files[0]} is a file; --set takes a set name or a folder "
+                             "of *.npz / *.dat problem files (for one file: `rigidlcp solve` "
+                             "or `rigidlcp certify`)")
         if unknown:
-            raise ValueError(f"unknown set(s) {', '.join(unknown)}: neither a set name "
+            hint = did_you_mean(unknown[0], SETS) if len(unknown) == 1 else ""
+            raise ValueError(f"unknown set(s) {', '.join(unknown)}{hint}: neither a set name "
                              f"({', '.join(SETS)}) nor a folder")
         notes: list[str] = []
         siconos_ok = siconos is not None and siconos.available

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 
 def register(sub) -> None:
@@ -87,8 +88,6 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     system = models.System(lattice, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                            mu_wall=args.mu_wall)
     if args.plot:  # checked before the SVD: never overwrite a user's file without --force
-        from pathlib import Path
-
         from rigidlcp.lcp.io.files import check_new, output_dir
 
         if args.no_localize:
@@ -102,6 +101,9 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
         output_dir(plot.parent, force=True)
     if args.states in ("normal", "tangential"):
         normal, tangential = paper_states(system, args.states)
+    elif not Path(args.states).exists():  # a typo of a name reads as a missing file
+        raise ValueError(f"--states {args.states!r}: neither 'normal' nor 'tangential' (the "
+                         "paper's states), nor an existing states file (.json or .npz)")
     else:
         normal, tangential = read_states(args.states, system.lattice)
     ns = null_space(system, normal, tangential, localize=not args.no_localize)

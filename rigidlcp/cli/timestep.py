@@ -44,12 +44,16 @@ def register(sub) -> None:
 def cmd_timestep(args) -> int:
     from rigidlcp.lcp.io.files import check_new
     from rigidlcp.models.runio import run_paths, save_run
-    from rigidlcp.models.timestepping import moreau_jean
+    from rigidlcp.models.timestepping import StepOptions, moreau_jean
 
     from .simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
 
     refuse_too_large_for_dense(args, "the time-stepper's dense step LCP", DENSE_ONLY)
     system = system_from_args(args)
+    # a bad --h, --theta, --t-max, ... is refused before the progress bar is drawn
+    StepOptions(h=args.h, theta=args.theta, method=args.method, t_max=args.t_max,
+                max_steps=args.max_steps, record_every=args.record_every,
+                selection=args.selection)
     if args.out:
         check_new(run_paths(args.out), force=args.force)
     bar = None

@@ -1,0 +1,81 @@
+"""What a new user tripped on (session 27): a typo of a method or set name answered with the
+whole list and no hint, a single problem file given to `bench --set` called "neither a set name
+nor a folder", `nullspace --states tangental` called a missing file, and `timestep --h 0` drew
+its progress bar before the one-line refusal."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rigidlcp import lcp
+from rigidlcp.cli import main
+
+
+@pytest.fixture
+def problem(tmp_path):
+    path = tmp_path / "problem.npz"
+    lcp.LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0])).save(path)
+    return path
+
+
+def _one_line_error(capsys, command: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"rigidlcp {command}: error: ") and "\n" not in err
+    return err
+
+
+@pytest.mark.parametrize("command", ["solve", "certify"])
+def test_a_mistyped_method_is_named_with_the_closest_one(problem, capsys, command):
+    assert main([command, str(problem), "--method", "lemk"]) == 2
+    err = _one_line_error(capsys, command)
+    assert "unknown method 'lemk' (did you mean 'lemke'?); available: enumerate," in err
+    assert main([command, str(problem), "--method", "zzz"]) == 2
+    err = _one_line_error(capsys, command)
+    assert "unknown method 'zzz'; available:" in err and "did you mean" not in err
+
+
+def test_python_api_names_the_closest_method_too():
+    with pytest.raises(lcp.InvalidProblem, match=r"'pivotting' \(did you mean 'pivoting'\?\)"):
+        lcp.solve(lcp.LCP(np.eye(2), -np.ones(2)), method="pivotting")
+
+
+def test_bench_names_the_closest_set_and_method(tmp_path, capsys):
+    out = tmp_path / "b"
+    assert main(["bench", "--set", "randomp", "--out", str(out), "--no-siconos"]) == 2
+    assert "unknown set(s) randomp (did you mean 'random-p'?)" in _one_line_error(capsys,
+                                                                                  "bench")
+    assert main(["bench", "--set", "random-p", "--methods", "pivot", "--out", str(out),
+                 "--no-siconos"]) == 2
+    assert "unknown method 'pivot' (did you mean 'pivoting'?)" in _one_line_error(capsys,
+                                                                                  "bench")
+    assert not out.exists()
+
+
+def test_bench_set_given_one_file_says_a_set_is_a_folder(problem, tmp_path, capsys):
+    out = tmp_path / "b"
+    assert main(["bench", "--set", str(problem), "--out", str(out), "--no-siconos"]) == 2
+    err = _one_line_error(capsys, "bench")
+    assert f"--set {problem} is a file; --set takes a set name or a folder" in err
+    assert "rigidlcp solve" in err and not out.exists()
+
+
+def test_nullspace_states_typo_is_not_called_a_missing_file(capsys):
+    assert main(["nullspace", "--lattice", "rect", "--lx", "2", "--ly", "2", "--states",
+                 "tangental"]) == 2
+    err = _one_line_error(capsys, "nullspace")
+    assert "--states 'tangental': neither 'normal' nor 'tangential'" in err
+    assert "No such" not in err
+    assert main(["nullspace", "--lattice", "rect", "--lx", "2", "--ly", "2", "--states",
+                 "normal"]) == 0
+
+
+@pytest.mark.parametrize("bad, says", [(["--h", "0"], "h must be a finite number > 0"),
+                                       (["--theta", "2"], "theta must lie in [0.5, 1]")])
+def test_timestep_refuses_bad_steps_before_its_progress_bar(tmp_path, capsys, bad, says):
+    out = tmp_path / "mj.npz"
+    assert main(["timestep", "--lattice", "rect", "--lx", "2", "--ly", "1", *bad, "--out",
+                 str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"rigidlcp timestep: error: {says}, got {float(bad[1])}\n"  # no bar before it
+    assert not out.exists()
