@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shlex
 from typing import Any
 
 from rigidlcp.lcp.api import ACCEPTS, methods, solve
@@ -27,7 +28,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "solve", help="solve a problem file (.npz, or Siconos's LCP/MLCP/FC2D text)",
         description="Solve the problem of a file: an LCP or MLCP .npz (LCP.save / MLCP.save) "
-        "or a Siconos text file (LCP, MLCP, 2D friction contact). Exit code 0 when solved, 1 "
+        "or a Siconos text file (LCP, MLCP, 2D friction contact), and print one solution "
+        "(uniqueness is not checked: `rigidlcp certify`). Exit code 0 when solved, 1 "
         "when the method did not solve it, 2 on bad input.",
     )
     _add_problem_arguments(p)
@@ -141,7 +143,8 @@ def cmd_certify(args: argparse.Namespace) -> int:
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    """Solve the problem file; print status, residual, iterations (or JSON)."""
+    """Solve the problem file; print status, residual, iterations and, when solved, the
+    solution (or JSON)."""
     problem = _load(args.problem)
     sol = solve(problem, method=args.method, **parse_options(args.option))
     if args.json:
@@ -155,4 +158,19 @@ def cmd_solve(args: argparse.Namespace) -> int:
         print(f"iterations : {sol.iterations}")
         if sol.message:
             print(f"message    : {sol.message}")
+        if sol.success:  # the answer itself, and what it is not (yet) known to be
+            if sol.u is not None:
+                print(f"u          : {_vector(sol.u)}")
+            print(f"z          : {_vector(sol.z)}")
+            print("note       : one solution, checked; whether it is the only one: "
+                  f"rigidlcp certify {shlex.quote(args.problem)}")
     return 0 if sol.success else 1
+
+
+def _vector(x) -> str:
+    """A vector on one line: every entry up to 10, else the first and last 3 (all in --json)."""
+    import numpy as np
+
+    return np.array2string(np.asarray(x), precision=6, threshold=10, edgeitems=3,
+                           max_line_width=10**6) + ("" if np.size(x) <= 10 else
+                                                    f"  ({np.size(x)} entries; all: --json)")

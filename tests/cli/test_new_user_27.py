@@ -79,3 +79,41 @@ def test_timestep_refuses_bad_steps_before_its_progress_bar(tmp_path, capsys, ba
     err = capsys.readouterr().err
     assert err == f"rigidlcp timestep: error: {says}, got {float(bad[1])}\n"  # no bar before it
     assert not out.exists()
+
+
+def test_solve_prints_the_solution_and_says_uniqueness_is_not_checked(problem, tmp_path,
+                                                                      capsys):
+    """`rigidlcp solve` printed status, residual and iterations, never the answer (only
+    --json had it)."""
+    assert main(["solve", str(problem)]) == 0
+    out = capsys.readouterr().out
+    assert "z          : [0.333333 0.333333]\n" in out  # (2 1; 1 2) z = (1, 1): z = 1/3
+    assert f"whether it is the only one: rigidlcp certify {problem}" in out
+    # z = (1, 0) and (0, 1) both solve (1 1; 1 1) z = (1, 1): one of them, not THE answer
+    both = tmp_path / "both.npz"
+    lcp.LCP(np.ones((2, 2)), -np.ones(2)).save(both)
+    assert main(["solve", str(both)]) == 0
+    out = capsys.readouterr().out
+    assert ("z          : [0. 1.]" in out or "z          : [1. 0.]" in out) and "only one" in out
+    big = tmp_path / "big.npz"  # identity, q = -1: z = 1, summarized beyond 10 entries
+    lcp.LCP(np.eye(12), -np.ones(12)).save(big)
+    assert main(["solve", str(big)]) == 0
+    assert "z          : [1. 1. 1. ... 1. 1. 1.]  (12 entries; all: --json)" in (
+        capsys.readouterr().out)
+    none = tmp_path / "none.npz"  # w = 0 z + (0, -1) < 0 for every z: no solution, no z line
+    lcp.LCP(np.zeros((2, 2)), np.array([0.0, -1.0])).save(none)
+    assert main(["solve", str(none)]) == 1
+    out = capsys.readouterr().out
+    assert "status     : infeasible" in out and "z          :" not in out
+
+
+def test_solve_prints_an_mlcps_free_unknowns(tmp_path, capsys):
+    # A u + C v + a = 0 with A = 1, C = 0, a = -2: u = 2; w = B v + b with B = 1, b = -3: v = 3
+    one, zero = np.eye(1), np.zeros((1, 1))
+    mlcp = lcp.MLCP(one, zero, zero, one, np.array([-2.0]), np.array([-3.0]))
+    f = tmp_path / "mlcp.npz"
+    mlcp.save(f)
+    assert main(["solve", str(f)]) == 0
+    out = capsys.readouterr().out
+    assert "u          : [2.]\nz          : [3.]\n" in out
+    assert "  u = [2.]\n  z = [3.]" in repr(lcp.solve(mlcp))  # the Solution's repr too
