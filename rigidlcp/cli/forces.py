@@ -36,10 +36,12 @@ def register(sub) -> None:
     p.add_argument("--seed", type=seed, default=0, help="seed of the angular velocities")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
-    p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1)")
-    p.add_argument("--method", default="lemke", help="LCP method for the solver's solution")
+    p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1; "
+                   "default %(default)s)")
+    p.add_argument("--method", default="lemke", help="LCP method for the solver's "
+                   "solution (default %(default)s)")
     p.add_argument("--time-limit", type=float, default=10.0,
-                   help="seconds for the paper's-choice MILP")
+                   help="seconds for the paper's-choice MILP (default %(default)s)")
     p.add_argument("--out", required=True, metavar="DIR", help="directory for the PNGs")
     p.add_argument("--force", action="store_true",
                    help="overwrite forces.json / network PNGs already in --out")

@@ -33,7 +33,7 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
                        help=f"{text} friction coefficient (default {DEFAULT_MU[name]})")
     g.add_argument("--gamma", type=float, default=0.1,
                    help="acceleration of the box relative to the plane, in g "
-                   "(0: constant velocity)")
+                   "(0: constant velocity; default %(default)s)")
     g.add_argument("--v0", type=float, default=0.0,
                    help="initial velocity of the box relative to the plane (sqrt(g r))")
     g.add_argument("--inertia", type=float, default=None,
@@ -122,15 +122,18 @@ def register(sub) -> None:
     g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
     g.add_argument("--omega-scale", type=float, default=1.0,
                    help="initial angular velocities uniform in [-scale, scale]")
-    g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
+    g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`; "
+                   "default %(default)s)")
     g.add_argument("--fallback", default="lemke",
-                   help="method used at an event where --method fails ('none': stop)")
+                   help="method used at an event where --method fails ('none': stop; "
+                   "default %(default)s)")
     g.add_argument("--selection", "--select", dest="select", type=selection_rule,
                    default="face-min-norm", metavar="RULE",
                    help="the point followed where an event's solution is not unique: "
                    "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none "
                    "(docs/integrators.md)")
-    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
+    g.add_argument("--t-max", type=float, default=np.inf,
+                   help="stop at this time (> 0; default: no limit)")
     g.add_argument("--max-events", type=int, default=100_000,
                    help="stop after this many events (default 100000)")
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")

@@ -35,7 +35,8 @@ def add_sweep(sub) -> None:
         "--mu-plane 0.1 --mu-wall 0 --gamma 0:1.0:41 --out sweep/ ; then "
         "rigidlcp effective sweep/")
     g = p.add_argument_group("system (each a grid)")
-    g.add_argument("--lattice", default=DEFAULTS["lattice"], help="rect, tri or rect,tri")
+    g.add_argument("--lattice", default=DEFAULTS["lattice"], help="rect, tri or rect,tri "
+                   "(default %(default)s)")
     for name, text in (("lx", "disks in the rows touching both walls"),
                        ("ly", "number of rows"), ("mu_pp", "particle-particle friction"),
                        ("mu_plane", "particle-plane friction"),
@@ -48,9 +49,11 @@ def add_sweep(sub) -> None:
         g.add_argument("--" + name.replace("_", "-"), default=default,
                        help=f"{text} (default {'default' if default is None else default})")
     r = p.add_argument_group("run (fixed for the sweep)")
-    r.add_argument("--method", default=RUN_OPTIONS["method"], help="LCP method")
+    r.add_argument("--method", default=RUN_OPTIONS["method"],
+                   help="LCP method (default %(default)s)")
     r.add_argument("--fallback", default=RUN_OPTIONS["fallback"],
-                   help="method used where --method fails ('none': stop)")
+                   help="method used where --method fails ('none': stop; default "
+                   "%(default)s)")
     r.add_argument("--selection", "--select", dest="select", type=selection_rule,
                    default=RUN_OPTIONS["select"], metavar="RULE",
                    help="the point followed where an event's solution is not unique: "
@@ -188,7 +191,8 @@ def add_effective(sub) -> None:
                    help="directory for mu_g.png (Fig. 11), effective.png (Fig. 12) and "
                    "effective.json (default: the sweep directory)")
     p.add_argument("--degree", type=int, default=1, help="degree of the local fits")
-    p.add_argument("--window", type=int, default=3, help="points per local fit")
+    p.add_argument("--window", type=int, default=3, help="points per local fit (default "
+                   "%(default)s)")
     p.add_argument("--force", action="store_true",
                    help="overwrite effective.json, mu_g.png, effective.png if present")
     p.add_argument("--json", action="store_true", help="print the table as JSON")

@@ -117,3 +117,27 @@ def test_solve_prints_an_mlcps_free_unknowns(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "u          : [2.]\nz          : [3.]\n" in out
     assert "  u = [2.]\n  z = [3.]" in repr(lcp.solve(mlcp))  # the Solution's repr too
+
+
+#: Options whose default --help does not state yet: pack's (rigidlcp/cli/pack.py was being
+#: changed by another developer in session 27), and -o, whose default is "no option".
+UNSTATED = {("pack", "--lx"), ("pack", "--ly"), ("solve", "--option"), ("certify", "--option")}
+
+
+def test_every_option_with_a_default_states_it_in_help():
+    """`simulate --help` said nothing of --gamma 0.1, --method lemke, --fallback lemke or of
+    --t-max's absence of a limit; `nullspace --help` hid its 4 x 3 array (simulate's is
+    10 x 4); timestep, compare-integrators, sweep, forces and fuzz hid theirs."""
+    import argparse
+
+    from rigidlcp.cli.main import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    silent = [(name, a.option_strings[0]) for name, p in sub.choices.items()
+              for a in p._actions
+              if a.option_strings and a.dest != "help" and a.default not in (None, False, True)
+              and "default" not in (a.help or "")]
+    assert sorted(set(silent) - UNSTATED) == []
+    helps = {a.option_strings[0]: a.help % {"default": a.default}
+             for a in sub.choices["simulate"]._actions if a.option_strings}
+    assert helps["--gamma"].endswith("default 0.1)") and "default lemke" in helps["--fallback"]
