@@ -240,8 +240,10 @@ def cmd_simulate(args) -> int:
             counts = state_counts(system, last)
             rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{summary['mu_g']:.6f}"
                       + selection_note(args.select, run.status, args.out)),
-                     ("F_g", f"{summary['F_g']:.6f}"),
-                     ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"),
+                     ("F_g", f"{summary['F_g']:.6f}" + same_state(run.status, "mu_g x "
+                                                                  "the weight")),
+                     ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"
+                      + same_state(run.status, "-sum S v_t")),
                      ("dD/dt", f"{summary['dissipation_rate_slope']:.6g}"),
                      ("dissipated energy", f"{summary['dissipated_energy']:.6g} over t in "
                       "[{:.6g}, {:.6g}]".format(*summary["dissipated_energy_interval"])),
@@ -266,6 +268,12 @@ def selection_note(rule: str, status: str, out: str | None) -> str:
         return f"  (selection {rule})"
     return (f"  (one valid steady state, selection {rule}; over all of them: "
             f"rigidlcp ranges {out or 'RUN.npz'})")
+
+
+def same_state(status: str, what: str) -> str:
+    """F_g and D are read at the state whose mu_g is annotated (`selection_note`): at a
+    steady state they vary with it over the valid steady states, so the row says so."""
+    return f"  ({what}, at the same selected state)" if status == "steady" else ""
 
 
 def title(lat) -> str:

@@ -141,3 +141,18 @@ def test_every_option_with_a_default_states_it_in_help():
     helps = {a.option_strings[0]: a.help % {"default": a.default}
              for a in sub.choices["simulate"]._actions if a.option_strings}
     assert helps["--gamma"].endswith("default 0.1)") and "default lemke" in helps["--fallback"]
+
+
+def test_simulate_reads_F_g_and_D_at_the_selected_state(tmp_path, capsys):
+    """mu_g was named as one valid steady state among others, but F_g = mu_g x weight and D
+    below it were printed as plain numbers (rect 3 x 2: mu_g ranges over [0.0858, 0.197])."""
+    out = tmp_path / "s.npz"
+    assert main(["simulate", "--lattice", "rect", "--lx", "3", "--ly", "2", "--out", str(out),
+                 "--no-progress"]) == 0
+    rows = {line.split("  ")[1].strip() if line.startswith("  ") else "": line
+            for line in capsys.readouterr().out.splitlines()}
+    mu_g = float(rows["mu_g"].split()[1])
+    assert "(mu_g x the weight, at the same selected state)" in rows["F_g"]
+    # 6 unit disks; both printed to 6 decimals: 6 x 5e-7 + 5e-7 of rounding at most
+    assert float(rows["F_g"].split()[1]) == pytest.approx(6 * mu_g, abs=3.5e-6)
+    assert "(-sum S v_t, at the same selected state)" in rows["dissipation rate D"]
