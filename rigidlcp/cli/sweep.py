@@ -126,7 +126,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             print(json.dumps(row))
     else:
         cols = varying(res.rows) or list(sweep.axes)
-        print_table(res.rows, cols)
+        print_table(res.rows, cols, selection=args.select)
         print(f"{len(res.rows)} points: {res.ran} run now, {res.skipped} found done; "
               f"results: {res.out / 'results.jsonl'}")
     outside = [r for r in res.rows if r.get("paper_regime") is False]
@@ -141,10 +141,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def print_table(rows: list[dict], cols: list[str]) -> None:
+def print_table(rows: list[dict], cols: list[str], selection: str | None = None) -> None:
     """One row per point; D(t) is the dissipation rate right after the last event (at t), dD/dt
     its slope: under gamma != 0 the sliding velocities grow linearly in the steady state, so
-    D(t) depends on when the run stopped and dD/dt is the steady observable (Sec. IV C)."""
+    D(t) depends on when the run stopped and dD/dt is the steady observable (Sec. IV C).
+    A steady row's mu_g, F_g and D are those of the steady state the `selection` rule reached,
+    one valid steady state (there may be others): the last line says so, and where the ranges
+    are."""
     head = cols + ["status", "events", "t", "mu_g", "F_g", "D(t)", "dD/dt", "NS", "sliding"]
     table = []
     for r in rows:
@@ -161,6 +164,10 @@ def print_table(rows: list[dict], cols: list[str]) -> None:
     if any(r.get("gamma") for r in rows):
         print("D(t): dissipation rate after the last event, at t (m g sqrt(g r)); under gamma "
               "!= 0 it grows as dD/dt in the steady state: compare dD/dt across points")
+    if selection is not None and any(r.get("status") == "steady" for r in rows):
+        print(f"mu_g, F_g, D of a steady row: the steady state the selection rule ({selection}) "
+              "reached, one valid steady state (there may be others); their range over all: "
+              "rigidlcp ranges on that point's run (--save-runs)")
 
 
 def _fmt(v) -> str:

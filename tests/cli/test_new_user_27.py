@@ -156,3 +156,16 @@ def test_simulate_reads_F_g_and_D_at_the_selected_state(tmp_path, capsys):
     # 6 unit disks; both printed to 6 decimals: 6 x 5e-7 + 5e-7 of rounding at most
     assert float(rows["F_g"].split()[1]) == pytest.approx(6 * mu_g, abs=3.5e-6)
     assert "(-sum S v_t, at the same selected state)" in rows["dissipation rate D"]
+
+
+def test_sweep_table_says_its_numbers_are_the_selections(tmp_path, capsys):
+    """The sweep's table printed mu_g, F_g and D per point as THE values; each is the steady
+    state its selection rule reached (the rule is named, and the command for the ranges)."""
+    out = tmp_path / "sw"
+    assert main(["sweep", "--lx", "2", "--ly", "1", "--gamma", "0.1:0.05:2", "--selection",
+                 "max-sum-R", "--out", str(out), "--no-progress"]) == 0
+    text = capsys.readouterr().out
+    assert "steady" in text
+    assert ("mu_g, F_g, D of a steady row: the steady state the selection rule (max-sum-R) "
+            "reached, one valid steady state (there may be others)") in text
+    assert "rigidlcp ranges on that point's run (--save-runs)" in text
