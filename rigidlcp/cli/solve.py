@@ -133,12 +133,25 @@ def cmd_certify(args: argparse.Namespace) -> int:
         fields = ("accepted", "tol", "residual", "scaled_residual", "eq_residual",
                   "scaled_eq_residual", "w_unique", "z_unique", "pattern_unique", "observables",
                   "method", "other_reason", "other_distance", "bound", "notes", "seconds")
-        out = {"solver": sol.method, "status": sol.status,
+        out = {"solver": sol.method, "status": sol.status, "z": sol.z, "u": sol.u,
                **{f: getattr(cert, f) for f in fields}}
         print(json.dumps(_jsonable(out), indent=2, allow_nan=False))
     else:
         print(f"solved by {sol.method} ({sol.iterations} iterations)")
         print(cert)
+        # the point certified, after the verdicts on whether it is the only one (a friction
+        # problem's answer is its forces r, judged as "forces"; its z is the Glocker LCP's)
+        from rigidlcp.lcp.problems.problem import LCP, MLCP
+
+        friction = not isinstance(problem, (LCP, MLCP))
+        rows = ([("r", sol.z, cert.observables.get("forces"))] if friction
+                else [("z", sol.z, cert.z_unique)])
+        if sol.u is not None:
+            rows.append(("u", sol.u, cert.observables.get("u")))
+        for name, x, unique in rows:
+            what = {True: f"the solution: {name} is unique", False: f"one of several {name} "
+                    "(another above)", None: f"one solution; uniqueness of {name} undecided"}
+            print(f"certified {name} = {_vector(x)}  ({what[unique]})")
     return 0 if cert.accepted else 1
 
 

@@ -5,6 +5,9 @@ its progress bar before the one-line refusal."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -169,3 +172,43 @@ def test_sweep_table_says_its_numbers_are_the_selections(tmp_path, capsys):
     assert ("mu_g, F_g, D of a steady row: the steady state the selection rule (max-sum-R) "
             "reached, one valid steady state (there may be others)") in text
     assert "rigidlcp ranges on that point's run (--save-runs)" in text
+
+
+def test_certify_prints_the_point_it_certified_after_the_verdict(problem, tmp_path, capsys):
+    """certify printed another solution z' when there was one, never the z it certified (nor
+    did --json); the certified z now comes after the verdicts, labelled by them."""
+    assert main(["certify", str(problem)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1] == "certified z = [0.333333 0.333333]  (the solution: z is unique)"
+    both = tmp_path / "both.npz"  # (1 1; 1 1) z = (1, 1): z = (1, 0) and (0, 1) both solve it
+    lcp.LCP(np.ones((2, 2)), -np.ones(2)).save(both)
+    assert main(["certify", str(both)]) == 0
+    out = capsys.readouterr().out
+    assert out.index("z               : another solution exists") < out.index("certified z")
+    assert out.splitlines()[-1] in ("certified z = [0. 1.]  (one of several z (another above))",
+                                    "certified z = [1. 0.]  (one of several z (another above))")
+    assert main(["certify", str(both), "--json"]) == 0
+    cert = json.loads(capsys.readouterr().out)
+    assert cert["z_unique"] is False and sorted(cert["z"]) == [0.0, 1.0] and cert["u"] is None
+
+
+def test_certify_names_an_mlcps_u_and_a_friction_problems_r(tmp_path, capsys):
+    one, zero = np.eye(1), np.zeros((1, 1))  # u = 2, v = 3 (as above)
+    f = tmp_path / "mlcp.npz"
+    lcp.MLCP(one, zero, zero, one, np.array([-2.0]), np.array([-3.0])).save(f)
+    assert main(["certify", str(f)]) == 0
+    assert capsys.readouterr().out.splitlines()[-2:] == [
+        "certified z = [3.]  (the solution: z is unique)",
+        "certified u = [2.]  (the solution: u is unique)"]
+    # a friction problem's answer is r, judged as "forces" (its z is the Glocker LCP's)
+    fc2d = Path(__file__).parents[1] / "data/siconos/FC2D_SliderCrankLagrangian00000.dat"
+    assert main(["certify", str(fc2d)]) == 0
+    last = capsys.readouterr().out.splitlines()[-1]
+    from rigidlcp import verify
+
+    fc = lcp.load(fc2d)
+    sol = lcp.solve(fc)
+    verdict = verify.certify(fc, sol).observables["forces"]  # the label follows this verdict
+    assert last.startswith(f"certified r = {np.array2string(sol.z, precision=6)}  (")
+    assert {True: "r is unique", False: "one of several r", None: "of r undecided"}[
+        verdict] in last
