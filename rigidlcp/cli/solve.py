@@ -174,7 +174,10 @@ def cmd_solve(args: argparse.Namespace) -> int:
         if sol.success:  # the answer itself, and what it is not (yet) known to be
             if sol.u is not None:
                 print(f"u          : {_vector(sol.u)}")
-            print(f"z          : {_vector(sol.z)}")
+            from rigidlcp.lcp.problems.problem import LCP, MLCP
+
+            name = "z" if isinstance(problem, (LCP, MLCP)) else "r"  # friction: the forces
+            print(f"{name}          : {_vector(sol.z)}")
             print("note       : one solution, checked; whether it is the only one: "
                   f"rigidlcp certify {shlex.quote(args.problem)}")
     return 0 if sol.success else 1

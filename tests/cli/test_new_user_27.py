@@ -212,3 +212,10 @@ def test_certify_names_an_mlcps_u_and_a_friction_problems_r(tmp_path, capsys):
     assert last.startswith(f"certified r = {np.array2string(sol.z, precision=6)}  (")
     assert {True: "r is unique", False: "one of several r", None: "of r undecided"}[
         verdict] in last
+
+
+def test_solve_names_a_friction_problems_answer_r(capsys):
+    fc2d = Path(__file__).parents[1] / "data/siconos/FC2D_SliderCrankLagrangian00000.dat"
+    assert main(["solve", str(fc2d)]) == 0
+    sol = lcp.solve(lcp.load(fc2d))
+    assert f"r          : {np.array2string(sol.z, precision=6)}\n" in capsys.readouterr().out
