@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import os
 import shlex
 import sys
@@ -197,6 +198,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if args.resume:
             if not os.path.isfile(csv_path):
                 raise ValueError(f"--resume: {csv_path} does not exist")
+            _check_same_run(args)
             done = read_csv(csv_path)
         return _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done,
                     {m: peers_ok[m][1] for m in methods if m in PEERS})
@@ -224,6 +226,10 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     try:
         if not args.resume and csv_path.exists():
             csv_path.unlink()  # --force: a fresh results.csv
+        if not args.resume:
+            from rigidlcp.lcp.io.files import atomic_write_text
+
+            atomic_write_text(out / OPTIONS, json.dumps(_run_options(args), indent=1) + "\n")
         load0 = os.getloadavg()[0]
         started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
         total = sum(1 if isinstance(p, Unreadable) else len(methods)
@@ -286,6 +292,35 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     for line in notes:
         print(f"note: {line}")
     return 0
+
+
+#: The options of a bench run that its kept rows depend on (the problems' data: --seed; their
+#: judgement and timing: --tol, --time-limit, batch, isolation), written to OUT/OPTIONS.
+OPTIONS = "options.json"
+
+
+def _run_options(args: argparse.Namespace) -> dict:
+    return {"--seed": args.seed, "--tol": args.tol, "--time-limit": args.time_limit,
+            "--no-batch": bool(args.no_batch), "--no-isolation": bool(args.no_isolation)}
+
+
+def _check_same_run(args: argparse.Namespace) -> None:
+    """--resume keeps the rows of results.csv: refused when the run in --out had other
+    options (a kept row of --seed 0 is another problem than this command's of --seed 5, one
+    judged at --tol 1e-8 is not judged at 1e-3). A folder of an older version has no
+    OPTIONS: nothing to compare."""
+    path = os.path.join(args.out, OPTIONS)
+    if not os.path.isfile(path):
+        return
+    with open(path) as fh:
+        before = json.load(fh)
+    now = _run_options(args)
+    differ = [f"{k} {before[k]} there, {now[k]} here" for k in now
+              if k in before and before[k] != now[k]]
+    if differ:
+        raise ValueError(f"--resume: {args.out} was run with other options ({'; '.join(differ)})"
+                         ": its kept rows would not be this run's; give the same options, or "
+                         "a new --out")
 
 
 def _print_summary(results, time_limit: float) -> None:

@@ -219,3 +219,25 @@ def test_solve_names_a_friction_problems_answer_r(capsys):
     assert main(["solve", str(fc2d)]) == 0
     sol = lcp.solve(lcp.load(fc2d))
     assert f"r          : {np.array2string(sol.z, precision=6)}\n" in capsys.readouterr().out
+
+
+def test_bench_resume_with_other_options_is_refused(tmp_path, capsys):
+    """`bench --resume --seed 5` kept the row of random-p/n4-0 drawn with --seed 0 (another
+    matrix: default_rng([seed, n, index])) and reported it as this run's; --tol 1e-3 kept rows
+    judged at 1e-8. The options are written to OUT/options.json and compared on --resume."""
+    out = tmp_path / "b"
+    base = ["bench", "--set", "random-p", "--sizes", "4", "--per-size", "1", "--methods",
+            "lemke", "--out", str(out), "--no-progress", "--no-siconos"]
+    assert main(base) == 0
+    capsys.readouterr()
+    before = (out / "results.csv").read_text()
+    assert json.loads((out / "options.json").read_text())["--seed"] == 0
+    assert main([*base, "--resume", "--seed", "5"]) == 2
+    err = _one_line_error(capsys, "bench")
+    assert "--resume: " in err and "(--seed 0 there, 5 here)" in err
+    assert main([*base, "--resume", "--tol", "1e-3"]) == 2
+    assert "--tol 1e-08 there, 0.001 here" in _one_line_error(capsys, "bench")
+    assert (out / "results.csv").read_text() == before  # nothing written by a refusal
+    assert main([*base[:-5], "lemke,pivoting", *base[-4:], "--resume"]) == 0  # same options
+    rows = (out / "results.csv").read_text().splitlines()
+    assert len(rows) == 3 and rows[1] == before.splitlines()[1]  # lemke's row kept, pivoting's
