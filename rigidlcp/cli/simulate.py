@@ -43,11 +43,13 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
                    "instead of --lattice/--lx/--ly")
 
 
-def system_from_args(args):
+def system_from_args(args, array_defaults: tuple | None = None):
+    """The System of the options; with --packing, refused when --lattice/--lx/--ly differ from
+    the command's own `array_defaults` (default ARRAY_DEFAULTS, simulate's 10 x 4 rect)."""
     from rigidlcp.models.system import make_system
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
-        refuse_array_options(args)
+        refuse_array_options(args, array_defaults or ARRAY_DEFAULTS)
         from rigidlcp.models.system import System
 
         return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,

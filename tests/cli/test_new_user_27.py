@@ -241,3 +241,17 @@ def test_bench_resume_with_other_options_is_refused(tmp_path, capsys):
     assert main([*base[:-5], "lemke,pivoting", *base[-4:], "--resume"]) == 0  # same options
     rows = (out / "results.csv").read_text().splitlines()
     assert len(rows) == 3 and rows[1] == before.splitlines()[1]  # lemke's row kept, pivoting's
+
+
+def test_forces_takes_a_packing_without_array_options(tmp_path, capsys):
+    """`rigidlcp forces --packing three.csv --out DIR` was refused ('--packing takes its disks
+    from the file: --lattice, --lx and --ly describe an array') with none of them given:
+    forces' own defaults (Fig. 4's tri 5 x 4) were compared with simulate's (rect 10 x 4)."""
+    f = tmp_path / "three.csv"
+    f.write_text("x,y,r\n1,1,1\n3,1,1\n2,2.7320508075688772,1\n")
+    assert main(["forces", "--packing", str(f), "--out", str(tmp_path / "f")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("packing: 3 disks, 7 contacts;") and (tmp_path / "f/forces.json").exists()
+    assert main(["forces", "--packing", str(f), "--lx", "6", "--out", str(tmp_path / "g")]) == 2
+    assert "--packing takes its disks from the file" in _one_line_error(capsys, "forces")
+    assert not (tmp_path / "g").exists()
