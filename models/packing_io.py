@@ -250,7 +250,8 @@ def _one_snapshot(path: Path, lines: list[str], end: int, n: int) -> None:
     steps = [lines[k + 1].strip() if k + 1 < len(lines) else "?" for k in starts]
     raise InvalidFile(f"{path} holds {len(starts)} snapshots (timesteps {steps[0]} to "
                       f"{steps[-1]}), a packing is one: write the one you want to its own "
-                      f"file, e.g. the last: tail -n +{starts[-1] + 1} {path} > last.dump")
+                      f"file, e.g. the last: tail -n +{starts[-1] + 1} {path} > "
+                      f"{path.with_name(path.stem + '_last' + path.suffix)}")
 
 
 def _lammps_box(path: Path, head: list[str], disks: Disks) -> None:
