@@ -12,13 +12,15 @@ trusted): see lcp.acceptance.trust.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import rigidlcp.lcp.registry as registry
 
 from .acceptance.residual import TOL
 from .acceptance.trust import Run, solve_checked
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
-from .registry import ACCEPTS, MethodInfo, check_options, lookup, register
+from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup, register
 from .solvers import BUILTIN as _BUILTIN
 
 __all__ = ["solve", "get_method", "methods", "register", "MethodInfo", "ACCEPTS",
@@ -48,7 +50,8 @@ def get_method(name: str) -> MethodInfo:
         info = lookup(name)
     if info is None:
         raise InvalidProblem(
-            f"unknown method {name!r}; available: {', '.join(sorted(registry._REGISTRY))}"
+            f"unknown method {name!r}{did_you_mean(name, registry._REGISTRY)}; available: "
+            f"{', '.join(sorted(registry._REGISTRY))}"
         )
     return info
 
@@ -92,7 +95,7 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
                 f"problem must be an lcp.LCP, lcp.MLCP or lcp.FrictionContact2D, got "
                 f"{type(problem).__name__}"
             )
-    info = get_method(method)
+    info = _returning_solutions(get_method(method))
     check_options(info, options)
     if friction:
         from .acceptance.friction import solve_friction
@@ -112,8 +115,26 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
             f"method {method!r} is limited to n <= {info.max_n}; this LCP has n = {lcp.n}"
         )
     on = info.equilibrate if equilibrate is None else bool(equilibrate)
-    run = Run(problem, lcp, get_method, TOL, _fallbacks(fallback))
+    run = Run(problem, lcp, lambda name: _returning_solutions(get_method(name)), TOL,
+              _fallbacks(fallback))
     return solve_checked(run, method, on, bool(repair), options)
+
+
+def _returning_solutions(info: MethodInfo) -> MethodInfo:
+    """`info` whose function raises TypeError, naming the method, when it returns anything but
+    an lcp.Solution: a registered method that forgot its `return` failed with "'NoneType'
+    object has no attribute 'method'" deep in lcp.acceptance.trust."""
+    func, name = info.func, info.name
+
+    def checked(*args, **kwargs) -> Solution:
+        sol = func(*args, **kwargs)
+        if not isinstance(sol, Solution):
+            raise TypeError(f"method {name!r} returned {type(sol).__name__}, not an "
+                            "lcp.Solution (a registered method returns lcp.Solution(z=..., "
+                            "w=..., status=..., method=...))")
+        return sol
+
+    return replace(info, func=checked)
 
 
 def _fallbacks(fallback) -> tuple[str, ...]:

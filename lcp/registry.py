@@ -9,6 +9,7 @@ solvers fill a table the facade reads (docs/architecture.md, "Adding a method").
 
 from __future__ import annotations
 
+import difflib
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -71,6 +72,13 @@ def register(name: str, *, accepts: str, description: str, max_n: int | None = N
 def lookup(name: str) -> MethodInfo | None:
     """The registered method `name`, or None (nothing is loaded here: see lcp.api.get_method)."""
     return _REGISTRY.get(name)
+
+
+def did_you_mean(name: str, names) -> str:
+    """" (did you mean 'lemke'?)" for the closest of `names` to a mistyped `name` (difflib's
+    ratio >= 0.6), else "": the tail of an "unknown method / set" message."""
+    close = difflib.get_close_matches(str(name), list(names), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def check_options(info: MethodInfo, options: dict) -> None:

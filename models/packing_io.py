@@ -5,9 +5,11 @@
   `# box: left=L right=R` (written by `write_packing`) gives the walls (a value "none": no
   such wall).
 * .npz: arrays x, y, r [, m, I] and optional scalars left, right (NaN: no such wall).
-* LAMMPS dump (text, `dump ... custom`): the first snapshot's `ITEM: ATOMS` columns x, y and
+* LAMMPS dump (text, `dump ... custom`) of one snapshot: its `ITEM: ATOMS` columns x, y and
   radius (or diameter, halved; mass optional); atoms in the file's order. Recognized by its
-  first line `ITEM: TIMESTEP`. Its `ITEM: BOX BOUNDS` give the walls from the x line and its
+  first line `ITEM: TIMESTEP`. A trajectory (several snapshots) is refused, naming the line
+  where its last snapshot starts: which one is the packing is the user's choice. Its
+  `ITEM: BOX BOUNDS` give the walls from the x line and its
   boundary flag (one letter per side: lo, hi): "f" (fixed; also a line without flags) a wall at
   xlo / xhi; "s", "m" (shrink-wrapped: the box follows the atoms' centres) no stated wall (the
   tight box, as without BOX BOUNDS); "p" (periodic) and a tilted box (triclinic, xy != 0) are
@@ -219,6 +221,7 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
     body = lines[start + 1: start + 1 + n]
     if len(body) < n:
         raise InvalidFile(f"{path}: {n} atoms announced, {len(body)} lines follow")
+    _one_snapshot(path, lines, start + 1 + n, n)
     for k, raw in enumerate(body, start=start + 2):
         fields = raw.split()
         if len(fields) != len(names):
@@ -232,6 +235,23 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
     disks = _finish(path, cols)
     _lammps_box(path, lines[:start], disks)
     return disks
+
+
+def _one_snapshot(path: Path, lines: list[str], end: int, n: int) -> None:
+    """InvalidFile when anything but blank lines follows the first snapshot's n atoms (which
+    end at line index `end`): more snapshots (a trajectory), or more atoms than announced."""
+    more = next((k for k in range(end, len(lines)) if lines[k].strip()), None)
+    if more is None:
+        return
+    if lines[more].strip() != "ITEM: TIMESTEP":
+        raise InvalidFile(f"{path} line {more + 1}: more lines than the {n} atoms announced "
+                          "by ITEM: NUMBER OF ATOMS")
+    starts = [k for k, line in enumerate(lines) if line.strip() == "ITEM: TIMESTEP"]
+    steps = [lines[k + 1].strip() if k + 1 < len(lines) else "?" for k in starts]
+    raise InvalidFile(f"{path} holds {len(starts)} snapshots (timesteps {steps[0]} to "
+                      f"{steps[-1]}), a packing is one: write the one you want to its own "
+                      f"file, e.g. the last: tail -n +{starts[-1] + 1} {path} > "
+                      f"{path.with_name(path.stem + '_last' + path.suffix)}")
 
 
 def _lammps_box(path: Path, head: list[str], disks: Disks) -> None:

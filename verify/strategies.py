@@ -17,10 +17,12 @@ that have the advertised property *by construction*, with the reason in its docs
                             sliding +1 / -1 or non-sliding candidate 0.
 
 Sizes may be an int or a strategy of ints, and matrix strategies can be passed to ``lcps``:
-``lcps(p_matrices(st.integers(1, 6)), planted=True)``. Entries are kept O(1) and the
-constructions keep conditioning moderate, so that a method disagreeing with another by more
-than ~1e-8 is a bug, not rounding. Entries lie on a grid of step 1/1000 (exact zeros and ties
-included; no 1e-140 next to 1).
+``lcps(p_matrices(st.integers(1, 6)), planted=True)``. Where a strategy of numbers or of
+matrices is asked for (``mu``, ``gamma``, ``candidates``, ``q_elements``, ``matrices``), a
+plain number or matrix is taken as that fixed value (``st.just``): ``systems(mu=0.3)``.
+Entries are kept O(1) and the constructions keep conditioning moderate, so that a method
+disagreeing with another by more than ~1e-8 is a bug, not rounding. Entries lie on a grid of
+step 1/1000 (exact zeros and ties included; no 1e-140 next to 1).
 """
 
 from __future__ import annotations
@@ -50,6 +52,22 @@ NU = st.integers(1, 4)
 M_PAIRS = st.integers(1, 5)
 LX = st.integers(1, 8)
 LY = st.integers(1, 6)
+
+
+def _strategy(value, name: str, matrix: bool = False) -> st.SearchStrategy:
+    """`value` itself when it is a strategy; a plain number (or, with `matrix`, a square
+    matrix) as the strategy of that one value; InvalidInput naming `name` otherwise."""
+    if isinstance(value, st.SearchStrategy):
+        return value
+    if matrix:
+        a = np.asarray(value, dtype=float) if isinstance(value, (np.ndarray, list)) else None
+        if a is not None and a.ndim == 2 and a.shape[0] == a.shape[1] and a.size:
+            return st.just(a)
+        raise InvalidInput(f"{name} must be a strategy of square matrices or a square matrix, "
+                           f"got {type(value).__name__}")
+    if isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool):
+        return st.just(float(value))
+    raise InvalidInput(f"{name} must be a number or a strategy of numbers, got {value!r}")
 
 
 def _size(draw, n: SizeLike, least: int = 1) -> int:
@@ -156,6 +174,9 @@ def planted_solution(draw, M: np.ndarray, *, degenerate: bool = True):
     z_i = w_i = 0 (a degenerate pair). Values are in [0.1, 1]. For positive semidefinite M this
     also makes a problem that is solvable at all (a singular PSD M with a random q need not be).
     """
+    if isinstance(M, st.SearchStrategy):
+        raise InvalidInput("planted_solution takes a matrix, not a strategy: for drawn "
+                           "matrices use lcps(matrices, planted=True), or draw M first")
     n = M.shape[0]
     states = st.sampled_from(("z", "w", "0") if degenerate else ("z", "w"))
     pattern = draw(st.lists(states, min_size=n, max_size=n))
@@ -174,14 +195,17 @@ def lcps(
 
     q has entries from ``q_elements`` (default [-1, 1]); with ``planted=True`` q is built from
     a planted complementary pair instead (see planted_solution), recorded in
-    ``meta["planted_z"]`` and ``meta["planted_w"]`` (lists).
+    ``meta["planted_z"]`` and ``meta["planted_w"]`` (lists). A plain matrix in place of
+    ``matrices`` is that fixed M.
     """
-    M = draw(matrices if matrices is not None else p_matrices())
+    M = draw(_strategy(matrices, "matrices", matrix=True) if matrices is not None
+             else p_matrices())
     n = M.shape[0]
     if planted:
         z, w, q = draw(planted_solution(M))
         return LCP(M, q, meta={"planted_z": z.tolist(), "planted_w": w.tolist()})
-    q = draw(arrays(np.float64, (n,), elements=q_elements or _unit()))
+    elements = _unit() if q_elements is None else _strategy(q_elements, "q_elements")
+    q = draw(arrays(np.float64, (n,), elements=elements))
     return LCP(M, q)
 
 
@@ -255,10 +279,11 @@ def mlcps(draw, nu: SizeLike = NU, m: SizeLike = M_PAIRS) -> MLCP:
 def lattices(draw, kinds: tuple[str, ...] = ("rect", "tri"), lx: SizeLike = LX,
              ly: SizeLike = LY):
     """``models.Lattice`` of a drawn kind and size; triangular arrays of two or more rows get
-    lx >= 2 (their rows in the hollows hold lx - 1 disks)."""
+    lx >= 2 (their rows in the hollows hold lx - 1 disks). ``kinds``: a tuple of "rect" and
+    "tri", or one of them as a string."""
     from rigidlcp import models
 
-    kind = draw(st.sampled_from(kinds))
+    kind = draw(st.sampled_from((kinds,) if isinstance(kinds, str) else tuple(kinds)))
     n_rows = _size(draw, ly)
     least = 2 if kind == "tri" and n_rows >= 2 else 1
     n_cols = max(_size(draw, lx), least)
@@ -270,14 +295,15 @@ def systems(draw, lattice=None, mu: st.SearchStrategy[float] | None = None,
             gamma: st.SearchStrategy[float] | None = None):
     """``models.System`` on ``lattice`` (a Lattice, a strategy of them, or None for
     ``lattices()``), coefficients per kind from ``mu`` (default 0 to 0.5 on a grid, 0 included)
-    and driving acceleration from ``gamma`` (default -0.5 to 0.5)."""
+    and driving acceleration from ``gamma`` (default -0.5 to 0.5); a plain number for ``mu``
+    or ``gamma`` fixes it."""
     from rigidlcp import models
 
     if lattice is None:
         lattice = lattices()
     lat = draw(lattice) if isinstance(lattice, st.SearchStrategy) else lattice
-    mu = _unit(0.0, 0.5) if mu is None else mu
-    gamma = _unit(-0.5, 0.5) if gamma is None else gamma
+    mu = _unit(0.0, 0.5) if mu is None else _strategy(mu, "mu")
+    gamma = _unit(-0.5, 0.5) if gamma is None else _strategy(gamma, "gamma")
     return models.System(lat, mu_pp=draw(mu), mu_plane=draw(mu), mu_wall=draw(mu),
                          gamma=draw(gamma), V0=draw(_unit(-1.0, 1.0)))
 
@@ -301,7 +327,7 @@ def event_states(draw, system, candidates: st.SearchStrategy[float] | None = Non
 
     p, c = system.p, system.c
     omega = _vector(draw, p)
-    frac = draw(_unit(0.0, 1.0) if candidates is None else candidates)
+    frac = draw(_unit(0.0, 1.0) if candidates is None else _strategy(candidates, "candidates"))
     stick = draw(arrays(np.float64, c, elements=_unit(0.0, 1.0))) < frac
     signs = draw(arrays(np.int64, c, elements=st.sampled_from([1, -1])))
     s = np.where(stick | (system.mu == 0), 0, signs)

@@ -86,6 +86,8 @@ class Solution:
             lines.append(f"  active set : {int(np.size(self.basis))} of {n} z basic")
         if self.message:
             lines.append(f"  message    : {self.message}")
+        if self.u is not None and self.u.size <= 8:  # an MLCP's free unknowns
+            lines.append(f"  u = {np.array2string(self.u, precision=6)}")
         if n <= 8:
             lines.append(f"  z = {np.array2string(self.z, precision=6)}")
             lines.append(f"  w = {np.array2string(self.w, precision=6)}")

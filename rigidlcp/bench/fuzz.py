@@ -151,7 +151,8 @@ def add_arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--seed", type=int, default=0, help="seed of the draw (default 0)")
     ap.add_argument("--out", default=None, help="folder for the silent-wrong / crash cases "
                     "(must not exist yet)")
-    ap.add_argument("--classes", default=",".join(CLASSES), help="comma-separated classes")
+    ap.add_argument("--classes", default=",".join(CLASSES),
+                    help="comma-separated classes (default: all, %(default)s)")
     ap.add_argument("--methods", default=None, help="comma-separated methods (default: all)")
     ap.add_argument("--progress", type=int, default=0, metavar="K",
                     help="print the table so far to stderr every K problems (default: never; "

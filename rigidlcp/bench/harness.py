@@ -195,8 +195,9 @@ def check_methods(methods: Iterable[str], siconos: SiconosRunner | None) -> None
     known = {m.name for m in lcp.methods()}
     for m in methods:
         if m not in known and m not in SICONOS_METHODS and m not in PEERS:
-            raise ValueError(f"unknown method {m!r}; available: "
-                             f"{', '.join(sorted(known) + list(SICONOS_METHODS) + list(PEERS))}")
+            every = sorted(known) + list(SICONOS_METHODS) + list(PEERS)
+            raise ValueError(f"unknown method {m!r}{lcp.registry.did_you_mean(m, every)}; "
+                             f"available: {', '.join(every)}")
         if m in SICONOS_METHODS and (siconos is None or not siconos.available):
             raise ValueError(f"{m} needs Siconos: "
                              f"{siconos.reason if siconos else 'no Siconos runner given'}")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import datetime
+import json
 import os
 import shlex
 import sys
@@ -76,6 +77,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from rigidlcp.bench.harness import SICONOS_METHODS, SiconosRunner, check_methods, read_csv
     from rigidlcp.bench.peers import PEERS, peer_available
     from rigidlcp.bench.problem_sets import SETS, get_set, list_sets
+    from rigidlcp.lcp.registry import did_you_mean
 
     siconos = None if args.no_siconos else SiconosRunner()
     try:
@@ -119,8 +121,14 @@ def cmd_bench(args: argparse.Namespace) -> int:
             params["per_size"] = args.per_size
         specs = [s.strip() for s in args.sets.split(",") if s.strip()]
         unknown = [s for s in specs if s not in SETS and not os.path.isdir(s)]
+        files = [s for s in unknown if os.path.isfile(s)]
+        if files:  # one problem file: a set is a folder of them
+            raise ValueError(f"--set {files[0]} is a file; --set takes a set name or a folder "
+                             "of *.npz / *.dat problem files (for one file: `rigidlcp solve` "
+                             "or `rigidlcp certify`)")
         if unknown:
-            raise ValueError(f"unknown set(s) {', '.join(unknown)}: neither a set name "
+            hint = did_you_mean(unknown[0], SETS) if len(unknown) == 1 else ""
+            raise ValueError(f"unknown set(s) {', '.join(unknown)}{hint}: neither a set name "
                              f"({', '.join(SETS)}) nor a folder")
         notes: list[str] = []
         siconos_ok = siconos is not None and siconos.available
@@ -190,6 +198,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
         if args.resume:
             if not os.path.isfile(csv_path):
                 raise ValueError(f"--resume: {csv_path} does not exist")
+            _check_same_run(args)
             done = read_csv(csv_path)
         return _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done,
                     {m: peers_ok[m][1] for m in methods if m in PEERS})
@@ -217,6 +226,10 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     try:
         if not args.resume and csv_path.exists():
             csv_path.unlink()  # --force: a fresh results.csv
+        if not args.resume:
+            from rigidlcp.lcp.io.files import atomic_write_text
+
+            atomic_write_text(out / OPTIONS, json.dumps(_run_options(args), indent=1) + "\n")
         load0 = os.getloadavg()[0]
         started = datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
         total = sum(1 if isinstance(p, Unreadable) else len(methods)
@@ -279,6 +292,35 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     for line in notes:
         print(f"note: {line}")
     return 0
+
+
+#: The options of a bench run that its kept rows depend on (the problems' data: --seed; their
+#: judgement and timing: --tol, --time-limit, batch, isolation), written to OUT/OPTIONS.
+OPTIONS = "options.json"
+
+
+def _run_options(args: argparse.Namespace) -> dict:
+    return {"--seed": args.seed, "--tol": args.tol, "--time-limit": args.time_limit,
+            "--no-batch": bool(args.no_batch), "--no-isolation": bool(args.no_isolation)}
+
+
+def _check_same_run(args: argparse.Namespace) -> None:
+    """--resume keeps the rows of results.csv: refused when the run in --out had other
+    options (a kept row of --seed 0 is another problem than this command's of --seed 5, one
+    judged at --tol 1e-8 is not judged at 1e-3). A folder of an older version has no
+    OPTIONS: nothing to compare."""
+    path = os.path.join(args.out, OPTIONS)
+    if not os.path.isfile(path):
+        return
+    with open(path) as fh:
+        before = json.load(fh)
+    now = _run_options(args)
+    differ = [f"{k} {before[k]} there, {now[k]} here" for k in now
+              if k in before and before[k] != now[k]]
+    if differ:
+        raise ValueError(f"--resume: {args.out} was run with other options ({'; '.join(differ)})"
+                         ": its kept rows would not be this run's; give the same options, or "
+                         "a new --out")
 
 
 def _print_summary(results, time_limit: float) -> None:

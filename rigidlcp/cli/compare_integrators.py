@@ -28,10 +28,12 @@ def register(sub) -> None:
     add_system_arguments(p)
     g = p.add_argument_group("comparison")
     g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
-    g.add_argument("--h", type=float, default=2e-3, help="largest time step")
-    g.add_argument("--levels", type=int, default=3, help="number of step sizes (h halving)")
+    g.add_argument("--h", type=float, default=2e-3, help="largest time step (default %(default)s)")
+    g.add_argument("--levels", type=int, default=3, help="number of step sizes (h halving; "
+                   "default %(default)s)")
     g.add_argument("--theta", type=float, default=1.0, help="theta of the Moreau-Jean scheme")
-    g.add_argument("--t-max", type=float, default=40.0, help="bound on both runs' time")
+    g.add_argument("--t-max", type=float, default=40.0, help="bound on both runs' time (default "
+                   "%(default)s)")
     g.add_argument("--T", type=float, default=None,
                    help="time at which the angular velocities are compared (default: half "
                    "the event-driven run's last event time)")

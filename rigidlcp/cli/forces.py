@@ -20,6 +20,9 @@ import numpy as np
 
 from rigidlcp.cli.main import seed
 
+#: The array of Fig. 4, forces' default (simulate's is ARRAY_DEFAULTS, rect 10 x 4).
+FIG4 = ("tri", 5, 4)
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -32,14 +35,16 @@ def register(sub) -> None:
     from rigidlcp.cli.simulate import add_system_arguments
 
     add_system_arguments(p)  # the system options of `rigidlcp simulate` (and its friction)
-    p.set_defaults(lattice="tri", lx=5, ly=4, gamma=0.0)  # Fig. 4: a triangular array
+    p.set_defaults(lattice=FIG4[0], lx=FIG4[1], ly=FIG4[2], gamma=0.0)  # Fig. 4
     p.add_argument("--seed", type=seed, default=0, help="seed of the angular velocities")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
-    p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1)")
-    p.add_argument("--method", default="lemke", help="LCP method for the solver's solution")
+    p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1; "
+                   "default %(default)s)")
+    p.add_argument("--method", default="lemke", help="LCP method for the solver's "
+                   "solution (default %(default)s)")
     p.add_argument("--time-limit", type=float, default=10.0,
-                   help="seconds for the paper's-choice MILP")
+                   help="seconds for the paper's-choice MILP (default %(default)s)")
     p.add_argument("--out", required=True, metavar="DIR", help="directory for the PNGs")
     p.add_argument("--force", action="store_true",
                    help="overwrite forces.json / network PNGs already in --out")
@@ -69,7 +74,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
     if not args.time_limit > 0:
         raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
     refuse_too_large_for_dense(args, "the dense event LCP and force polyhedra", DENSE_ONLY)
-    system = system_from_args(args)
+    system = system_from_args(args, FIG4)  # its own array defaults, beside --packing
     lcp.get_method(args.method)
     names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"
                                               for k in range(args.networks)]

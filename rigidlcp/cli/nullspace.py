@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from pathlib import Path
 
 
 def register(sub) -> None:
@@ -41,8 +42,9 @@ def add_nullspace(sub) -> None:
         "output has this form. See docs/verification.md.")
     p.add_argument("--lattice", choices=("rect", "tri"), default="rect",
                    help="rectangular or triangular array (default rect)")
-    p.add_argument("--lx", type=int, default=4, help="disks in the rows touching both walls")
-    p.add_argument("--ly", type=int, default=3, help="number of rows")
+    p.add_argument("--lx", type=int, default=4,
+                   help="disks in the rows touching both walls (default 4)")
+    p.add_argument("--ly", type=int, default=3, help="number of rows (default 3)")
     p.add_argument("--packing", metavar="FILE", default=None,
                    help="disks from a packing file (.csv/.npz/LAMMPS dump) or a saved run "
                    "(RUN.npz) instead of --lattice/--lx/--ly (docs/packings.md)")
@@ -87,8 +89,6 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     system = models.System(lattice, mu_pp=args.mu_pp, mu_plane=args.mu_plane,
                            mu_wall=args.mu_wall)
     if args.plot:  # checked before the SVD: never overwrite a user's file without --force
-        from pathlib import Path
-
         from rigidlcp.lcp.io.files import check_new, output_dir
 
         if args.no_localize:
@@ -102,6 +102,9 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
         output_dir(plot.parent, force=True)
     if args.states in ("normal", "tangential"):
         normal, tangential = paper_states(system, args.states)
+    elif not Path(args.states).exists():  # a typo of a name reads as a missing file
+        raise ValueError(f"--states {args.states!r}: neither 'normal' nor 'tangential' (the "
+                         "paper's states), nor an existing states file (.json or .npz)")
     else:
         normal, tangential = read_states(args.states, system.lattice)
     ns = null_space(system, normal, tangential, localize=not args.no_localize)
@@ -200,7 +203,8 @@ def add_verify_formulas(sub) -> None:
                    help="range of Ly (default 1 8)")
     p.add_argument("--walls", choices=("rough", "frictionless"), default="rough",
                    help="rough: wall contacts NS in the tangential state (Eq. 3.4's "
-                   "convention); frictionless: S = 0 at the walls (the paper's simulations)")
+                   "convention); frictionless: S = 0 at the walls (the paper's simulations); "
+                   "default %(default)s")
     p.add_argument("--json", action="store_true", help="the table as JSON")
     p.add_argument("--markdown", action="store_true", help="the table in Markdown")
     p.add_argument("--grid", action="store_true",

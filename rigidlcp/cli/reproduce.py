@@ -33,7 +33,7 @@ def register(sub) -> None:
 def cmd_reproduce(args: argparse.Namespace) -> int:
     from rigidlcp.lcp.io.files import output_dir
     from rigidlcp.reproduce.claims import evaluate
-    from rigidlcp.reproduce.experiments import plan, run_all
+    from rigidlcp.reproduce.experiments import SELECT, plan, run_all
     from rigidlcp.reproduce.report import figures, write_report
 
     if args.jobs is not None and args.jobs < 1:
@@ -47,13 +47,38 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     claims = evaluate(res)
     files = figures(res, out)
     path = write_report(res, claims, out, files, command)
-    width = max(len(c.id) for c in claims)
-    for c in claims:
-        print(f"{c.verdict}  {c.id:<{width}}  {c.measured}")
-    n_pass = sum(c.passed for c in claims)
-    print(f"{n_pass} PASS, {len(claims) - n_pass} FAIL; report: {path} "
-          f"({res.wall_time:.0f} s on {res.executor})")
+    print_claims(claims, f"{path} ({res.wall_time:.0f} s on {res.executor})", SELECT)
     errors = [c for c in claims if c.error]
     for c in errors:
         print(f"{c.id}: evaluation error: {c.error}", file=sys.stderr)
     return 1 if errors else 0
+
+
+def print_claims(claims, report: str, select: str) -> None:
+    """One line per claim: the selection's PASS / FAIL, then its verdict over all valid
+    steady states (`overall_word`), then what was measured; a last line with both counts."""
+    width = max(len(c.id) for c in claims)
+    words = [overall_word(c.overall) for c in claims]
+    wide = max(len(w) for w in words)
+    print(f"the selection ({select}): PASS / FAIL; over all valid steady states: all / some "
+          "/ none / unknown (report.md says which)")
+    for c, word in zip(claims, words):
+        print(f"{c.verdict}  {word:<{wide}}  {c.id:<{width}}  {c.measured}")
+    n_pass = sum(c.passed for c in claims)
+    counts = ", ".join(f"{words.count(w)} {w}" for w in dict.fromkeys(words))
+    print(f"{n_pass} PASS, {len(claims) - n_pass} FAIL for this toolkit's selection; over all "
+          f"valid steady states: {counts}; report: {report}")
+
+
+def overall_word(text: str) -> str:
+    """The verdict of a claim over all valid steady states (rigidlcp.reproduce.overall), in
+    one word: "all", "some", "none", "unknown", "not judged" or "n/a" (not a steady-state
+    claim): the terminal's summary of report.md's column; a PASS of the selection is one
+    state's answer where the steady states are not unique."""
+    for word in ("all", "some", "none"):
+        if text.startswith(f"holds for {word}"):
+            return word
+    for word in ("unknown", "not judged", "n/a"):
+        if text.startswith(word):
+            return word
+    return "-"

@@ -33,7 +33,7 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
                        help=f"{text} friction coefficient (default {DEFAULT_MU[name]})")
     g.add_argument("--gamma", type=float, default=0.1,
                    help="acceleration of the box relative to the plane, in g "
-                   "(0: constant velocity)")
+                   "(0: constant velocity; default %(default)s)")
     g.add_argument("--v0", type=float, default=0.0,
                    help="initial velocity of the box relative to the plane (sqrt(g r))")
     g.add_argument("--inertia", type=float, default=None,
@@ -43,11 +43,13 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
                    "instead of --lattice/--lx/--ly")
 
 
-def system_from_args(args):
+def system_from_args(args, array_defaults: tuple | None = None):
+    """The System of the options; with --packing, refused when --lattice/--lx/--ly differ from
+    the command's own `array_defaults` (default ARRAY_DEFAULTS, simulate's 10 x 4 rect)."""
     from rigidlcp.models.system import make_system
 
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
-        refuse_array_options(args)
+        refuse_array_options(args, array_defaults or ARRAY_DEFAULTS)
         from rigidlcp.models.system import System
 
         return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
@@ -122,15 +124,18 @@ def register(sub) -> None:
     g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
     g.add_argument("--omega-scale", type=float, default=1.0,
                    help="initial angular velocities uniform in [-scale, scale]")
-    g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`)")
+    g.add_argument("--method", default="lemke", help="LCP method (see `rigidlcp methods`; "
+                   "default %(default)s)")
     g.add_argument("--fallback", default="lemke",
-                   help="method used at an event where --method fails ('none': stop)")
+                   help="method used at an event where --method fails ('none': stop; "
+                   "default %(default)s)")
     g.add_argument("--selection", "--select", dest="select", type=selection_rule,
                    default="face-min-norm", metavar="RULE",
                    help="the point followed where an event's solution is not unique: "
                    "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none "
                    "(docs/integrators.md)")
-    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
+    g.add_argument("--t-max", type=float, default=np.inf,
+                   help="stop at this time (> 0; default: no limit)")
     g.add_argument("--max-events", type=int, default=100_000,
                    help="stop after this many events (default 100000)")
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json)")
@@ -237,8 +242,10 @@ def cmd_simulate(args) -> int:
             counts = state_counts(system, last)
             rows += [("t (last event)", f"{last.t:.6g}"), ("mu_g", f"{summary['mu_g']:.6f}"
                       + selection_note(args.select, run.status, args.out)),
-                     ("F_g", f"{summary['F_g']:.6f}"),
-                     ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"),
+                     ("F_g", f"{summary['F_g']:.6f}" + same_state(run.status, "mu_g x "
+                                                                  "the weight")),
+                     ("dissipation rate D", f"{summary['dissipation_rate']:.6g}"
+                      + same_state(run.status, "-sum S v_t")),
                      ("dD/dt", f"{summary['dissipation_rate_slope']:.6g}"),
                      ("dissipated energy", f"{summary['dissipated_energy']:.6g} over t in "
                       "[{:.6g}, {:.6g}]".format(*summary["dissipated_energy_interval"])),
@@ -263,6 +270,12 @@ def selection_note(rule: str, status: str, out: str | None) -> str:
         return f"  (selection {rule})"
     return (f"  (one valid steady state, selection {rule}; over all of them: "
             f"rigidlcp ranges {out or 'RUN.npz'})")
+
+
+def same_state(status: str, what: str) -> str:
+    """F_g and D are read at the state whose mu_g is annotated (`selection_note`): at a
+    steady state they vary with it over the valid steady states, so the row says so."""
+    return f"  ({what}, at the same selected state)" if status == "steady" else ""
 
 
 def title(lat) -> str:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import shlex
 from typing import Any
 
 from rigidlcp.lcp.api import ACCEPTS, methods, solve
@@ -27,7 +28,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "solve", help="solve a problem file (.npz, or Siconos's LCP/MLCP/FC2D text)",
         description="Solve the problem of a file: an LCP or MLCP .npz (LCP.save / MLCP.save) "
-        "or a Siconos text file (LCP, MLCP, 2D friction contact). Exit code 0 when solved, 1 "
+        "or a Siconos text file (LCP, MLCP, 2D friction contact), and print one solution "
+        "(uniqueness is not checked: `rigidlcp certify`). Exit code 0 when solved, 1 "
         "when the method did not solve it, 2 on bad input.",
     )
     _add_problem_arguments(p)
@@ -131,17 +133,31 @@ def cmd_certify(args: argparse.Namespace) -> int:
         fields = ("accepted", "tol", "residual", "scaled_residual", "eq_residual",
                   "scaled_eq_residual", "w_unique", "z_unique", "pattern_unique", "observables",
                   "method", "other_reason", "other_distance", "bound", "notes", "seconds")
-        out = {"solver": sol.method, "status": sol.status,
+        out = {"solver": sol.method, "status": sol.status, "z": sol.z, "u": sol.u,
                **{f: getattr(cert, f) for f in fields}}
         print(json.dumps(_jsonable(out), indent=2, allow_nan=False))
     else:
         print(f"solved by {sol.method} ({sol.iterations} iterations)")
         print(cert)
+        # the point certified, after the verdicts on whether it is the only one (a friction
+        # problem's answer is its forces r, judged as "forces"; its z is the Glocker LCP's)
+        from rigidlcp.lcp.problems.problem import LCP, MLCP
+
+        friction = not isinstance(problem, (LCP, MLCP))
+        rows = ([("r", sol.z, cert.observables.get("forces"))] if friction
+                else [("z", sol.z, cert.z_unique)])
+        if sol.u is not None:
+            rows.append(("u", sol.u, cert.observables.get("u")))
+        for name, x, unique in rows:
+            what = {True: f"the solution: {name} is unique", False: f"one of several {name} "
+                    "(another above)", None: f"one solution; uniqueness of {name} undecided"}
+            print(f"certified {name} = {_vector(x)}  ({what[unique]})")
     return 0 if cert.accepted else 1
 
 
 def cmd_solve(args: argparse.Namespace) -> int:
-    """Solve the problem file; print status, residual, iterations (or JSON)."""
+    """Solve the problem file; print status, residual, iterations and, when solved, the
+    solution (or JSON)."""
     problem = _load(args.problem)
     sol = solve(problem, method=args.method, **parse_options(args.option))
     if args.json:
@@ -155,4 +171,22 @@ def cmd_solve(args: argparse.Namespace) -> int:
         print(f"iterations : {sol.iterations}")
         if sol.message:
             print(f"message    : {sol.message}")
+        if sol.success:  # the answer itself, and what it is not (yet) known to be
+            if sol.u is not None:
+                print(f"u          : {_vector(sol.u)}")
+            from rigidlcp.lcp.problems.problem import LCP, MLCP
+
+            name = "z" if isinstance(problem, (LCP, MLCP)) else "r"  # friction: the forces
+            print(f"{name}          : {_vector(sol.z)}")
+            print("note       : one solution, checked; whether it is the only one: "
+                  f"rigidlcp certify {shlex.quote(args.problem)}")
     return 0 if sol.success else 1
+
+
+def _vector(x) -> str:
+    """A vector on one line: every entry up to 10, else the first and last 3 (all in --json)."""
+    import numpy as np
+
+    return np.array2string(np.asarray(x), precision=6, threshold=10, edgeitems=3,
+                           max_line_width=10**6) + ("" if np.size(x) <= 10 else
+                                                    f"  ({np.size(x)} entries; all: --json)")

@@ -35,7 +35,8 @@ def add_sweep(sub) -> None:
         "--mu-plane 0.1 --mu-wall 0 --gamma 0:1.0:41 --out sweep/ ; then "
         "rigidlcp effective sweep/")
     g = p.add_argument_group("system (each a grid)")
-    g.add_argument("--lattice", default=DEFAULTS["lattice"], help="rect, tri or rect,tri")
+    g.add_argument("--lattice", default=DEFAULTS["lattice"], help="rect, tri or rect,tri "
+                   "(default %(default)s)")
     for name, text in (("lx", "disks in the rows touching both walls"),
                        ("ly", "number of rows"), ("mu_pp", "particle-particle friction"),
                        ("mu_plane", "particle-plane friction"),
@@ -48,9 +49,11 @@ def add_sweep(sub) -> None:
         g.add_argument("--" + name.replace("_", "-"), default=default,
                        help=f"{text} (default {'default' if default is None else default})")
     r = p.add_argument_group("run (fixed for the sweep)")
-    r.add_argument("--method", default=RUN_OPTIONS["method"], help="LCP method")
+    r.add_argument("--method", default=RUN_OPTIONS["method"],
+                   help="LCP method (default %(default)s)")
     r.add_argument("--fallback", default=RUN_OPTIONS["fallback"],
-                   help="method used where --method fails ('none': stop)")
+                   help="method used where --method fails ('none': stop; default "
+                   "%(default)s)")
     r.add_argument("--selection", "--select", dest="select", type=selection_rule,
                    default=RUN_OPTIONS["select"], metavar="RULE",
                    help="the point followed where an event's solution is not unique: "
@@ -123,7 +126,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             print(json.dumps(row))
     else:
         cols = varying(res.rows) or list(sweep.axes)
-        print_table(res.rows, cols)
+        print_table(res.rows, cols, selection=args.select)
         print(f"{len(res.rows)} points: {res.ran} run now, {res.skipped} found done; "
               f"results: {res.out / 'results.jsonl'}")
     outside = [r for r in res.rows if r.get("paper_regime") is False]
@@ -138,10 +141,13 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     return 0
 
 
-def print_table(rows: list[dict], cols: list[str]) -> None:
+def print_table(rows: list[dict], cols: list[str], selection: str | None = None) -> None:
     """One row per point; D(t) is the dissipation rate right after the last event (at t), dD/dt
     its slope: under gamma != 0 the sliding velocities grow linearly in the steady state, so
-    D(t) depends on when the run stopped and dD/dt is the steady observable (Sec. IV C)."""
+    D(t) depends on when the run stopped and dD/dt is the steady observable (Sec. IV C).
+    A steady row's mu_g, F_g and D are those of the steady state the `selection` rule reached,
+    one valid steady state (there may be others): the last line says so, and where the ranges
+    are."""
     head = cols + ["status", "events", "t", "mu_g", "F_g", "D(t)", "dD/dt", "NS", "sliding"]
     table = []
     for r in rows:
@@ -158,6 +164,10 @@ def print_table(rows: list[dict], cols: list[str]) -> None:
     if any(r.get("gamma") for r in rows):
         print("D(t): dissipation rate after the last event, at t (m g sqrt(g r)); under gamma "
               "!= 0 it grows as dD/dt in the steady state: compare dD/dt across points")
+    if selection is not None and any(r.get("status") == "steady" for r in rows):
+        print(f"mu_g, F_g, D of a steady row: the steady state the selection rule ({selection}) "
+              "reached, one valid steady state (there may be others); their range over all: "
+              "rigidlcp ranges on that point's run (--save-runs)")
 
 
 def _fmt(v) -> str:
@@ -188,7 +198,8 @@ def add_effective(sub) -> None:
                    help="directory for mu_g.png (Fig. 11), effective.png (Fig. 12) and "
                    "effective.json (default: the sweep directory)")
     p.add_argument("--degree", type=int, default=1, help="degree of the local fits")
-    p.add_argument("--window", type=int, default=3, help="points per local fit")
+    p.add_argument("--window", type=int, default=3, help="points per local fit (default "
+                   "%(default)s)")
     p.add_argument("--force", action="store_true",
                    help="overwrite effective.json, mu_g.png, effective.png if present")
     p.add_argument("--json", action="store_true", help="print the table as JSON")

@@ -22,17 +22,19 @@ def register(sub) -> None:
     add_system_arguments(p)
     g = p.add_argument_group("run")
     g.add_argument("--seed", type=seed, default=1, help="seed of the initial angular velocities")
-    g.add_argument("--h", type=float, default=1e-3, help="time step")
+    g.add_argument("--h", type=float, default=1e-3, help="time step (default %(default)s)")
     g.add_argument("--theta", type=float, default=1.0, help="theta in [0.5, 1]")
-    g.add_argument("--method", default="lemke", help="LCP method of a step")
+    g.add_argument("--method", default="lemke", help="LCP method of a step (default %(default)s)")
     g.add_argument("--selection", type=selection_rule, default="none", metavar="RULE",
                    help="the point followed where a step's solution is not unique: none "
                    "(default: the solver's), face-min-norm, max-sum-R[:CAP], random:SEED")
-    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0)")
+    g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0; default: "
+                   "no limit)")
     g.add_argument("--max-steps", type=int, default=2_000_000,
                    help="stop after this many steps (default 2000000)")
     g.add_argument("--record-every", type=int, default=100,
-                   help="also record every N steps (besides state changes; 0: only those)")
+                   help="also record every N steps (besides state changes; 0: only those; "
+                   "default %(default)s)")
     g.add_argument("--out", default=None, help="save the run to OUT (.npz + .json); an "
                    "existing run is not overwritten without --force")
     g.add_argument("--force", action="store_true", help="overwrite an existing --out")
@@ -44,12 +46,16 @@ def register(sub) -> None:
 def cmd_timestep(args) -> int:
     from rigidlcp.lcp.io.files import check_new
     from rigidlcp.models.runio import run_paths, save_run
-    from rigidlcp.models.timestepping import moreau_jean
+    from rigidlcp.models.timestepping import StepOptions, moreau_jean
 
     from .simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
 
     refuse_too_large_for_dense(args, "the time-stepper's dense step LCP", DENSE_ONLY)
     system = system_from_args(args)
+    # a bad --h, --theta, --t-max, ... is refused before the progress bar is drawn
+    StepOptions(h=args.h, theta=args.theta, method=args.method, t_max=args.t_max,
+                max_steps=args.max_steps, record_every=args.record_every,
+                selection=args.selection)
     if args.out:
         check_new(run_paths(args.out), force=args.force)
     bar = None

@@ -200,3 +200,30 @@ def test_lammps_diameter_column_and_a_bad_atom_count(tmp_path):
     f.write_text(LAMMPS.replace(" radius mass", " r mass"))
     with pytest.raises(InvalidFile, match=r"radius or diameter \(missing radius\)"):
         read_disks(f)
+
+
+def test_lammps_trajectory_is_refused_naming_its_last_snapshot(tmp_path):
+    """A dump of several snapshots was read silently as its first one (in a trajectory, the
+    start, not the packing at rest); it is refused naming where the last one starts, and that
+    snapshot alone, cut there, reads."""
+    last = LAMMPS.replace("TIMESTEP\n0\n", "TIMESTEP\n500\n").replace("3.0 1.0", "3.5 1.0")
+    f = tmp_path / "traj.dump"
+    f.write_text(LAMMPS + last)
+    first_lines = len(LAMMPS.splitlines())
+    with pytest.raises(InvalidFile, match=r"holds 2 snapshots \(timesteps 0 to 500\), a "
+                       r"packing is one: ") as exc:
+        read_disks(f)  # the command that cuts the last one, to a new file beside it
+    assert str(exc.value).endswith(f"tail -n +{first_lines + 1} {f} > "
+                                   f"{tmp_path / 'traj_last.dump'}")
+    cut = tmp_path / "last.dump"
+    cut.write_text("\n".join(f.read_text().splitlines()[first_lines:]) + "\n")
+    assert np.array_equal(read_disks(cut).x, [[1, 1], [3.5, 1]])
+    f.write_text(LAMMPS + "\n\n")  # blank lines after the atoms: one snapshot
+    assert np.array_equal(read_disks(f).x, [[1, 1], [3, 1]])
+
+
+def test_lammps_more_atoms_than_announced_is_refused(tmp_path):
+    f = tmp_path / "dump.atoms"
+    f.write_text(LAMMPS + "3 1 5.0 1.0 0 1.0 2.0\n")
+    with pytest.raises(InvalidFile, match=r"line 12: more lines than the 2 atoms announced"):
+        read_disks(f)

@@ -137,6 +137,11 @@ def certify(
     """
     if uniqueness not in UNIQUENESS_METHODS:
         raise InvalidInput(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
+    for name, value, most in (("tol", tol, np.finfo(float).max),  # -1 read as "REJECTED"
+                              ("time_limit", time_limit, np.inf)):
+        if not (isinstance(value, (int, float, np.number)) and 0 < value <= most):
+            raise InvalidInput(f"{name} must be a number > 0{' (finite)' if name == 'tol' else ''}"
+                               f", got {value!r}")
     t0 = time.perf_counter()
     obs: dict[str, np.ndarray] = {}
     fc_residual, fc = None, None
