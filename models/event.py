@@ -28,6 +28,7 @@ from functools import cached_property
 import numpy as np
 
 from rigidlcp.lcp import LCP, MLCP
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.lcp.problems.friction import FrictionContact2D
 
 from .dynamics import Dynamics
@@ -66,9 +67,9 @@ def initial_state(
     p = system.p
     if omega is None and seed is not None:
         if not (np.isfinite(omega_scale) and omega_scale >= 0):
-            raise ValueError(f"omega_scale must be a finite number >= 0, got {omega_scale!r}")
+            raise InvalidInput(f"omega_scale must be a finite number >= 0, got {omega_scale!r}")
         if isinstance(seed, (int, np.integer)) and seed < 0:  # numpy's own message names none
-            raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
+            raise InvalidInput(f"seed must be an integer >= 0, got {seed!r}")
     if omega is None:
         omega = (
             np.zeros(p) if seed is None
@@ -76,9 +77,9 @@ def initial_state(
         )
     omega = np.array(omega, dtype=float).reshape(-1)
     if omega.size != p:
-        raise ValueError(f"omega must have one angular velocity per disk ({p}), got {omega.size}")
+        raise InvalidInput(f"omega must have one angular velocity per disk ({p}), got {omega.size}")
     if not np.all(np.isfinite(omega)):
-        raise ValueError("omega contains NaN or Inf")
+        raise InvalidInput("omega contains NaN or Inf")
     vt = Dynamics(system).velocities(omega, system.V0)[system.c:]
     s = np.where(np.abs(vt) <= zero_tol, 0, np.sign(vt)).astype(int)
     s[system.mu == 0] = 0

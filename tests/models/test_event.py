@@ -151,3 +151,17 @@ def test_event_as_friction_contact_problem_obeys_the_contact_laws(method):
         a = ep.dyn.relative_accelerations(lam)
         u = fc.u(sol.z)
         assert np.allclose(u[0::2], a[: system.c], atol=1e-8 * scale)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"seed": -1}, "seed must be an integer >= 0"),
+    ({"seed": 1, "omega_scale": -1.0}, "omega_scale must be a finite number >= 0"),
+    ({"omega": np.zeros(3)}, "one angular velocity per disk"),
+    ({"omega": np.full(8, np.nan)}, "omega contains NaN or Inf"),
+])
+def test_initial_state_bad_input_is_a_typed_error(kwargs, message):
+    from rigidlcp.lcp.errors import InvalidInput
+
+    system = models.System(models.rectangular(4, 2))
+    with pytest.raises(InvalidInput, match=message):
+        models.initial_state(system, **kwargs)
