@@ -7,11 +7,12 @@ LP's dual y (weak duality, DUAL_TOL); "unbounded" must come with a checked prima
 the check fails it tries, in order:
 
 1. the same basis, solved again: w_B = K_B^-1 b and y = K_B^-T c_B by one sparse LU of the
-   optimal basis. A warm-started simplex updates its values from one LP to the next, so an
-   optimum reached after one of a million weights (a pair between walls near mu = 1) carries
-   an absolute error of that size times the rounding; the basis itself is right, and its
-   values recomputed from scratch are accurate to the rounding of one LU (deep hypothesis
-   profile: n 3, seed 304, mu 0.99999 and n 15, seed 28, mu 1.03125, docs/packings.md);
+   optimal basis. A warm-started simplex updates its values (the point w and the certificate
+   y) from one LP to the next, and they drift from those of its basis: after optima a million
+   times larger (a pair between walls near mu = 1) the point carried a balance error of 9e-8
+   of the weights (n 3, seed 304, mu 0.99999), and elsewhere y fell 2e-8 short of the end
+   (n 15, seed 28, mu 1.03125; docs/packings.md); the basis itself was right, and its values
+   recomputed from scratch are accurate to the rounding of one LU;
 2. a cold LP: a new ForceLP (primal simplex from the slack basis), its answer checked the same
    way (and its basis re-solved if needed); HiGHS's warm primal simplex has answered
    "unbounded" with a ray that fails its check (cost . r = -5.5e-9 of |r| = 2e3) on a bounded

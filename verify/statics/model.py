@@ -13,8 +13,10 @@ These are linear: the admissible set P = {lambda : H^T lambda = -f, R >= 0, S - 
 `ForceLP` holds P once in HiGHS (highspy) and re-solves it for one objective after another,
 warm-started from the previous basis (the ranges of every R and S are 4c such LPs);
 `DualForceLP` solves the same LPs through their dual, about twice as fast on deposited piles.
-Every optimum is checked against P in floating point (`residuals`), and its value against the
-dual bound (`certified`), not taken on the solver's word.
+Every optimum is checked against P in floating point (`admissible`: the balance's
+componentwise backward error and the laws' violation), and its value against the dual bound
+(`certified`), not taken on the solver's word (verify.statics.ends: what is done when a check
+fails).
 """
 
 from __future__ import annotations
