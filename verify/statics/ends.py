@@ -125,6 +125,8 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
     fresh = cold() if cold is not None else ForceLP(prob)
     status, lam = fresh.solve(cost)
     lps += 1
+    if status in as_is:
+        return Settled(status, lam, lps, how="cold", first=ev)
     ev2 = judge(prob, fresh, cost, status, lam, fixed)
     if ev2 is None:
         return Settled(status, lam, lps, how="cold", first=ev)
