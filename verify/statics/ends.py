@@ -13,7 +13,8 @@ the check fails it tries, in order:
    of the weights (n 3, seed 304, mu 0.99999), and elsewhere y fell 2e-8 short of the end
    (n 15, seed 28, mu 1.03125; docs/packings.md); the basis itself was right, and its values
    recomputed from scratch are accurate to the rounding of one LU;
-2. a cold LP: a new ForceLP (primal simplex from the slack basis), its answer checked the same
+2. after an "unbounded" whose ray fails its check, a ray from an LP of our own (`ray_lp`);
+3. a cold LP: a new ForceLP (primal simplex from the slack basis), its answer checked the same
    way (and its basis re-solved if needed); HiGHS's warm primal simplex has answered
    "unbounded" with a ray that fails its check (cost . r = -5.5e-9 of |r| = 2e3) on a bounded
    LP (n 5, seed 5, mu 1.0).
@@ -33,6 +34,7 @@ import scipy.sparse as sp
 from .model import (
     BALANCE_TOL,
     DUAL_TOL,
+    LP_TOL,
     DualForceLP,
     ForceLP,
     StaticProblem,
@@ -70,7 +72,7 @@ class Evidence:
 class Settled:
     """An end: status "optimal" (lam: a checked optimum), "unbounded" (a checked ray) or
     "unknown" (evidence: the last try's failed check); lps: LPs solved; how: the try that
-    settled it ("warm", "basis", "cold", "cold basis"; "" when unknown); first: the warm
+    settled it ("warm", "basis", "ray LP", "cold", "cold basis"; "" when unknown); first: the warm
     answer's evidence when a retry was needed."""
 
     status: str
@@ -122,6 +124,10 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
         got = _rebasis(prob, lp, cost, fixed)
         if got is not None:
             return Settled(status, got, lps, how="basis", first=ev)
+    if status == "unbounded":
+        lps += 1
+        if ray_lp(prob, _primal(lp), cost, fixed) is not None:
+            return Settled(status, None, lps, how="ray LP", first=ev)
     fresh = cold() if cold is not None else ForceLP(prob)
     status, lam = fresh.solve(cost)
     lps += 1
@@ -135,6 +141,39 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
         if got is not None:
             return Settled(status, got, lps, how="cold basis", first=ev)
     return Settled("unknown", None, lps, evidence=ev2, how="", first=ev)
+
+
+def ray_lp(prob: StaticProblem, primal: ForceLP, cost: np.ndarray,
+           fixed: tuple[int, ...] = ()) -> np.ndarray | None:
+    """A ray of P in cone coordinates along which cost . lambda decreases, from an LP of our
+    own: min (T^T cost) . r subject to K r = 0 and 0 <= r <= 1 (0 on the `fixed` columns), a
+    vertex, whose basic entries are solved from exact 0 and 1 bounds. It is returned when it
+    passes ray_defect (the range LP is then unbounded), else None (also when the optimum is
+    0: no such ray). HiGHS's own ray after "unbounded" can miss the sign check by 7e-8 of its
+    size on a truly unbounded LP (deep profile: n 17, seed 17, mu 1.015625)."""
+    import highspy
+
+    from rigidlcp.lcp.quiet import new_highs
+
+    K = sp.csc_matrix(primal.KT.T)
+    m, nw = K.shape
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = nw, m
+    lp.col_cost_ = np.asarray(primal.TT @ np.asarray(cost, dtype=float), dtype=float)
+    upper = np.ones(nw)
+    upper[list(fixed)] = 0.0
+    lp.col_lower_, lp.col_upper_ = np.zeros(nw), upper
+    lp.row_lower_ = lp.row_upper_ = np.zeros(m)
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (K.indptr, K.indices, K.data)
+    h = new_highs(presolve="off", primal_feasibility_tolerance=LP_TOL,
+                  dual_feasibility_tolerance=LP_TOL)
+    h.passModel(lp)
+    h.run()
+    if h.getModelStatus() != highspy.HighsModelStatus.kOptimal:
+        return None
+    r = np.asarray(h.getSolution().col_value, dtype=float)
+    return r if ray_defect(primal, r, cost, RAY_TOL, fixed) is None else None
 
 
 def judge(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray, status: str,

@@ -11,7 +11,7 @@ import json
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
@@ -48,9 +48,9 @@ def _in_P(system: models.System, lam: np.ndarray) -> bool:
     return bool(np.all(r <= TOL * terms)) and laws <= TOL * max(scale, float(np.max(np.abs(lam))))
 
 
-def _linprog_end(prob: StaticProblem, k: int, sgn: float) -> float:
-    """min sgn lambda_k over P by linprog (cone rows as rows, no warm start); -sgn inf when
-    unbounded."""
+def _linprog(prob: StaticProblem, k: int, sgn: float) -> tuple[float, np.ndarray | None]:
+    """min sgn lambda_k over P by linprog (cone rows as rows, no warm start): (the end, its
+    optimum), (-sgn inf, None) when unbounded."""
     bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
               for lo, hi in zip(prob.lb, prob.ub)]
     e = np.zeros(prob.n)
@@ -58,17 +58,29 @@ def _linprog_end(prob: StaticProblem, k: int, sgn: float) -> float:
     res = linprog(e, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A, b_eq=prob.b,
                   bounds=bounds, method="highs")
     assert res.status in (0, 3), res.message
-    return float(res.x[k]) if res.status == 0 else -sgn * np.inf
+    return (float(res.x[k]), res.x) if res.status == 0 else (-sgn * np.inf, None)
 
 
-def _agree(prob: StaticProblem, lo: np.ndarray, hi: np.ndarray, ks) -> None:
-    """The ends at indices ks are linprog's: the same infinite ends, finite ones within 1e-7
-    of the largest finite end (test_contact_ranges's tolerance)."""
-    want = {(k, s): _linprog_end(prob, k, s) for k in ks for s in (1.0, -1.0)}
-    size = max([1.0] + [abs(v) for v in want.values() if np.isfinite(v)])
-    for (k, s), v in want.items():
+def _linprog_end(prob: StaticProblem, k: int, sgn: float) -> float:
+    return _linprog(prob, k, sgn)[0]
+
+
+def _agree(prob: StaticProblem, lo: np.ndarray, hi: np.ndarray, ks, size: float = 0.0) -> None:
+    """The ends at indices ks against linprog's: the same infinite ends; linprog's optimum x,
+    when it passes _in_P, lies within the reported range (to 1e-7 of the force scale or of
+    |x|: our ends are optima certified to 1e-8); finite ends equal to 1e-7 of `size` (at
+    least the largest finite end; the property passes the largest force of its witnesses
+    too). linprog's default tolerances are 1e-7: on one pile (n 11, seed 3137, mu 1.140625)
+    its dual infeasibility 3.6e-8 times a cone slack of 1.3e5 weights left its min S 4.6e-3
+    above ours, which a point of P attains."""
+    want = {(k, s): _linprog(prob, k, s) for k in ks for s in (1.0, -1.0)}
+    size = max([1.0, size] + [abs(v) for v, _ in want.values() if np.isfinite(v)])
+    for (k, s), (v, x) in want.items():
         got = lo[k] if s > 0 else hi[k]
         assert (got == v) if np.isinf(v) else abs(got - v) <= 1e-7 * size, (k, s, got, v)
+        if x is not None and _in_P(prob.system, x):
+            tol = 1e-7 * max(prob.scale, float(np.max(np.abs(x))))
+            assert lo[k] <= x[k] + tol and x[k] <= hi[k] + tol, (k, lo[k], x[k], hi[k])
 
 
 # --- the deep profile's reproducers (each failed before the fix: unchecked > 0) -------------
@@ -129,10 +141,29 @@ def test_a_sliding_lp_that_fails_warm_is_solved_cold():
     assert fs.retried >= 1 and not fs.unknown
 
 
+def test_an_unbounded_end_whose_highs_ray_misses_its_check_gets_a_ray_of_its_own():
+    """n 17, seed 17, mu 1.015625 (the deep profile, after the fixes above), the range LPs by
+    a warm primal simplex: min S of contact 16 is unbounded (linprog agrees), but HiGHS's ray
+    has entries of -7e-8 of its size, warm and cold; `ray_lp`'s ray passes the check, so the
+    end is -inf, proved, not unknown."""
+    system = _pile(17, 17, 1.015625)
+    fs = analyse(system, ranges=False)
+    prob = StaticProblem(system)
+    k = prob.c + 16
+    lo, hi, _, unchecked = ranges_of(prob, ForceLP(prob), fs.implicit, np.arange(prob.c),
+                                     Witnesses.of(prob, fs.solution))
+    assert unchecked == 0 and lo[k] == -np.inf == _linprog_end(prob, k, 1.0)
+    e = np.zeros(prob.n)
+    e[k] = 1.0
+    assert ends.ray_lp(prob, ForceLP(prob), e) is not None
+    assert ends.ray_lp(prob, ForceLP(prob), -e) is None or hi[k] == np.inf
+
+
 # --- the property -----------------------------------------------------------------------------
 
 @settings(max_examples=8)
 @given(n=st.integers(3, 14), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.2))
+@example(n=11, seed=3137, mu=1.140625)  # linprog 4.6e-3 above a min S we attain (_agree)
 def test_every_reported_end_has_an_independently_checked_witness(n, seed, mu):
     """Every finite end is attained (to 1e-9 of the force scale) at a point that passes _in_P:
     the analysis' solution or an optimum `settle` returned as checked; an end is NaN exactly
@@ -168,7 +199,7 @@ def test_every_reported_end_has_an_independently_checked_witness(n, seed, mu):
                 tol = 1e-9 * max(prob.scale, abs(v))
                 assert any(abs(lam[k] - v) <= tol for lam in points), (k, side, v)
     known = [k for k in range(prob.n) if not (np.isnan(r.lo[k]) or np.isnan(r.hi[k]))]
-    _agree(prob, r.lo, r.hi, known)
+    _agree(prob, r.lo, r.hi, known, max(float(np.max(np.abs(lam))) for lam in points))
 
 
 # --- an end refused on purpose ----------------------------------------------------------------
