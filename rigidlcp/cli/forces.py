@@ -49,13 +49,67 @@ def register(sub) -> None:
     p.add_argument("--force", action="store_true",
                    help="overwrite forces.json / network PNGs already in --out")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_forces)
+
+
+class _Stages:
+    """Progress on stderr (models.progress.new_bar, erased at the end): one step per stage of
+    the command, named while it runs (the paper's-choice MILP alone may take --time-limit s)."""
+
+    def __init__(self, names: list[str], show: bool):
+        self.names, self.k, self.bar = names, 0, None
+        if show:
+            from rigidlcp.models.progress import new_bar
+
+            self.bar = new_bar(total=len(names), desc=names[0], unit="stage", mininterval=0,
+                               miniters=1)  # every stage shown, however short
+
+    def done(self) -> None:
+        """The current stage is over: count it and name the next one."""
+        self.k += 1
+        if self.bar is not None:
+            if self.k < len(self.names):
+                self.bar.set_description_str(self.names[self.k], refresh=False)
+            self.bar.update(1)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
 
 
 def cmd_forces(args: argparse.Namespace) -> int:
     from rigidlcp import lcp, models
     from rigidlcp.cli.simulate import DENSE_ONLY, refuse_too_large_for_dense, system_from_args
-    from rigidlcp.lcp.io.files import atomic_write_text, output_dir
+    from rigidlcp.lcp.io.files import output_dir
+
+    if args.networks < 1:
+        raise ValueError(f"--networks must be >= 1, got {args.networks}")
+    if not args.time_limit > 0:
+        raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
+    refuse_too_large_for_dense(args, "the dense event LCP and force polyhedra", DENSE_ONLY)
+    system = system_from_args(args, FIG4)  # its own array defaults, beside --packing
+    lcp.get_method(args.method)
+    names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"
+                                              for k in range(args.networks)]
+    state = models.initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
+    out = output_dir(args.out, force=args.force, names=names)  # after every input is checked
+    stages = _Stages(["event LCP", "force ranges"]
+                     + (["minimum-norm network"] if args.networks >= 2 else [])
+                     + ([f"paper's choice (MILP, up to {args.time_limit:g} s)"]
+                        if args.networks >= 3 else [])
+                     + ["other networks", "certify networks", "figures"],
+                     show=not args.no_progress)
+    try:
+        return _forces(args, system, state, out, stages)
+    finally:
+        stages.close()
+
+
+def _forces(args: argparse.Namespace, system, state, out: Path, stages: _Stages) -> int:
+    from rigidlcp import lcp, models
+    from rigidlcp.lcp.io.files import atomic_write_text
     from rigidlcp.models.event import acceleration_tol
     from rigidlcp.verify.certificates.certify import certify
     from rigidlcp.verify.forces.particular import (
@@ -69,22 +123,12 @@ def cmd_forces(args: argparse.Namespace) -> int:
         state_polyhedron,
     )
 
-    if args.networks < 1:
-        raise ValueError(f"--networks must be >= 1, got {args.networks}")
-    if not args.time_limit > 0:
-        raise ValueError(f"--time-limit must be > 0, got {args.time_limit}")
-    refuse_too_large_for_dense(args, "the dense event LCP and force polyhedra", DENSE_ONLY)
-    system = system_from_args(args, FIG4)  # its own array defaults, beside --packing
-    lcp.get_method(args.method)
-    names = ["forces.json", "networks.png"] + [f"network_{k + 1}.png"
-                                              for k in range(args.networks)]
-    state = models.initial_state(system, seed=args.seed, omega_scale=args.omega_scale)
-    out = output_dir(args.out, force=args.force, names=names)  # after every input is checked
     ep = models.event_problem(system, state)
     sol = lcp.solve(ep.lcp, method=args.method)
     if sol.status != "solved":
         raise ValueError(f"the event LCP was not solved by {args.method!r}: {sol.status} "
                          f"({sol.message})")
+    stages.done()
     es = ep.unpack(sol.z)
     tol_a = acceleration_tol(system)
     normal = es.a_n <= tol_a
@@ -94,14 +138,17 @@ def cmd_forces(args: argparse.Namespace) -> int:
         ranges = force_ranges(poly, {"F_g": gvec})
     except EmptyPolyhedron as exc:  # cannot happen: the solver's solution lies in it
         raise ValueError(str(exc)) from None
+    stages.done()
     c, p = system.c, system.p
     x_solver = ep.forces(sol.z)
     cands: list[tuple[str, np.ndarray]] = [(f"solver ({args.method})", x_solver)]
     if args.networks >= 2:
         cands.append(("minimum norm", min_norm_solution(poly).x))
+        stages.done()
     if args.networks >= 3:
         pa = paper_solution(poly, time_limit=args.time_limit, ranges=ranges)
         cands.append(("paper's choice (most NT)", pa.x))
+        stages.done()
     fscale = poly.scale
     networks: list[tuple[str, np.ndarray]] = []
     seed = 0
@@ -115,6 +162,7 @@ def cmd_forces(args: argparse.Namespace) -> int:
             seed += 1
         if all(np.max(np.abs(x[:c] - y[:c])) > 1e-6 * fscale for _, y in networks):
             networks.append((name, x))
+    stages.done()
     rows = []
     for name, x in networks:
         z = event_z(ep, x)
@@ -128,7 +176,10 @@ def cmd_forces(args: argparse.Namespace) -> int:
             "omega_dot": nu_dot[2 * p:].tolist(), "accepted": cert.accepted,
             "scaled_residual": cert.scaled_residual, "R": R.tolist(), "S": x[c:].tolist(),
         })
+    stages.done()
     paths = _draw(system, networks, out, args)
+    stages.done()
+    stages.close()  # before the summary is printed
     indet = ranges.indeterminate(1e-6 * fscale)
     summary = {
         "system": system.describe(), "seed": args.seed, "contacts": c,

@@ -2,7 +2,8 @@
 (verify.statics). The interface is fixed (issue 22): `rigidlcp forceset FILE.csv [--mu-pp A
 --mu-plane B --mu-wall C] --json` prints one JSON object with "exists", "dimension", "box"
 and "contacts" (i, j, R: [lo, hi], S: [lo, hi]; j = -1 left wall, -2 right wall, -3 plane;
-null for an unbounded end)."""
+null for an unbounded end, "unknown" for an end whose check failed, listed with the evidence
+in "unknown_ends")."""
 
 from __future__ import annotations
 
@@ -23,8 +24,11 @@ def register(sub) -> None:
         "checked Farkas certificate, first sought as one moving a small cluster of disks with "
         "the others fixed, checked exactly: farkas_disks in the JSON), its dimension (of its "
         "affine hull), the range of every R and S (linear programs, HiGHS; each end checked "
-        "in the set and certified by the LP's duals, a failed check counted in "
-        "unchecked_optima), the contacts that can slide against 2M - 3N.")
+        "in the set and certified by the LP's duals, an unbounded end by a checked ray; an "
+        "answer failing its check is retried, and an end no retry settles is \"unknown\" in "
+        "the JSON, not a number nor null: unknown_ends gives the failed check and its "
+        "measure, unchecked_optima their count with the unknown can_slide), the contacts "
+        "that can slide against 2M - 3N.")
     p.add_argument("file", help="packing file: .csv / .npz (x, y, r [, m, I]) or LAMMPS dump "
                    "(x, y, radius or diameter [, mass]; its BOX BOUNDS give the walls)")
     for name in ("mu_pp", "mu_plane", "mu_wall"):
@@ -48,7 +52,8 @@ def register(sub) -> None:
                    "to sample an unbounded set of forces, e.g. walls that can pinch the pile)")
     p.add_argument("--seed", type=int, default=0, help="seed of the sampler (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object (its keys: "
-                   "docs/packings.md, 'The JSON')")
+                   "docs/packings.md, 'The JSON'; a range end is a number, null: unbounded, "
+                   "or \"unknown\": its check failed, see unknown_ends)")
     p.add_argument("--out", metavar="DIR", help="write forceset.json and forceset.png here")
     p.add_argument("--force", action="store_true", help="overwrite files in --out")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -164,18 +169,33 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
           + (" (unique forces)" if fs.dimension == 0 else ""))
     if not args.no_ranges:
         lo, hi = fs.diameter()
-        open_r = int(np.sum(~np.isfinite(fs.hi[:fs.c])))
+        open_r = int(np.sum(np.isinf(fs.hi[:fs.c])))
         size = (f"diameter in [{lo:.4g}, {hi:.4g}]" if open_r == 0 else
                 f"unbounded: {open_r} of {fs.c} R have no upper end (walls and plane can wedge "
                 "the pile with any force; null in the JSON)")
         print(f"{int(fs.sliding.sum())} contacts can slide (2M - 3N = {fs.sliding_bound}); "
               f"{size}; {fs.lps} LPs")
+        if fs.unchecked:
+            print(_unknown_line(fs))
     if "ensemble" in result:
         e = result["ensemble"]
         print(f"{e['samples']} uniform samples ({e['sampler']}), each checked: largest "
               f"residuals {e['residuals'][0]:.2e} (balance), {e['residuals'][1]:.2e} (laws); "
               f"force fluctuation {e['fluctuation']:.4g} <R>; samples.npz, pf.png")
     return 0
+
+
+def _unknown_line(fs) -> str:
+    """How many ends and sliding verdicts are unknown (their checks failed after the retries),
+    and the first one's evidence."""
+    slide = int(np.sum(fs.sliding_unknown)) if fs.sliding_unknown is not None else 0
+    text = (f"unknown: {len(fs.unknown)} range ends and {slide} can_slide verdicts (their "
+            "checks failed after the retries; \"unknown\" in the JSON, see unknown_ends)")
+    if fs.unknown:
+        u, c = fs.unknown[0], fs.c
+        text += (f"; first: {u.side} {'R' if u.k < c else 'S'} of contact {u.k % c}, "
+                 f"{u.evidence.text()}")
+    return text
 
 
 def _first_missing(path):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 from rigidlcp.lcp.errors import RigidLCPError
@@ -35,12 +36,24 @@ COMMAND_MODULES = (
 )
 
 
+#: A word that starts like a negative number ("-1:1", "-1e-3", "-.5"): a value, never an
+#: option (argparse takes only "-1" and "-1.5" as numbers; no option of ours starts "-<digit>").
+_NEGATIVE = re.compile(r"^-\.?\d")
+
+
 class OneLineParser(argparse.ArgumentParser):
-    """An ArgumentParser whose usage errors are one line (not the usage block), exit status 2."""
+    """An ArgumentParser whose usage errors are one line (not the usage block), exit status 2,
+    and that reads a word starting like a negative number as a value (`--radii -1:1` reaches
+    the option's own check instead of "expected one argument")."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
         text = " ".join(message.split())
         self.exit(2, f"{self.prog}: error: {text} (see `{self.prog} --help`)\n")
+
+    def _parse_optional(self, arg_string):  # argparse's hook: None means "a value"
+        if _NEGATIVE.match(arg_string):
+            return None
+        return super()._parse_optional(arg_string)
 
 
 def seed(text: str) -> int:

@@ -51,3 +51,16 @@ def test_pack_never_overwrites(tmp_path, capsys):
     assert main(["pack", "--n", "3", "--out", str(out)]) == 2
     assert "exists" in capsys.readouterr().err and out.read_text() == "mine"
 
+
+
+@pytest.mark.parametrize("value", ["-1:1", "-1e-3", "-.5:2"])
+def test_pack_negative_radii_reach_the_radii_check(tmp_path, capsys, value):
+    """`--radii -1:1` (no '='): argparse took a word starting with '-' for an option ("expected
+    one argument"); it now reaches --radii's own check: one line, exit status 2."""
+    out = tmp_path / "p.csv"
+    with pytest.raises(SystemExit) as stop:
+        main(["pack", "--n", "5", "--radii", value, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and err.count("\n") == 1
+    assert f"argument --radii: expected MIN:MAX with 0 < MIN <= MAX, got {value!r}" in err
+    assert not out.exists()

@@ -4,7 +4,9 @@ verify.statics.forceset's `analyse`), in this process or split over worker proce
 Each end is the optimum of a range LP (DualForceLP: dual simplex on its dual, warm-started from
 the previous optimum) checked to lie in P and certified by the dual's optimum y (weak duality,
 `DualForceLP.certified`; an infinite end by HiGHS's primal ray of ForceLP,
-`ForceLP.ray_checked`; an end failing its check is counted in `unchecked`), or a bound that
+`ForceLP.ray_checked`); an answer failing its check is retried (its basis solved again, then
+a cold LP: verify.statics.ends) and, when no retry passes, the end is unknown: NaN in lo / hi,
+listed with the evidence in `unknown`, never a number nor +-inf. Or the end is a bound that
 holds on all of P and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0)
 when some checked point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when
 one has S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP
@@ -21,13 +23,14 @@ from __future__ import annotations
 import multiprocessing
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from rigidlcp import models
 from rigidlcp.lcp.errors import InvalidInput
 
+from .ends import Evidence, Unknown, settle
 from .hull import ZERO
 from .model import DualForceLP, ForceLP, StaticProblem
 
@@ -64,14 +67,20 @@ class Witnesses:
 
 @dataclass
 class Ranges:
-    """lo, hi: (2c,) ranges of [R; S] (+-inf unbounded); sliding (c,); lps solved; unchecked:
-    LP optima that failed the check against P or of their dual bound (none expected)."""
+    """lo, hi: (2c,) ranges of [R; S] (+-inf unbounded, NaN unknown); sliding (c,);
+    sliding_unknown (c,): whether the sliding verdict rests on an LP whose check failed (then
+    sliding is False there, but unknown); lps solved; unchecked: ends and sliding verdicts
+    reported unknown (none expected); unknown: their ends with the evidence; retried: LP
+    answers that failed their check and were settled by a retry (verify.statics.ends)."""
 
     lo: np.ndarray
     hi: np.ndarray
     sliding: np.ndarray
     lps: int = 0
     unchecked: int = 0
+    unknown: list[Unknown] = field(default_factory=list)
+    sliding_unknown: np.ndarray | None = None
+    retried: int = 0
 
 
 def at_bound(prob: StaticProblem, lam: np.ndarray) -> np.ndarray:
@@ -90,32 +99,35 @@ def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
 
 
 def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str],
-              contacts: np.ndarray, wit: Witnesses, step: Callable[[int], None] | None = None
+              contacts: np.ndarray, wit: Witnesses, step: Callable[[int], None] | None = None,
+              unknown: list[Unknown] | None = None, retried: list[int] | None = None
               ) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S), LPs solved,
-    ends that failed their check; wit is updated with every checked optimum. step(n): called
-    with the number of ends settled (by LP or filter) after each contact."""
+    """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S; NaN: unknown),
+    LPs solved, ends reported unknown (their check failed after the retries; appended to
+    `unknown` with their evidence, indices in P's [R; S]); wit is updated with every checked
+    optimum; retried[0] counts the answers settled by a retry. step(n): called with the
+    number of ends settled (by LP or filter) after each contact."""
     c, n, mu = prob.c, prob.n, prob.mu
     m = len(contacts)
     lo, hi = np.zeros(2 * m), np.zeros(2 * m)
-    lps = unchecked = 0
+    lps = 0
+    found: list[Unknown] = []
 
     def bound(k: int, sgn: float) -> float:
-        nonlocal lps, unchecked
+        nonlocal lps
         e = np.zeros(n)
         e[k] = sgn
-        status, lam = lp.solve(e)
-        lps += 1
-        if status == "unbounded":
-            unchecked += not lp.ray_checked(e)
+        end = settle(prob, lp, e)
+        lps += end.lps
+        if retried is not None:
+            retried[0] += end.retried
+        if end.status == "unbounded":
             return -sgn * np.inf
-        if status != "optimal":
-            raise RuntimeError(f"range LP {status} on a non-empty P (please report)")
-        ok = prob.admissible(lam) and lp.certified(e, lam)
-        unchecked += not ok
-        if ok:
-            wit.add(prob, lam)
-        return float(lam[k])
+        if end.status == "unknown":
+            found.append(Unknown(int(k), "min" if sgn > 0 else "max", end.evidence))
+            return np.nan
+        wit.add(prob, end.lam)
+        return float(end.lam[k])
 
     def tol() -> float:
         return 1e-9 * prob.scale
@@ -132,7 +144,12 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
         ends += 2
         if mu[a] > 0 and kind:  # S = +- mu R on all of P
             sg = mu[a] if kind == "S=+muR" else -mu[a]
-            lo[m + x], hi[m + x] = sorted((sg * lo[x], sg * hi[x]))
+            lo[m + x], hi[m + x] = ((sg * lo[x], sg * hi[x]) if sg > 0 else
+                                    (sg * hi[x], sg * lo[x]))
+            for side, v in (("min", lo[m + x]), ("max", hi[m + x])):
+                if np.isnan(v):  # S = +-mu R of an unknown end of R: unknown too
+                    found.append(Unknown(c + int(a), side, Evidence(
+                        "from R", np.nan, 0.0, "S = +-mu R of an unknown R end")))
         elif mu[a] > 0:
             top = mu[a] * hi[x]
             hi[m + x] = (min(float(wit.s_max[a]), top)
@@ -144,42 +161,64 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
             ends += 2
         if step:
             step(ends)
-    return lo, hi, lps, unchecked
+    if unknown is not None:
+        unknown.extend(found)
+    return lo, hi, lps, len(found)
 
 
 def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.ndarray,
-               seen: np.ndarray, contacts: np.ndarray) -> tuple[np.ndarray, int, int]:
+               seen: np.ndarray, contacts: np.ndarray, unsure: list[int] | None = None,
+               retried: list[int] | None = None) -> tuple[np.ndarray, int, int]:
     """Whether S = +-mu R with R > 0 is attainable at each of `contacts` (forceset's
-    docstring), the LPs solved and their optima that failed a check (in P, and certified by
-    their duals on the face: a "no" rests on that bound); hi_R: (c,) max R; seen: (c,)
-    contacts already found at the bound at a checked optimum (no LP needed)."""
+    docstring), the LPs solved and the verdicts left unknown (a "no" rests on checked LP
+    answers: optima in P certified by their duals on the face, or checked rays, or HiGHS's
+    "infeasible" for the face, taken as it is (not checked, as before); when an
+    answer fails its check after the retries of verify.statics.ends, and no other answer
+    says "yes", the contact is appended to `unsure` and its verdict is False there, but
+    unknown); hi_R: (c,) max R (NaN: unknown); seen: (c,) contacts already found at the
+    bound at a checked optimum (no LP needed); retried[0] counts the answers settled by a
+    retry."""
     k = prob.fric.size
     row_of = {int(a): n for n, a in enumerate(prob.fric)}
     out = np.array([bool(seen[a]) for a in contacts], dtype=bool)
-    lps = unchecked = 0
+    lps = 0
+    found: list[int] = []
     for x, a in enumerate(contacts):
         kind = implicit[a]
         if prob.mu[a] <= 0 or kind == "R=0" or out[x]:
             continue
         if kind:
             out[x] = hi_R[a] > ZERO * prob.scale
+            if np.isnan(hi_R[a]):
+                found.append(int(a))
             continue
         n = row_of[int(a)]
+        doubt = False
         for row in (n, k + n):
             col = lp.set_cone_row(row, True)
             e = np.zeros(prob.n)
             e[a] = -1.0
-            status, lam = lp.solve(e)
-            lps += 1
-            if status == "optimal":
-                unchecked += not (prob.admissible(lam) and lp.certified(e, lam, fixed=(col,)))
-            elif status == "unbounded":
-                unchecked += not lp.ray_checked(e, fixed=(col,))
+
+            def cold(row: int = row) -> ForceLP:
+                fresh = ForceLP(prob)
+                fresh.set_cone_row(row, True)
+                return fresh
+
+            end = settle(prob, lp, e, fixed=(col,), cold=cold, as_is=("infeasible",))
+            lps += end.lps
+            if retried is not None:
+                retried[0] += end.retried
             lp.set_cone_row(row, False)
-            if status == "unbounded" or (status == "optimal" and lam[a] > ZERO * prob.scale):
+            doubt |= end.status == "unknown"
+            if end.status == "unbounded" or (end.status == "optimal"
+                                             and end.lam[a] > ZERO * prob.scale):
                 out[x] = True
                 break
-    return out, lps, unchecked
+        if doubt and not out[x]:
+            found.append(int(a))
+    if unsure is not None:
+        unsure.extend(found)
+    return out, lps, len(found)
 
 
 def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
@@ -204,9 +243,21 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
         return _in_workers(prob, implicit, wit, step, jobs)
     lp = lp or ForceLP(prob)
     every = np.arange(c)
-    lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step)
-    sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every)
-    return Ranges(lo, hi, sliding, lps + more, unchecked + bad)
+    unknown: list[Unknown] = []
+    unsure: list[int] = []
+    retried = [0]
+    lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step,
+                                       unknown, retried)
+    sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every, unsure,
+                                    retried)
+    return Ranges(lo, hi, sliding, lps + more, unchecked + bad, unknown,
+                  _mask(c, unsure), retried[0])
+
+
+def _mask(c: int, unsure: list[int]) -> np.ndarray:
+    out = np.zeros(c, dtype=bool)
+    out[np.asarray(unsure, dtype=int)] = True
+    return out
 
 
 def check_jobs(jobs: int) -> None:
@@ -230,15 +281,20 @@ def _start(system: models.System) -> None:
 
 def _range_chunk(task):
     implicit, contacts, wit = task
+    unknown: list[Unknown] = []
+    retried = [0]
     lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["dual"], implicit, contacts,
-                                       wit)
-    return contacts, lo, hi, lps, unchecked, wit
+                                       wit, None, unknown, retried)
+    return contacts, lo, hi, lps, unchecked, wit, unknown, retried[0]
 
 
 def _sliding_chunk(task):
     implicit, contacts, hi_R, seen = task
-    return contacts, *sliding_of(_WORKER["prob"], _WORKER["lp"], implicit, hi_R, seen,
-                                 contacts)
+    unsure: list[int] = []
+    retried = [0]
+    out = sliding_of(_WORKER["prob"], _WORKER["lp"], implicit, hi_R, seen, contacts, unsure,
+                     retried)
+    return contacts, *out, unsure, retried[0]
 
 
 def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
@@ -246,7 +302,7 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
     c = prob.c
     lo, hi = np.zeros(prob.n), np.zeros(prob.n)
     sliding = np.zeros(c, dtype=bool)
-    out = Ranges(lo, hi, sliding)
+    out = Ranges(lo, hi, sliding, sliding_unknown=np.zeros(c, dtype=bool))
     size = max(1, min(64, c // (8 * jobs)))  # small chunks: balance, and fresh witnesses
     chunks = [np.arange(s, min(s + size, c)) for s in range(0, c, size)]
     # spawn: fresh interpreters, no inherited threads or locks (HiGHS, BLAS) from this one
@@ -264,22 +320,27 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
                     merge(fut.result())
 
         def merge_ranges(res) -> None:
-            contacts, lo_x, hi_x, lps, unchecked, w = res
+            contacts, lo_x, hi_x, lps, unchecked, w, unknown, retried = res
             m = len(contacts)
             lo[contacts], hi[contacts] = lo_x[:m], hi_x[:m]
             lo[c + contacts], hi[c + contacts] = lo_x[m:], hi_x[m:]
             out.lps += lps
             out.unchecked += unchecked
+            out.unknown.extend(unknown)
+            out.retried += retried
             wit.merge(w)
             step(int(sum(2 + 2 * (prob.mu[a] > 0 and not implicit[a])
                          for a in contacts if implicit[a] != "R=0")))
 
         def merge_sliding(res) -> None:
-            contacts, s, lps, unchecked = res
+            contacts, s, lps, unchecked, unsure, retried = res
             sliding[contacts] = s
+            out.sliding_unknown[unsure] = True
             out.lps += lps
             out.unchecked += unchecked
+            out.retried += retried
 
         run(_range_chunk, lambda ch: (implicit, ch, wit), merge_ranges)
         run(_sliding_chunk, lambda ch: (implicit, ch, hi[:c], wit.seen), merge_sliding)
+    out.unknown.sort(key=lambda u: (u.k, u.side))
     return out

@@ -20,9 +20,11 @@
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),
-  every optimum checked to lie in P and its value certified by the LP's duals
-  (verify.statics.contact_ranges; in `jobs` worker processes when jobs > 1); an optimum
-  failing either check is counted ("unchecked_optima" in the JSON).
+  every optimum checked to lie in P and its value certified by the LP's duals, every infinite
+  end proved by a checked ray (verify.statics.contact_ranges; in `jobs` worker processes when
+  jobs > 1); an answer failing its check is retried (verify.statics.ends), and an end that no
+  retry settles is unknown: NaN in lo / hi, "unknown" in the JSON, with the failed check and
+  its measure in `unknown` ("unknown_ends"), never a number nor +-inf.
 * sliding: whether |S| = mu R with R > 0 is attainable at each frictional contact (a checked
   optimum of a range LP at the bound is a witness; else an LP with
   that cone row made an equality), and their count against McNamara & Herrmann's 2M - 3N
@@ -63,7 +65,10 @@ class ForceSet:
     lo: np.ndarray | None = None
     hi: np.ndarray | None = None
     sliding: np.ndarray | None = None
-    unchecked: int = 0  # LP optima failing the check against P or of their duals (none seen)
+    unchecked: int = 0  # ends and sliding verdicts left unknown (their checks failed)
+    unknown: list = field(default_factory=list)  # verify.statics.ends.Unknown, per unknown end
+    sliding_unknown: np.ndarray | None = None  # (c,) can_slide unknown (sliding False there)
+    retried: int = 0  # LP answers that failed their check and were settled by a retry
     residuals: tuple[float, float] = (0.0, 0.0)  # of `solution`: balance, laws (force units)
     lps: int = 0
     exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
@@ -84,16 +89,21 @@ class ForceSet:
         return self.hi - self.lo
 
     def diameter(self) -> tuple[float, float]:
-        """(lower, upper) bounds on the diameter of P from the ranges."""
-        w = self.width
-        return float(np.max(w, initial=0.0)), float(np.sqrt(np.sum(w**2)))
+        """(lower, upper) bounds on the diameter of P from the ranges: the widest known range,
+        and the diagonal of the box (inf if a range is unbounded, else NaN, unknown, when an
+        end is)."""
+        w = np.where(np.isinf(self.lo) | np.isinf(self.hi), np.inf, self.width)
+        known = w[~np.isnan(w)]
+        hi = np.inf if np.any(np.isinf(known)) else float(np.sqrt(np.sum(w**2)))
+        return float(np.max(known, initial=0.0)), hi
 
     def box(self) -> dict:
         lat = self.system.lattice
         return {"left": lat.left, "right": lat.right, "plane": 0.0}
 
     def to_dict(self) -> dict:
-        """The JSON of `rigidlcp forceset --json` (null for an unbounded end)."""
+        """The JSON of `rigidlcp forceset --json` (null for an unbounded end, "unknown" for an
+        end whose check failed: its evidence in "unknown_ends")."""
         lat, c = self.system.lattice, self.c
         out = {"exists": self.exists, "dimension": self.dimension, "box": self.box(),
                "p": lat.p, "c": c, "mu": {"pp": self.system.mu_pp,
@@ -111,6 +121,8 @@ class ForceSet:
             return out
 
         def end(v: float):
+            if np.isnan(v):
+                return UNKNOWN
             return None if not np.isfinite(v) else float(v) + 0.0  # no "-0.0"
 
         if self.lo is None:  # existence and dimension only
@@ -124,15 +136,21 @@ class ForceSet:
             {"i": int(lat.i[a]), "j": int(lat.j[a]),
              "R": [end(self.lo[a]), end(self.hi[a])],
              "S": [end(self.lo[c + a]), end(self.hi[c + a])],
-             "implicit": self.implicit[a] or None, "can_slide": bool(self.sliding[a])}
+             "implicit": self.implicit[a] or None,
+             "can_slide": UNKNOWN if self._slide_unknown(a) else bool(self.sliding[a])}
             for a in range(c)]
         lo, hi = self.diameter()
         out.update(solution_residuals=list(self.residuals),
                    unique=self.dimension == 0, rank_gap=list(self.rank_gap),
                    sliding=int(self.sliding.sum()), sliding_bound_2M_3N=self.sliding_bound,
                    diameter=[end(lo), end(hi)], lps=self.lps,
-                   unchecked_optima=self.unchecked)
+                   unchecked_optima=self.unchecked,
+                   unknown_ends=[u.to_dict(c, lat.i, lat.j) for u in self.unknown],
+                   retried=self.retried)
         return out
+
+    def _slide_unknown(self, a: int) -> bool:
+        return self.sliding_unknown is not None and bool(self.sliding_unknown[a])
 
 
 def analyse(system: models.System, ranges: bool = True,
@@ -189,10 +207,15 @@ def analyse(system: models.System, ranges: bool = True,
     if ranges:
         r = contact_ranges(prob, lp, fs.implicit, witness, progress, jobs)
         fs.lo, fs.hi, fs.sliding = r.lo, r.hi, r.sliding
+        fs.sliding_unknown, fs.unknown, fs.retried = r.sliding_unknown, r.unknown, r.retried
         fs.lps += r.lps
         fs.unchecked += r.unchecked
     return fs
 
+
+#: The JSON's marker of an end (or a can_slide) whose check failed: not a number, and not
+#: null (which is a proved unbounded end).
+UNKNOWN = "unknown"
 
 #: Largest number of disks for which the IPM's checked point is replaced by a closer vertex.
 VERTEX_MAX_P = 3000

@@ -13,8 +13,10 @@ These are linear: the admissible set P = {lambda : H^T lambda = -f, R >= 0, S - 
 `ForceLP` holds P once in HiGHS (highspy) and re-solves it for one objective after another,
 warm-started from the previous basis (the ranges of every R and S are 4c such LPs);
 `DualForceLP` solves the same LPs through their dual, about twice as fast on deposited piles.
-Every optimum is checked against P in floating point (`residuals`), and its value against the
-dual bound (`certified`), not taken on the solver's word.
+Every optimum is checked against P in floating point (`admissible`: the balance's
+componentwise backward error and the laws' violation), and its value against the dual bound
+(`certified`), not taken on the solver's word (verify.statics.ends: what is done when a check
+fails).
 """
 
 from __future__ import annotations
@@ -32,6 +34,11 @@ LP_TOL = 1e-10
 #: HiGHS applies LP_TOL to its scaled LP, and the unscaled reduced costs of the primal simplex
 #: reached -2.3e-9 (|y| = 1.1) on one of 143 range LPs of the 1000-disk pile.
 DUAL_TOL = 1e-8
+#: Acceptance of a point of P (`StaticProblem.admissible`): the balance's componentwise
+#: backward error and the laws' relative violation at most this, lcp.acceptance.residual's TOL
+#: (the one tolerance of "solved" for an LCP): the point is then an exact equilibrium of the
+#: packing with every balance coefficient and weight changed by at most 1e-8 of its size.
+BALANCE_TOL = 1e-8
 
 
 class StaticProblem:
@@ -60,6 +67,7 @@ class StaticProblem:
         self.G = sp.csr_matrix((vals, (rows, cols)), shape=(2 * k, 2 * c))
         self.lb = np.r_[np.zeros(c), np.where(self.mu > 0, -np.inf, 0.0)]
         self.ub = np.r_[np.full(c, np.inf), np.where(self.mu > 0, np.inf, 0.0)]
+        self._absA = None  # |A|, for backward_error
 
     @property
     def n(self) -> int:
@@ -75,13 +83,30 @@ class StaticProblem:
                    float(np.max(lam - self.ub, initial=0.0)))
         return eq, viol
 
-    def admissible(self, lam: np.ndarray, tol: float = 1e-8) -> bool:
-        """lambda in P up to tol times the force scale (balance to tol x the size of its
-        terms: sum |R| + |S| acting on a disk, and its weight)."""
-        eq, viol = self.residuals(lam)
-        terms = float(np.max(abs(self.A) @ np.abs(lam) + np.abs(self.b), initial=0.0))
-        return eq <= tol * max(terms, self.scale) and viol <= tol * max(
-            self.scale, float(np.max(np.abs(lam), initial=0.0)))
+    def backward_error(self, lam: np.ndarray) -> float:
+        """Componentwise (Oettli-Prager) backward error of the balance A lambda = b:
+        max_i |A lambda - b|_i / max((|A| |lambda| + |b|)_i, scale). lambda balances exactly
+        the forces of a packing whose balance coefficients (normals, tangents, lever arms) and
+        weights are each changed by at most this fraction of their own size (of the largest
+        weight on a row whose terms are smaller), as lcp.acceptance.accuracy's backward_error
+        for an LCP; its own rounding is below 8 eps (at most 6 terms a row)."""
+        lam = np.asarray(lam, dtype=float)
+        if self._absA is None:
+            self._absA = abs(self.A)
+        r = np.abs(self.A @ lam - self.b)
+        s = np.maximum(self._absA @ np.abs(lam) + np.abs(self.b), self.scale)
+        return float(np.max(r / s, initial=0.0))
+
+    def law_error(self, lam: np.ndarray) -> float:
+        """The largest violation of R >= 0, |S| <= mu R, S = 0 where mu = 0, relative to the
+        force scale (the largest weight, or |lambda|_inf when larger)."""
+        viol = self.residuals(lam)[1]
+        return viol / max(self.scale, float(np.max(np.abs(lam), initial=0.0)))
+
+    def admissible(self, lam: np.ndarray, tol: float = BALANCE_TOL) -> bool:
+        """lambda in P: its balance's backward error (`backward_error`) and its laws' violation
+        (`law_error`) both <= tol."""
+        return self.backward_error(lam) <= tol and self.law_error(lam) <= tol
 
 
 class ForceLP:
@@ -145,17 +170,7 @@ class ForceLP:
         _, has_ray, values = self.h.getPrimalRay()
         if not has_ray:
             return False
-        r = np.asarray(values, dtype=float)
-        big = float(np.max(np.abs(r), initial=0.0))
-        if big == 0.0:
-            return False
-        lam = self.T @ r
-        drop = -float(np.asarray(self.TT @ np.asarray(cost, dtype=float)) @ r)
-        terms = abs(self.KT.T) @ np.abs(r)
-        return (float(np.min(r, initial=0.0)) >= -tol * big
-                and all(abs(r[j]) <= tol * big for j in fixed)
-                and bool(np.all(np.abs(self.KT.T @ r) <= tol * np.maximum(terms, big)))
-                and drop > tol * float(np.max(np.abs(lam))))
+        return ray_defect(self, np.asarray(values, dtype=float), cost, tol, fixed) is None
 
     def set_cone_row(self, row: int, equality: bool) -> int:
         """Make cone row `row` (0..2k-1: S - mu R <= 0 for the k frictional contacts, then
@@ -171,13 +186,44 @@ def dual_bound_holds(lp: ForceLP, cost: np.ndarray, lam: np.ndarray, y: np.ndarr
                      tol: float = DUAL_TOL, fixed: tuple[int, ...] = ()) -> bool:
     """ForceLP.certified's test of y (one entry per balance row) for min cost . lambda = cost .
     lam over P in lp's cone coordinates."""
+    infeasible, gap = dual_defects(lp, cost, lam, y, fixed)
+    return infeasible <= tol and gap <= tol
+
+
+def dual_defects(lp: ForceLP, cost: np.ndarray, lam: np.ndarray, y: np.ndarray,
+                 fixed: tuple[int, ...] = ()) -> tuple[float, float]:
+    """(dual infeasibility -min d / max(1, |y|_inf), gap |cost . lam - b . y| / the force
+    scale of ForceLP.certified): y certifies lam's value when both are <= its tol."""
     cost = np.asarray(cost, dtype=float)
     d = lp.TT @ cost - lp.KT @ y
     d[list(fixed)] = 0.0
     obj, dual = float(cost @ lam), float(lp.prob.b @ y)
     big = max(lp.prob.scale, abs(obj), float(np.abs(lp.prob.b) @ np.abs(y)))
-    return (float(np.min(d, initial=0.0)) >= -tol * max(1.0, float(np.max(np.abs(y))))
-            and abs(obj - dual) <= tol * big)
+    infeasible = -float(np.min(d, initial=0.0)) / max(1.0, float(np.max(np.abs(y), initial=0.0)))
+    return infeasible, abs(obj - dual) / big
+
+
+def ray_defect(lp: ForceLP, r: np.ndarray, cost: np.ndarray, tol: float = 1e-9,
+               fixed: tuple[int, ...] = ()) -> tuple[str, float] | None:
+    """None when r (cone coordinates) proves min cost . lambda unbounded (ForceLP.ray_checked),
+    else (the first part that fails: "sign", "fixed", "balance" or "descent", its measure
+    relative to the ray's own terms, to compare with tol)."""
+    big = float(np.max(np.abs(r), initial=0.0))
+    if not big > 0.0:
+        return "sign", 0.0
+    lam = lp.T @ r
+    drop = -float(np.asarray(lp.TT @ np.asarray(cost, dtype=float)) @ r)
+    terms = np.maximum(abs(lp.KT.T) @ np.abs(r), big)
+    parts = (("sign", -float(np.min(r, initial=0.0)) / big),
+             ("fixed", max((abs(r[j]) for j in fixed), default=0.0) / big),
+             ("balance", float(np.max(np.abs(lp.KT.T @ r) / terms, initial=0.0))))
+    for name, value in parts:
+        if not value <= tol:
+            return name, value
+    size = float(np.max(np.abs(lam), initial=0.0))
+    if not drop > tol * size:
+        return "descent", drop / size if size > 0 else 0.0
+    return None
 
 
 class DualForceLP:

@@ -13,7 +13,8 @@ from .forceset import ForceSet
 
 def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path:
     """PNG of the packing and its forces: width ~ R of the checked solution, colour ~ R's
-    range width (unbounded ranges drawn at the top of the scale, dashed)."""
+    range width (unbounded ranges drawn at the top of the scale, dotted; a range with an
+    unknown end dotted, grey)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -31,14 +32,15 @@ def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path
     draw_lattice(ax, system)
     a, b = contact_points(system)
     R = np.maximum(fs.solution[:c], 0.0)
-    spread = fs.hi[:c] - fs.lo[:c]
+    spread = np.where(np.isinf(fs.hi[:c]), np.inf, fs.hi[:c] - fs.lo[:c])
     finite = np.isfinite(spread)
     top = float(np.max(spread[finite], initial=0.0)) or 1.0
-    colour = np.where(finite, spread, top)
+    colour = np.where(np.isinf(spread), top, spread)  # NaN (an unknown end): grey
     widths = max_width * R / max(float(R.max(initial=0.0)), 1e-300)
     segs = LineCollection(np.stack([a, b], axis=1), linewidths=np.maximum(widths, 0.2),
                           cmap="viridis", linestyles=[":" if not f else "-" for f in finite])
-    segs.set_array(colour)
+    segs.cmap.set_bad("0.6")
+    segs.set_array(np.ma.masked_invalid(colour))
     segs.set_clim(0.0, top)
     ax.add_collection(segs)
     cb = fig.colorbar(segs, ax=ax, shrink=0.7, pad=0.02)
