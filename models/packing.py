@@ -9,7 +9,8 @@ g = |x_j - x_i| - r_i - r_j of two disks (x - r - left, right - x - r, y - r for
 and the scale s = min(r_i, r_j) (r_i for an obstacle), a pair is a contact when |g| <= gap_tol s;
 a pair with g < -gap_tol s overlaps and is refused (`Overlap`, naming the pair and the overlap).
 The default gap_tol = 1e-9 keeps contacts that are exact up to rounding (a deposited packing
-written with 17 significant digits) and nothing else. Normals point from i to j; of two disks
+written with 17 significant digits) and nothing else; gap_tol is at most MAX_GAP_TOL = 0.05.
+Normals point from i to j; of two disks
 i is the lower one (the left one at equal heights), as in the arrays.
 
 `report(lattice)`: rattlers (disks with fewer than two contacts, obstacles counted) and the
@@ -29,6 +30,10 @@ from .lattice import LEFT_WALL, MAX_DISKS, PLANE, RIGHT_WALL, InvalidSystem, Lat
 
 #: Default relative gap tolerance (module docstring).
 GAP_TOL = 1e-9
+#: Largest gap tolerance accepted: overlaps up to 5 % of the smaller radius (a soft-particle
+#: DEM packing's contacts, say) are read as contacts of rigid disks; beyond that two disks
+#: interpenetrate and the packing is not one of touching rigid disks (the paper's model).
+MAX_GAP_TOL = 0.05
 
 
 class Overlap(InvalidSystem):
@@ -86,8 +91,10 @@ def packing(x, r, m=None, I=None, *, left: float | None = None,  # noqa: E741 (t
     if left is not None and right is not None and right <= left:
         raise InvalidSystem(f"the right wall ({right}) must be right of the left wall ({left})")
     tol = float(gap_tol)
-    if not (np.isfinite(tol) and 0 <= tol < 1):
-        raise InvalidSystem(f"gap_tol must be in [0, 1), got {gap_tol!r}")
+    if not (np.isfinite(tol) and 0 <= tol <= MAX_GAP_TOL):
+        raise InvalidSystem(f"gap_tol must be in [0, {MAX_GAP_TOL:g}] (a fraction of the radius; "
+                            f"more is interpenetration, not rigid disks in contact), got "
+                            f"{gap_tol!r}")
     ci, cj, normals, kinds = _contacts(x, r, left, right, tol)
     n = np.array(normals, dtype=float).reshape(-1, 2)
     t = np.column_stack([-n[:, 1], n[:, 0]])

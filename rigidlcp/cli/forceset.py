@@ -38,7 +38,8 @@ def register(sub) -> None:
                    "file's '# box:', else the tight box)")
     p.add_argument("--right", default=None, help="right wall abscissa, or 'none'")
     p.add_argument("--gap-tol", type=float, default=None,
-                   help="relative gap tolerance of contact detection (default 1e-9)")
+                   help="relative gap tolerance of contact detection (default 1e-9, at most 0.05: "
+                   "overlaps up to G x the smaller radius are contacts)")
     p.add_argument("--no-ranges", action="store_true",
                    help="existence and dimension only (no range LPs)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
@@ -72,7 +73,7 @@ def _wall(text: str | None):
 def cmd_forceset(args: argparse.Namespace) -> int:
 
     from rigidlcp.lcp.io.files import output_dir
-    from rigidlcp.models.packing import GAP_TOL, Overlap
+    from rigidlcp.models.packing import GAP_TOL, MAX_GAP_TOL, Overlap
     from rigidlcp.models.packing_io import read_disks, read_packing
     from rigidlcp.models.system import System
 
@@ -84,8 +85,12 @@ def cmd_forceset(args: argparse.Namespace) -> int:
     try:
         lat = read_packing(args.file, left=left, right=right, gap_tol=gap_tol)
     except Overlap as exc:  # a hand-written file rounds its centres: say what accepts it
-        raise Overlap(f"{exc}; --gap-tol G accepts overlaps up to G x radius", exc.i, exc.j,
-                      exc.overlap) from None
+        s = min(disks.r[exc.i], disks.r[exc.j]) if exc.j >= 0 else disks.r[exc.i]
+        hint = (f"--gap-tol G accepts overlaps up to G x radius (G <= {MAX_GAP_TOL:g})"
+                if exc.overlap <= MAX_GAP_TOL * s else
+                f"{exc.overlap / s:.3g} of the radius: the disks interpenetrate, beyond what "
+                f"any --gap-tol accepts (at most {MAX_GAP_TOL:g}): not rigid disks in contact")
+        raise Overlap(f"{exc}; {hint}", exc.i, exc.j, exc.overlap) from None
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
