@@ -62,9 +62,11 @@ def attempt(func: Callable[..., Solution], name: str, eq: Equilibration, options
     sol.method = name
     z = np.asarray(sol.z, dtype=float)
     if z.shape != (n,) or not np.all(np.isfinite(z)):
-        if sol.status == "solved":
+        if sol.status == "solved":  # elsewhere z is no claim (infeasible, ray: z may be None)
             sol.status = "failed"
-        sol.message = (sol.message + "; " if sol.message else "") + "method returned a bad z"
+            sol.message = ((sol.message + "; " if sol.message else "")
+                           + ("the method's z is not finite" if z.shape == (n,) else
+                              f"the method's z is missing or of shape {z.shape}, not ({n},)"))
         z = np.where(np.isfinite(z), z, 0.0) if z.shape == (n,) else np.zeros(n)
     sol.z = eq.z_back(z)
     for key in ("point",):

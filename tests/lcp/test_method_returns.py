@@ -64,3 +64,24 @@ def test_an_honest_method_is_unchanged(methods):
     sol = lcp.solve(lcp.LCP(M, Q), method="test-honest")
     assert sol.success and sol.method == "test-honest"
     assert np.allclose(sol.z, [1 / 3, 1 / 3])  # (2 1; 1 2) z = (1, 1)
+
+
+def test_a_claim_without_z_is_judged_on_its_certificate_not_on_z(methods):
+    """z is no claim of an 'infeasible' answer: z=None was reported as 'method returned a bad
+    z' beside the missing certificate (a new user's method, session 27); a non-finite z of a
+    'solved' answer is named as such and the answer fails."""
+
+    @lcp.register("test-says-infeasible", accepts="any", description="claims, no y")
+    def says(M, q):
+        return lcp.Solution(z=None, w=None, status="infeasible", method="test-says-infeasible")
+
+    @lcp.register("test-nan-z", accepts="any", description="a NaN z, 'solved'")
+    def nan_z(M, q):
+        return lcp.Solution(z=np.full(q.size, np.nan), w=q.copy(), status="solved",
+                            method="test-nan-z")
+
+    sol = lcp.solve(lcp.LCP(M, Q), method="test-says-infeasible")  # solvable: no certificate
+    assert sol.status == "failed" and "bad z" not in sol.message and "z is" not in sol.message
+    assert "no Farkas certificate" in sol.message
+    sol = lcp.solve(lcp.LCP(M, Q), method="test-nan-z")
+    assert sol.status == "failed" and "the method's z is not finite" in sol.message
