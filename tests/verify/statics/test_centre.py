@@ -65,6 +65,8 @@ S3 = np.sqrt(3.0)
     # tests/verify/statics/test_forceset.py's cases 1-3: R_w = 0 on all of P below mu_w = 1
     (_packing([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=0.9), True),
     (_packing([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=1.5), False),
+    # at mu_w = 1 exactly: S_w = -R_w = -mu_w R_w on all of P, with R_w in [0, 1]
+    (_packing([[1.0, 1.0]], left=0.0, mu_plane=0.5, mu_wall=1.0), True),
     (_packing([[1.0, 1.0]], left=0.0, right=2.0, mu_pp=0.5, mu_plane=0.5, mu_wall=0.5),
      False),
     (_packing([[1.0, 1.0]], left=0.0, right=2.0), False),  # mu = 0: S = 0 by bounds
@@ -90,12 +92,12 @@ def test_symmetric_arrays(kind, mu):
 
 @settings(max_examples=10)
 @given(n=st.integers(2, 120), seed=st.integers(0, 10**5),
-       mu=st.sampled_from([0.0, 0.1, 0.3, 0.5, 0.988, 1.0, 1.5]),
+       mu=st.sampled_from([0.0, 0.1, 0.3, 0.5, 0.988, 1.0, 1.5, 2.0]),
        spread=st.floats(1.0, 1.6), across=st.sampled_from([1, 2, 3, 6]))
 def test_new_path_agrees_on_deposited_packings(n, seed, mu, spread, across):
-    """Deposited piles (narrow boxes wedge disks between the walls; mu = 0 and mu near and
-    above 1 give implicit equalities and unbounded P); the box is `across` largest diameters
-    wide."""
+    """Deposited piles (narrow boxes wedge disks between the walls; mu = 0, mu near and
+    above 1 and mu_wall = 1 give implicit equalities and unbounded P); the box is `across`
+    largest diameters wide."""
     lat = deposit(n, seed=seed, radii=(1.0, spread), width=2.0 * spread * across)
     _agree(models.System(lat, mu_pp=mu, mu_plane=mu, mu_wall=0.5 * mu))
 
