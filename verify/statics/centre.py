@@ -18,9 +18,12 @@ seconds of HiGHS's iterative normal-equation solver, docs/packings.md, Scale). t
 fixed at one weight, never driven to 0, so the point stays well inside P.
 
 Nothing here is a verdict: when P has an implicit equality (some w_j = 0 on all of P) there is
-no centre and the iteration stops without a point (None); the callers check every point
-returned against P (`StaticProblem.admissible`) and decide the rows from its slacks as from
-any other point of P.
+no centre: the iteration stops (w_j -> 0 and z_j -> inf there, the normal matrix singular or
+the duals diverging), and it is run once more with the coordinates then below 1e-6 weights
+fixed at 0: when they are exactly the implicit equalities, that face of P has a centre, a
+point of the relative interior of P; else there is no point (None). The callers check every
+point returned against P (`StaticProblem.admissible`) and decide the rows from its slacks as
+from any other point of P (a coordinate fixed at 0 leaves its row to the slack LPs).
 """
 
 from __future__ import annotations
@@ -36,6 +39,9 @@ from .model import StaticProblem, cone_lp
 MAX_STEPS = 80
 #: Dual or primal iterates beyond this (in weights) mean there is no centre.
 DIVERGED = 1e12
+#: A coordinate below this (in weights) where the iteration stops is taken for an implicit
+#: equality, for one more try on the face where it is 0.
+SMALL = 1e-6
 #: A centred point: every w_j z_j within this factor of tau.
 CENTRED = 4.0
 
@@ -53,12 +59,25 @@ def analytic_centre(prob: StaticProblem) -> np.ndarray | None:
     rows = np.diff(K.indptr) > 0  # e.g. the torque rows of frictionless disks: 0 = 0
     if np.any(b[~rows] != 0):
         return None  # 0 = b_i != 0: P is empty (a Farkas certificate says so, not this)
-    w = _newton(K[rows], b[rows])
+    K, b = K[rows], b[rows]
+    w, small = _newton(K, b)
+    if w is None and small is not None and 0 < small.sum() < small.size:
+        # the coordinates that went to 0 are likely the implicit equalities: the centre of
+        # the face where they are 0 (its slack rows then go to the slack LPs)
+        keep = ~small
+        face, _ = _newton(sp.csr_matrix(K[:, keep]), b, reg=1e-12)
+        if face is not None:
+            w = np.zeros(keep.size)
+            w[keep] = face
     return None if w is None else T @ (w * s)
 
 
-def _newton(K: sp.csr_matrix, b: np.ndarray) -> np.ndarray | None:
-    """w(1) for {K w = b, w >= 0} and the cost 1 (module docstring), or None."""
+def _newton(K: sp.csr_matrix, b: np.ndarray, reg: float = 0.0
+            ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(w(1) for {K w = b, w >= 0} and the cost 1 (module docstring), None), or (None, the
+    coordinates below SMALL at the last iterate) when there is no centred point. reg > 0 adds
+    reg times the largest diagonal entry to the normal matrix's diagonal (on a face, K's rows
+    may be dependent: the steps are then inexact, the residual test unchanged)."""
     m, n = K.shape
     KT = sp.csr_matrix(K.T)
     w, y, z = np.ones(n), np.zeros(m), np.ones(n)
@@ -70,24 +89,28 @@ def _newton(K: sp.csr_matrix, b: np.ndarray) -> np.ndarray | None:
         feasible = np.all(np.abs(rp) <= 1e-12 * (np.abs(K) @ w + size))
         if feasible and np.max(np.abs(rd)) <= 1e-9 and np.all(w * z <= CENTRED) \
                 and np.all(w * z >= 1.0 / CENTRED):
-            return w
+            return w, None
         d = w / z
+        N = K @ sp.diags(d) @ KT
+        if reg:
+            N = N + reg * float(N.diagonal().max()) * sp.eye(m)
         try:
-            lu = splu(sp.csc_matrix(K @ sp.diags(d) @ KT), permc_spec="MMD_AT_PLUS_A",
+            lu = splu(sp.csc_matrix(N), permc_spec="MMD_AT_PLUS_A",
                       diag_pivot_thresh=0.0, options={"SymmetricMode": True})
         except RuntimeError:  # singular: K has dependent rows, or d degenerated
-            return None
+            return None, w < SMALL
         dy = lu.solve(rp - K @ ((rc - w * rd) / z))
         dz = rd - KT @ dy
         dw = (rc - w * dz) / z
         if not (np.all(np.isfinite(dy)) and np.all(np.isfinite(dw))):
-            return None
+            return None, w < SMALL
         if np.max(np.abs(y)) > DIVERGED or np.max(w) > DIVERGED:
-            return None  # y -> inf: P empty or an implicit equality (its Farkas-like ray)
+            # y -> inf: P empty or an implicit equality (its Farkas-like ray)
+            return None, w < SMALL
         w = w + _step(w, dw) * dw
         a = _step(z, dz)
         y, z = y + a * dy, z + a * dz
-    return None
+    return None, w < SMALL
 
 
 def _step(x: np.ndarray, dx: np.ndarray) -> float:

@@ -4,9 +4,10 @@ per-row slack LPs (forceset.analyse with the centre switched off), and against a
 
 The centre exists exactly when P has a point with every cone coordinate w_j > 0, i.e. when no
 inequality of P is an implicit equality (centre's docstring): so on a packing whose existing
-analysis labels some contact "R=0" or "S=+-muR" the centre must give no point of P, and on
-one without such labels it must give a point of P at which every inequality row has a clearly
-positive slack (> 1e-6 of the largest weight, the rule of hull.implicit_equalities).
+analysis labels no contact "R=0" or "S=+-muR" it must give a point of P at which every
+inequality row has a clearly positive slack (> 1e-6 of the largest weight, the rule of
+hull.implicit_equalities); where some are labelled, any point of P it gives (the centre of
+a face) must have no clear slack on a row the labels say is an equality on all of P.
 """
 
 from __future__ import annotations
@@ -44,13 +45,26 @@ def _agree(system: models.System) -> forceset.ForceSet:
     prob = StaticProblem(system)
     assert prob.admissible(new.solution)
     lam = analytic_centre(prob)
-    if any(old.implicit):
-        assert lam is None or not prob.admissible(lam)
-    else:
+    if not any(old.implicit):
         assert lam is not None and prob.admissible(lam)
+    if lam is not None and prob.admissible(lam):
         slack = np.r_[lam[: prob.c], -(prob.G @ lam)]
-        assert np.min(slack, initial=np.inf) > 1e-6 * prob.scale
+        clear = slack > 1e-6 * prob.scale
+        assert not np.any(clear & _implicit_rows(prob, old.implicit))
+        assert any(old.implicit) or np.all(clear)
     return new
+
+
+def _implicit_rows(prob: StaticProblem, implicit: list[str]) -> np.ndarray:
+    """The inequality rows (-R <= 0 for the c contacts, then S - mu R <= 0 and -S - mu R <= 0
+    for the k frictional ones) that the labels say hold with equality on all of P."""
+    c, k = prob.c, prob.fric.size
+    rows = np.zeros(c + 2 * k, dtype=bool)
+    rows[:c] = [kind == "R=0" for kind in implicit]
+    for n, a in enumerate(prob.fric):
+        rows[c + n] = implicit[a] in ("R=0", "S=+muR")
+        rows[c + k + n] = implicit[a] in ("R=0", "S=-muR")
+    return rows
 
 
 def _packing(x, left=None, right=None, **mu) -> models.System:
