@@ -13,9 +13,9 @@
   on all of P (an implicit equality: R = 0, S = mu R or S = -mu R on the whole set) is found
   by linear programs maximizing slacks t_k in [0, scale] of the undecided rows (a row whose
   slack can be made positive is not implicit; when no undecided row can, all are: at most one
-  LP per row, a few in practice). An interior point of P (the analytic centre,
-  verify.statics.centre, or when it has none HiGHS's IPM without crossover; checked to lie in
-  P) decides most rows first: a clearly positive slack there is a witness.
+  LP per row, a few in practice). An interior point of P (the analytic centre of P or of a
+  face, verify.statics.centre, or failing those HiGHS's IPM without crossover; checked to lie
+  in P) decides most rows first: a clearly positive slack there is a witness.
   Then dim P = (number of unknowns left once the implicit equalities are substituted) - rank
   of the balance equations on them: full row rank is settled by the extreme eigenvalues of
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
@@ -197,10 +197,10 @@ def analyse(system: models.System, ranges: bool = True,
 
 
 def _interior(prob: StaticProblem, weight: float) -> tuple[str, np.ndarray | None]:
-    """A point deep in P: the analytic centre (verify.statics.centre: 1.6-4 CPU s at 10^4
-    disks) when it passes the check against P, else HiGHS's IPM in a box (`interior_point`:
-    67-111 CPU s there; it also answers when P has implicit equalities, where the centre does
-    not exist)."""
+    """A point deep in P: the analytic centre (verify.statics.centre: 1.5-4.2 CPU s at 10^4
+    disks; where P has implicit equalities, the centre of the face where the coordinates that
+    vanished are 0) when it passes the check against P, else HiGHS's IPM in a box
+    (`interior_point`: 67-111 CPU s there)."""
     lam = analytic_centre(prob)
     if lam is not None and prob.admissible(lam):
         return "optimal", lam
