@@ -99,20 +99,22 @@ def reduced_balance(prob: StaticProblem, implicit: list[str]) -> sp.csc_matrix:
     """The balance matrix on the unknowns left once the implicit equalities are substituted:
     per contact none (R = 0), one column A_R +- mu A_S (S = +-mu R; or A_R when mu = 0), or
     two (A_R, A_S)."""
-    A = sp.csc_matrix(prob.A)
     c, mu = prob.c, prob.mu
-    cols = []
-    for a in range(c):
-        kind = implicit[a]
-        if kind == "R=0":
-            continue
-        if mu[a] == 0:
-            cols.append(A[:, a])
-        elif kind:
-            cols.append(A[:, a] + (mu[a] if kind == "S=+muR" else -mu[a]) * A[:, c + a])
-        else:
-            cols += [A[:, a], A[:, c + a]]
-    return sp.hstack(cols, format="csc") if cols else sp.csc_matrix((A.shape[0], 0))
+    kind = np.asarray(implicit, dtype=object)
+    keep = kind != "R=0"
+    two = keep & (kind == "") & (mu != 0)  # both R and S stay
+    ncol = keep.astype(int) + two  # columns per contact, in contact order
+    first = np.cumsum(ncol) - ncol
+    a = np.flatnonzero(keep)  # the column of R (or of R with S = +-mu R substituted)
+    sign = np.where(kind[a] == "S=+muR", 1.0, np.where(kind[a] == "S=-muR", -1.0, 0.0))
+    sign[mu[a] == 0] = 0.0  # S = 0 there: the column is A_R
+    tied = np.flatnonzero(sign != 0)
+    s2 = np.flatnonzero(two)
+    rows = np.r_[a, c + a[tied], c + s2]
+    cols = np.r_[first[a], first[a[tied]], first[s2] + 1]
+    vals = np.r_[np.ones(a.size), sign[tied] * mu[a[tied]], np.ones(s2.size)]
+    Z = sp.csc_matrix((vals, (rows, cols)), shape=(prob.n, int(ncol.sum())))
+    return sp.csc_matrix(prob.A @ Z)
 
 
 def dimension(prob: StaticProblem, implicit: list[str]
@@ -139,12 +141,16 @@ def dimension(prob: StaticProblem, implicit: list[str]
 def _full_row_rank(B: sp.csr_matrix) -> float | None:
     """sigma_min(B) when B (rows <= columns) has full row rank beyond doubt, else None.
 
-    The extreme eigenvalues of B B^T (sparse: shift-invert at 0 for the smallest) give
-    sigma_min and sigma_max; rank = rows by the SVD's own rule (sigma_min > max(shape) eps
-    sigma_max) is accepted only with a wide margin, sigma_min > 1e-6 sigma_max, since the
-    eigenvalues of B B^T carry an absolute error ~ eps sigma_max^2 (else the dense SVD, or
-    None, decides)."""
-    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, eigsh
+    The extreme eigenvalues of C = B B^T give sigma_min and sigma_max; rank = rows by the SVD's
+    own rule (sigma_min > max(shape) eps sigma_max) is accepted only with a wide margin,
+    sigma_min > 1e-6 sigma_max, since the eigenvalues of C carry an absolute error
+    ~ eps sigma_max^2 (else the dense SVD, or None, decides). The smallest eigenvalue is found
+    by Lanczos on C^-1 (shift-invert at 0, C factored once by SuperLU in a minimum-degree
+    order of its symmetric pattern); the largest is first bounded above by Gershgorin's
+    theorem (the largest absolute row sum of C, within 2x of it on the arrays and piles),
+    which can only make the test stricter, and computed by Lanczos only when that bound does
+    not settle it (docs/packings.md, Scale: 0.5-0.8 against 5-6 CPU s at 10^4 disks)."""
+    from scipy.sparse.linalg import ArpackError, ArpackNoConvergence, LinearOperator, eigsh, splu
 
     rows, cols = B.shape
     if rows > cols:
@@ -155,9 +161,14 @@ def _full_row_rank(B: sp.csr_matrix) -> float | None:
         lo, hi = float(ev[0]), float(ev[-1])
     else:
         try:
-            hi = float(eigsh(C, k=1, which="LA", return_eigenvectors=False, tol=1e-6)[0])
-            lo = float(eigsh(C, k=1, sigma=0.0, which="LM", return_eigenvectors=False,
-                             tol=1e-6)[0])
+            lu = splu(C, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                      options={"SymmetricMode": True})
+            inv = LinearOperator(C.shape, matvec=lu.solve, dtype=float)
+            lo = float(eigsh(C, k=1, sigma=0.0, which="LM", OPinv=inv,
+                             return_eigenvectors=False, tol=1e-6)[0])
+            hi = float(np.max(abs(C).sum(axis=1)))  # >= the largest eigenvalue
+            if not (lo > 0 and np.sqrt(lo) > 1e-6 * np.sqrt(hi)):
+                hi = float(eigsh(C, k=1, which="LA", return_eigenvectors=False, tol=1e-6)[0])
         except (ArpackError, ArpackNoConvergence, RuntimeError, ValueError):
             return None  # e.g. C exactly singular: the factorization at sigma = 0 fails
     if hi <= 0 or lo <= 0:
