@@ -148,9 +148,9 @@ def closed_solution(ep: EventProblem, scale: float, tol: float, node_limit: int 
     if best is not None:
         return ClosedSearch("found", z=best[1], nodes=nodes, message=(
             f"a solution keeping every contact closed followed (sum R = {best[0]:.6g}, least "
-            f"over the closed solutions; {nodes} LPs)"))
+            f"over the closed solutions; {nodes} LP(s))"))
     return ClosedSearch("none", nodes=nodes, radius=radius, message=(
-        f"proved: no solution of the event keeps every contact closed ({nodes} LPs, each "
+        f"proved: no solution of the event keeps every contact closed ({nodes} LP(s), each "
         f"infeasible with a Farkas certificate checked: any closed solution would need "
         f"sum z >= {radius:.3g} x the loads)"))
 

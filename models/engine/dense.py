@@ -50,6 +50,11 @@ class DenseBackend:
     seeded random point of the face) are the other rules of models/selection.py, for ensembles
     over rules; their points are checked like the solver's (residual <= check_tol x scale, else
     the face-min-norm point is kept). dump_dir: write every event's LCP to DIR/event_NNNNNN.npz.
+
+    closed_search: when the selected point would open a contact or translate a disk (the loop's
+    stop rules, `leaves_regime`), the event's solution of least sum R with every contact closed
+    is followed instead, or its absence proved (models/engine/closed.py; the verdict goes in the
+    Outcome's note, the events followed in `closed_events`).
     """
 
     system: System

@@ -290,8 +290,9 @@ def closed_text(c: dict) -> str:
     """One line of the summary for `closed_summary`."""
     if not c["search"]:
         return "off (--no-closed-search)"
-    text = f"on: ran at {c['searched']} event(s), a closed solution followed at " + (
-        ", ".join(str(e) for e in c["followed"][:10]) if c["followed"] else "none")
+    text = f"on: ran at {c['searched']} event(s); a closed solution followed at " + (
+        "event(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
+        else "no event")
     if c["at_stop"]:
         text += f"; at the stop: {c['at_stop']} (message)"
     return text

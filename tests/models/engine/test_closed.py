@@ -4,6 +4,8 @@ absence is proved. The V-groove by hand is in tests/verify/statics/test_groove.p
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -16,6 +18,9 @@ from rigidlcp.models.engine.closed import RADIUS, closed_solution
 from .test_fig9_reference import FIELDS, fig9_run
 
 LEFT, RIGHT, PLANE = -1, -2, -3
+#: 15 examples in CI (each runs a search and an event); the deep profile's count otherwise
+EXAMPLES = (settings.get_profile("deep").max_examples
+            if os.environ.get("HYPOTHESIS_PROFILE") == "deep" else 15)
 
 
 def scale_of(ep) -> float:
@@ -129,7 +134,7 @@ def _small_case(n: int, seed: int, mu: float, spins: bool):
     return system, state
 
 
-@settings(deadline=None, max_examples=15)
+@settings(deadline=None, max_examples=EXAMPLES)
 @given(n=st.integers(3, 9), seed=st.integers(0, 10_000), mu=st.sampled_from([0.1, 0.3, 0.5, 0.8]),
        spins=st.booleans())
 def test_closed_solutions_satisfy_the_event_laws(n, seed, mu, spins):
