@@ -2,6 +2,7 @@
 packing"): how each run ends, and why (a script, not a test; it prints a markdown table).
 
     python benchmarks/pile_dynamics.py [--seeds 1:10] [--max-events 2000] [--no-closed-search]
+                                       [--rows 0,1,...]
 
 Rows: `deposit(n, seed, radii=(0.8, 1.2), width)` for the (n, width) of each row, one mu on
 every contact, gamma = 0.1, the default method; started with random spins (spin seed 1) or at
