@@ -26,7 +26,8 @@ from rigidlcp.models.event import (
 from rigidlcp.models.selection import Selection, select
 from rigidlcp.models.system import System
 
-from .loop import Outcome
+from .closed import closed_solution
+from .loop import TRANSLATION_FACTOR, Outcome
 
 #: How an event's particular solution is chosen when it is not unique (see `DenseBackend`;
 #: "random" is given with its seed, "random:SEED"; models/selection.py).
@@ -49,6 +50,11 @@ class DenseBackend:
     seeded random point of the face) are the other rules of models/selection.py, for ensembles
     over rules; their points are checked like the solver's (residual <= check_tol x scale, else
     the face-min-norm point is kept). dump_dir: write every event's LCP to DIR/event_NNNNNN.npz.
+
+    closed_search: when the selected point would open a contact or translate a disk (the loop's
+    stop rules, `leaves_regime`), the event's solution of least sum R with every contact closed
+    is followed instead, or its absence proved (models/engine/closed.py; the verdict goes in the
+    Outcome's note, the events followed in `closed_events`).
     """
 
     system: System
@@ -59,6 +65,7 @@ class DenseBackend:
     warm_start: bool = True
     dump_dir: str | None = None
     check_tol: float = 1e-8  # the loop's acceptance; only accepted solutions are selected among
+    closed_search: bool = True
     info: dict | None = None
     _prev: EventSolution | None = field(default=None, repr=False)
     _events: int = field(default=0, repr=False)
@@ -68,6 +75,10 @@ class DenseBackend:
     #: point failed the acceptance test (the face-min-norm point was kept)
     capped: int = field(default=0, repr=False)
     rejected: int = field(default=0, repr=False)
+    #: events (indices) where the selected solution would open a contact or translate a disk
+    #: and a solution keeping every contact closed was followed instead (models/engine/closed.py)
+    closed_events: list = field(default_factory=list, repr=False)
+    closed_searched: int = field(default=0, repr=False)  # events where the search ran
 
     def __post_init__(self) -> None:
         self._rule = Selection.parse(self.select)  # InvalidSelection (a ValueError) naming RULES
@@ -95,10 +106,25 @@ class DenseBackend:
             if self._rule.rule in ("max-sum-R", "random"):
                 z, residual = self._other_rule(ep, z, residual, scale)
         es = ep.unpack(z)
+        note = ""
+        if self.closed_search and residual <= self.check_tol * scale and leaves_regime(
+                ep, es, residual):
+            self.closed_searched += 1
+            found = closed_solution(ep, scale, self.check_tol)
+            note = found.message
+            if found.status == "found":  # checked again by the engine's own acceptance
+                r = lcp.complementarity_residual(found.z, ep.lcp.M @ found.z + ep.lcp.q)
+                closed = ep.unpack(found.z)
+                if r <= self.check_tol * scale and not leaves_regime(ep, closed, r):
+                    self.closed_events.append(self._events - 1)
+                    z, residual, es = found.z, r, closed
+                else:
+                    note = (f"undecided: the closed solution found fails the engine's check "
+                            f"(residual {r:.3g}, max a_n {closed.a_n.max(initial=0):.3g})")
         self._prev = es
         return Outcome("solved", sol.method, R=es.R, S=es.S, omega_dot=es.omega_dot,
                        a_n=es.a_n, a_t=es.a_t, residual=residual, scale=scale,
-                       iterations=sol.iterations, n_lcp=z.size, fallback=fell_back)
+                       iterations=sol.iterations, n_lcp=z.size, fallback=fell_back, note=note)
 
     def _solve_lcp(self, ep: EventProblem, state: State) -> tuple[lcp.Solution, bool]:
         options = {}
@@ -148,6 +174,30 @@ class DenseBackend:
             return z0, r0
         self.capped += status == "capped"
         return y, r
+
+
+def leaves_regime(ep: EventProblem, es: EventSolution, residual: float) -> bool:
+    """Whether the solution es would stop the run (models/engine/loop.py's `_detached` and
+    `_translating`, same thresholds): a contact opens, or a disk translates."""
+    tol_a = acceleration_tol(ep.system)
+    if np.any(es.a_n > max(tol_a, 10 * residual)):
+        return True
+    size = np.hypot(*es.trans_acc.reshape(2, ep.system.p))
+    return bool(np.any(size > max(TRANSLATION_FACTOR * tol_a, 10 * residual)))
+
+
+def closed_note(backend, run):
+    """Say in run.closed and run.message at which events a closed solution was followed
+    instead of a selected one that would have opened a contact (models/engine/closed.py)."""
+    if isinstance(backend, DenseBackend):
+        run.closed = {"search": backend.closed_search, "searched": backend.closed_searched,
+                      "followed": list(backend.closed_events)}
+        if backend.closed_events:
+            ev = backend.closed_events
+            shown = ", ".join(str(e) for e in ev[:10]) + (", ..." if len(ev) > 10 else "")
+            run.message += (f"; at {len(ev)} event(s) ({shown}) the selected solution would "
+                            "open a contact and one keeping every contact closed was followed")
+    return run
 
 
 def selection_note(backend, run):

@@ -71,6 +71,7 @@ class Outcome:
     iterations: int = 0
     n_lcp: int = 0
     fallback: bool = False
+    note: str = ""  # the closed-solution search's verdict when it ran (models/engine/closed.py)
 
 
 class Backend(Protocol):
@@ -158,7 +159,7 @@ def _detached(run: Run, state: State, out: Outcome, tol_a: float) -> bool:
     names = "; ".join(f"{run.system.lattice.label(a)} (a_n = {out.a_n[a]:.3g})"
                       for a in opening[:5])
     run.message = (f"t = {state.t:.6g}: contact(s) would open, the no-displacement regime "
-                   f"ends: {names}")
+                   f"ends: {names}" + (f"; {out.note}" if out.note else ""))
     return True
 
 
@@ -180,7 +181,7 @@ def _translating(run: Run, state: State, out: Outcome, dyn: Dynamics, tol_a: flo
     run.status, run.contacts = "detachment", []
     names = "; ".join(f"disk {k} (|v'| = {size[k]:.3g})" for k in moving[:5])
     run.message = (f"t = {state.t:.6g}: disk(s) would translate with every contact closed, the "
-                   f"no-displacement regime ends: {names}")
+                   f"no-displacement regime ends: {names}" + (f"; {out.note}" if out.note else ""))
     return True
 
 

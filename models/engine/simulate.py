@@ -12,7 +12,7 @@ from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, initial_state
 from rigidlcp.models.system import System
 
-from .dense import DenseBackend, selection_note
+from .dense import DenseBackend, closed_note, selection_note
 from .loop import Limits, blas_limit, run_events
 from .records import Run
 
@@ -36,6 +36,7 @@ def simulate(
     fallback: str | None = "lemke",
     blas_threads: int | None = 1,
     selection: str | None = None,
+    closed_search: bool = True,
 ) -> Run:
     """Evolve `system` from `state` (or from omega / a seed) event by event (Sec. II C, IV).
 
@@ -55,16 +56,25 @@ def simulate(
     with the run after each event (None or False: not called). blas_threads: BLAS threads
     during the run (the event problems are small dense matrices, for which one thread is
     fastest, and much faster on a loaded machine); None leaves BLAS alone.
+
+    closed_search (dense backend): when an event's selected solution would open a contact or
+    translate a disk, look for a solution of the same event keeping every contact closed and
+    follow it, or prove there is none (models/engine/closed.py); run.closed lists the events
+    where one was followed. It runs only where the run would otherwise stop, so a run that
+    never detaches is the same bit for bit with or without it.
     """
     select = _one_rule(select, selection)
     backend = _backend(system, method, select, fallback, warm_start, dump_dir, check_tol)
+    if isinstance(backend, DenseBackend):
+        backend.closed_search = bool(closed_search)
     if state is None:
         state = initial_state(system, omega=omega, seed=seed)
     limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
     if progress is True or progress is False:
         progress = None if progress is False else _print_progress
     with blas_limit(blas_threads):
-        return selection_note(backend, run_events(system, state, backend, limits, progress or None))
+        run = run_events(system, state, backend, limits, progress or None)
+    return selection_note(backend, closed_note(backend, run))
 
 
 def _backend(system: System, method: str, select: str, fallback: str | None, warm_start: bool,

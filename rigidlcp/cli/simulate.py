@@ -134,6 +134,10 @@ def register(sub) -> None:
                    help="the point followed where an event's solution is not unique: "
                    "face-min-norm (default), max-sum-R[:CAP], random:SEED, global, none "
                    "(docs/integrators.md)")
+    g.add_argument("--no-closed-search", dest="closed_search", action="store_false",
+                   help="stop at the first selected solution that opens a contact, without "
+                   "looking for one of the same event that keeps every contact closed "
+                   "(docs/packings.md)")
     g.add_argument("--t-max", type=float, default=np.inf,
                    help="stop at this time (> 0; default: no limit)")
     g.add_argument("--max-events", type=int, default=100_000,
@@ -213,7 +217,7 @@ def cmd_simulate(args) -> int:
 
     run = simulate(system, state, method=args.method, t_max=args.t_max,
                    max_events=args.max_events, progress=progress, dump_dir=args.dump_problems,
-                   select=args.select, fallback=fallback)
+                   select=args.select, fallback=fallback, closed_search=args.closed_search)
     if bar is not None:
         bar.close()
     if args.out:
@@ -225,6 +229,8 @@ def cmd_simulate(args) -> int:
     if run.status == "detachment" and run.final is not None:
         summary["detachment_check"] = detachment_check(system, run.final)
     summary["selection"] = args.select
+    if run.closed is not None:
+        summary["closed_search"] = closed_summary(run)
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
@@ -235,6 +241,8 @@ def cmd_simulate(args) -> int:
         rows = [("status", run.status), ("message", run.message)]
         if "detachment_check" in summary:
             rows.append(("detachment check", summary["detachment_check"]))
+        if "closed_search" in summary:
+            rows.append(("closed search", closed_text(summary["closed_search"])))
         rows += [("events", run.n_events),
                 ("wall time (s)", f"{run.wall_time:.3f}"), ("method", run.method)]
         if run.records:
@@ -278,6 +286,31 @@ def same_state(status: str, what: str) -> str:
     return f"  ({what}, at the same selected state)" if status == "steady" else ""
 
 
+def closed_summary(run) -> dict:
+    """The closed-solution search of the run (models/engine/closed.py) for the JSON: on or off,
+    at how many events it ran, the events where a closed solution was followed, and its
+    verdict at the stop ("proved", "undecided") when the run ends in a detachment."""
+    out = dict(run.closed)
+    verdict = None
+    if run.status == "detachment" and run.closed.get("search"):
+        verdict = ("proved" if "proved: no solution of the event" in run.message
+                   else "undecided" if "undecided" in run.message else None)
+    out["at_stop"] = verdict
+    return out
+
+
+def closed_text(c: dict) -> str:
+    """One line of the summary for `closed_summary`."""
+    if not c["search"]:
+        return "off (--no-closed-search)"
+    text = f"on: ran at {c['searched']} event(s); a closed solution followed at " + (
+        "event(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
+        else "no event")
+    if c["at_stop"]:
+        text += f"; at the stop: {c['at_stop']} (message)"
+    return text
+
+
 def title(lat) -> str:
     """"rect 10x4" for an array, "packing" for any other set of disks (whose lx, ly are only a
     box estimate)."""
@@ -294,9 +327,10 @@ def detachment_check(system, state) -> str:
     if r.exists is False:
         return "proved: " + r.text()
     if r.exists:
-        return ("not forced: forces that keep every disk in place exist at this event (checked "
-                "witness); the selected solution of the event's LCP opens a contact anyway "
-                "(another --selection may keep it closed)")
+        return ("not forced for the translations: forces that keep every disk in place exist "
+                "at this event (checked witness, without the candidates' tangential laws); "
+                "whether a solution of the event's LCP keeps every contact closed is the "
+                "closed search's verdict (message)")
     return r.text()
 
 

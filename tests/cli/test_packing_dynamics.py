@@ -80,6 +80,26 @@ def test_simulate_says_the_detachment_is_forced(tmp_path, capsys):
     summary = json.loads(capsys.readouterr().out)
     assert summary["status"] == "detachment"
     assert summary["detachment_check"].startswith("proved: ")
+    assert summary["closed_search"] == {"search": True, "searched": 1, "followed": [],
+                                        "at_stop": "proved"}
+    assert main(["simulate", "--packing", str(pile), "--no-progress", "--json",
+                 "--no-closed-search"]) == 1
+    off = json.loads(capsys.readouterr().out)
+    assert off["closed_search"] == {"search": False, "searched": 0, "followed": [],
+                                    "at_stop": None}
+    assert off["message"] in summary["message"] and "proved: no solution" not in off["message"]
+
+
+def test_simulate_follows_a_closed_solution(tmp_path, capsys):
+    """The 12-disk pile at rest with mu = 0.5 (tests/models/engine/test_closed.py): steady,
+    the summary naming the event where a closed solution was followed."""
+    pile = write_packing(tmp_path / "pile.csv", deposit(12, seed=2, radii=(0.8, 1.2),
+                                                         width=6.0))
+    args = ["simulate", "--packing", str(pile), "--no-progress", "--omega-scale", "0",
+            "--mu-pp", "0.5", "--mu-plane", "0.5", "--mu-wall", "0.5"]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "steady" in out and "a closed solution followed at event(s) 0" in out
 
 
 def test_ranges_of_an_equal_radii_packing_run_are_the_arrays(tmp_path, capsys):

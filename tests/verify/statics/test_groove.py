@@ -72,7 +72,8 @@ def test_groove_statics_by_hand(mu):
 def test_groove_dynamics_by_hand(mu):
     """(From mu = 0.4 on, the top disk pushes the lower left one hard enough that the event's
     selected solution lets it leave the wall, although forces holding every translation exist:
-    the regime check calls that detachment "not forced"; docs/packings.md.)"""
+    the regime check, which leaves out the candidates' tangential laws, cannot call that
+    detachment forced; the closed search proves it is: test_groove_closed_search_by_hand.)"""
     system = _groove(mu)
     state = models.initial_state(system, omega=np.array([0.0, 0.0, 1.0]))
     a1, a2 = _top_contacts(system.lattice)
@@ -105,3 +106,77 @@ def test_groove_event_ranges_over_every_solution():
     top = er.every["alpha[2]"]
     assert top.lo.status == top.hi.status == "optimal"
     assert abs(top.lo.value - want) <= 1e-9 and abs(top.hi.value - want) <= 1e-9
+
+
+def _closed_by_hand(mu: float) -> dict:
+    """The closed solution of least sum R of the spinning groove's event, by hand (mu <= 1/3).
+
+    The top disk's R1, R2 are fixed by its translation (module doc), S_k = mu R_k, and
+    omega'_top = -2 mu (R1 + R2). Lower left disk (plane p, left wall L; a = R1 (0.6 - 0.8 mu),
+    s1 = mu R1, b = 1 + R1 (0.8 + 0.6 mu)), at rest with every contact closed: x: R_L = S_p + a;
+    y: R_p + S_L = b; torque (I omega'): -S_p - S_L - s1. Its plane and wall contacts are
+    candidates with a_t = -omega' (mu = 1). Sticking (omega' = 0): S_L = -s1 - S_p and
+    |S_L| <= R_L needs s1 <= a, i.e. mu <= 1/3, and S_p >= -(s1 + a) / 2; sum R = R_p + R_L =
+    b + s1 + a + 2 S_p is least at S_p = -(s1 + a) / 2: R_L = S_L = (a - s1) / 2,
+    R_p = b - R_L. Rolling with omega' < 0 (S = -R at both: a_t > 0): x gives R_p + R_L = a,
+    y gives R_p - R_L = b > a, so R_L < 0; with omega' > 0 (S = +R at both) the torque is
+    -R_p - R_L - s1 < 0: neither exists, so for mu > 1/3 no closed solution does.
+    Lower right disk (plane p', right wall W, a' = 0.6 R2 + 0.8 s2, s2 = mu R2): x: R_W =
+    a' - S_p'; y: R_p' = 1 + 0.8 R2 - 0.6 s2 + S_W; sticking, S_W = -s2 - S_p', and sum R =
+    const - 2 S_p' is least at the largest S_p' that |S_W| <= R_W (S_p' <= (a' - s2) / 2) and
+    |S_p'| <= R_p' (S_p' <= (1 + 0.8 R2 - 1.6 s2) / 2) allow."""
+    ratio = (0.6 + 0.8 * mu) / (0.6 - 0.8 * mu)
+    R2 = 1.0 / (ratio * (0.8 + 0.6 * mu) + 0.8 - 0.6 * mu)
+    R1 = ratio * R2
+    s1, s2 = mu * R1, mu * R2
+    a, b = R1 * (0.6 - 0.8 * mu), 1.0 + R1 * (0.8 + 0.6 * mu)
+    R_L = (a - s1) / 2
+    a2 = 0.6 * R2 + 0.8 * s2
+    S_p2 = min((a2 - s2) / 2, (1 + 0.8 * R2 - 1.6 * s2) / 2)
+    S_W = -s2 - S_p2
+    return {"R1": R1, "R2": R2, "S1": s1, "S2": s2, "R_L": R_L, "S_L": R_L, "R_p": b - R_L,
+            "S_p": -(s1 + a) / 2, "R_W": a2 - S_p2, "S_W": S_W,
+            "R_p2": 1 + 0.8 * R2 - 0.6 * s2 + S_W, "S_p2": S_p2,
+            "omega_dot": [0.0, 0.0, -2 * mu * (R1 + R2)]}
+
+
+@pytest.mark.parametrize("mu", [0.2, 0.3])
+def test_groove_closed_solution_followed_by_hand(mu, monkeypatch):
+    """Up to mu = 1/3 a closed solution exists; with the engine told that its selected solution
+    leaves the regime, the run follows the closed solution of least sum R: by hand."""
+    import rigidlcp.models.engine.dense as dense
+
+    calls, real = [], dense.leaves_regime
+
+    def selected_leaves(*args):  # the selected solution "leaves"; the closed one is checked
+        calls.append(1)
+        return len(calls) == 1 or real(*args)
+
+    monkeypatch.setattr(dense, "leaves_regime", selected_leaves)
+    system = _groove(mu)
+    lat = system.lattice
+    state = models.initial_state(system, omega=np.array([0.0, 0.0, 1.0]))
+    run = models.simulate(system, state, max_events=1)
+    assert run.closed["followed"] == [0]
+    rec, want = run.records[0], _closed_by_hand(mu)
+
+    def at(i, j):
+        return int(np.flatnonzero((lat.i == i) & (lat.j == j))[0])
+
+    for key, alpha in (("1", at(0, 2)), ("2", at(1, 2)), ("_L", at(0, -1)), ("_p", at(0, -3)),
+                       ("_W", at(1, -2)), ("_p2", at(1, -3))):
+        assert abs(rec.R[alpha] - want["R" + key]) <= 1e-10, key
+        assert abs(rec.S[alpha] - want["S" + key]) <= 1e-10, key
+    np.testing.assert_allclose(rec.omega_dot, want["omega_dot"], rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("mu", [0.4, 0.5])
+def test_groove_closed_search_by_hand(mu):
+    """From mu > 1/3 no solution of the event keeps the lower left disk at the wall (the
+    sticking one needs mu <= 1/3, neither rolling one exists: _closed_by_hand): the detachment
+    the selected solution shows is forced by the LCP itself, and the search proves it."""
+    system = _groove(mu)
+    state = models.initial_state(system, omega=np.array([0.0, 0.0, 1.0]))
+    run = models.simulate(system, state, max_events=1)
+    assert run.status == "detachment" and run.closed["followed"] == []
+    assert "proved: no solution of the event keeps every contact closed" in run.message
