@@ -62,8 +62,8 @@ class NoVelocityBound(RigidLCPError, ValueError):
 
 def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
     """(T_u, T_V, OMEGA): v_t = T_u u + T_V V with u_i = r_i omega_i (each disk's own radius:
-    unequal radii keep the unit forms, v_t = -(r_i omega_i + r_j omega_j) = -(u_i + u_j)), and a box |u|, |V| <= OMEGA that
-    contains a solution of every feasible system of sign conditions on v_t.
+    unequal radii keep the unit forms, v_t = -(r_i omega_i + r_j omega_j) = -(u_i + u_j)), and
+    a box |u|, |V| <= OMEGA that contains a solution of every feasible system of sign conditions on v_t.
 
     Proof: each row of (T_u, T_V) has at most two nonzero entries, each +-1 (checked here;
     models.dynamics: plane -V - u_i, disks -(u_i + u_j), wall -u_i). The conditions v_t = 0,
@@ -172,8 +172,8 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
               ) -> Formulation:
     """The MILP of the module docstring (no objective), in sparse form: the translational
     force balance per disk (no translation; with it a_n = 0 on every contact, checked below),
-    the torque balance I_i alpha_i = -r_i sum S written for ra_i = r_i alpha_i (per disk), and a_t = T_u ra + T_V gamma
-    (the same two-variable form as v_t)."""
+    the torque balance I_i alpha_i = -r_i sum S written for ra_i = r_i alpha_i (per disk), and
+    a_t = T_u ra + T_V gamma (the same two-variable form as v_t)."""
     dyn = Dynamics(system)
     c, p, mu = system.c, system.p, system.mu
     r = system.lattice.radii
