@@ -63,7 +63,8 @@ class NoVelocityBound(RigidLCPError, ValueError):
 def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
     """(T_u, T_V, OMEGA): v_t = T_u u + T_V V with u_i = r_i omega_i (each disk's own radius:
     unequal radii keep the unit forms, v_t = -(r_i omega_i + r_j omega_j) = -(u_i + u_j)), and
-    a box |u|, |V| <= OMEGA that contains a solution of every feasible system of sign conditions on v_t.
+    a box |u|, |V| <= OMEGA that contains a solution of every feasible system of sign
+    conditions on v_t.
 
     Proof: each row of (T_u, T_V) has at most two nonzero entries, each +-1 (checked here;
     models.dynamics: plane -V - u_i, disks -(u_i + u_j), wall -u_i). The conditions v_t = 0,
