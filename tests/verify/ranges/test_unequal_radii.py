@@ -29,6 +29,8 @@ import itertools
 
 import numpy as np
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from rigidlcp import models
@@ -184,3 +186,27 @@ def test_brute_force_over_sign_patterns_of_a_t(n, seed):
             if end.witness is not None:
                 w = end.witness
                 assert steady_check(system, w.omega, w.V, w.R, w.S)[0] <= 1e-9, name
+
+
+@settings(max_examples=6, deadline=None)
+@given(n=st.integers(3, 6), seed=st.integers(0, 40), mu=st.sampled_from([0.1, 0.2]))
+def test_seeded_unequal_radii_piles_that_reach_a_steady_state(n, seed, mu):
+    """Every decided end's witness is a valid steady state; the run's own mu_g lies in the
+    range (its state is one of them)."""
+    pile = deposit(n, seed=seed, radii=(0.8, 1.2), width=2.0 * n)
+    system = models.System(pile, mu_pp=mu, mu_plane=mu, mu_wall=mu, gamma=0.1)
+    run = models.simulate(system, seed=1)
+    assume(run.status == "steady")
+    res = steady_ranges(run, which="alpha", time_limit=20)
+    for name, r in res.ranges.items():
+        for e in (r.lo, r.hi):
+            assert e.status in ("optimal", "unbounded", "time limit"), (name, e.status)
+            if e.witness is not None:
+                w = e.witness
+                assert steady_check(system, w.omega, w.V, w.R, w.S)[0] <= 1e-9, name
+    mg = res.ranges["mu_g"]
+    tol = 1e-9 * max(1.0, abs(res.run_values["mu_g"]))
+    if mg.lo.status == "optimal":
+        assert mg.lo.value <= res.run_values["mu_g"] + tol
+    if mg.hi.status == "optimal":
+        assert res.run_values["mu_g"] <= mg.hi.value + tol
