@@ -107,6 +107,7 @@ def test_ranges_of_an_equal_radii_packing_run_are_the_arrays(tmp_path, capsys):
     lat, pack = out["lattice"]["steady"], out["packing"]["steady"]
     assert lat["status"]["mu_g"] == pack["status"]["mu_g"] == ["optimal", "optimal"]
     assert np.allclose(lat["mu_g"], pack["mu_g"], rtol=1e-9, atol=1e-12)
+    assert lat["mu_g"] == pack["mu_g"]  # bit for bit: per-disk radii all equal r
     assert np.allclose(lat["own_states"]["mu_g"], pack["own_states"]["mu_g"], rtol=1e-9)
 
 
