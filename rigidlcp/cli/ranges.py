@@ -54,15 +54,13 @@ def cmd_ranges(args: argparse.Namespace) -> int:
         raise InvalidInput(f"{args.run}: the run ended {run.status!r} ({run.message}), not in "
                            "a steady state: `rigidlcp ranges` needs a run that reached one "
                            "(rerun `rigidlcp simulate` with a larger --t-max or --max-events)")
-    r = run.system.lattice.radii
-    if run.status == "steady" and float(r.max()) == float(r.min()):
-        _warn_long(run.system, args)  # else refused in one line below, without the note
+    _warn_long(run.system, args)
     try:
         result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
                                box=args.box, split=True if args.deep is None else args.deep)
     except NoVelocityBound as exc:
-        raise NoVelocityBound(f"{args.run}: {unit_forms_note(run.system.lattice)} ({exc})"
-                              ) from None
+        raise NoVelocityBound(f"{args.run}: the ranges over all valid steady states do not "
+                              f"handle this system ({exc})") from None
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
@@ -91,14 +89,3 @@ def _warn_long(system, args: argparse.Namespace) -> None:
           f"up to about {span}; `--observables mu_g` for mu_g alone, --time-limit S to stop "
           "each end sooner", file=sys.stderr, flush=True)
 
-
-def unit_forms_note(lattice) -> str:
-    """Why the steady ranges refuse a system: they need every tangential velocity of the form
-    +-u_i +- u_j with u = r omega, which unequal radii break (v_t = -(r_i omega_i + r_j omega_j)
-    between two disks, docs/mechanics.md)."""
-    r = lattice.radii
-    if r.size and float(r.max()) != float(r.min()):
-        return (f"the ranges over all valid steady states need equal radii (v_t = +-u_i +- u_j, "
-                f"u = r omega); this packing's radii span {r.min():.6g} to {r.max():.6g}, so a "
-                "disk-disk contact has v_t = -(r_i omega_i + r_j omega_j): not handled")
-    return "the ranges over all valid steady states do not handle this system"

@@ -66,11 +66,21 @@ def test_nullspace_packing_bad_file_one_line(tmp_path, capsys):
     assert err.count("\n") == 1 and "bad.csv" in err
 
 
-def test_ranges_refuses_unequal_radii_in_one_line(pile_run, capsys):
-    _, path, _ = pile_run
-    assert main(["ranges", str(path)]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "equal radii" in err and "r_i omega_i" in err
+def test_ranges_of_an_unequal_radii_pile(pile_run, capsys):
+    """radii 0.8:1.2 (u_i = r_i omega_i keeps the unit forms): both ends of mu_g decided, the
+    run's own mu_g inside, each witness a valid steady state (verify.ranges.steady_check)."""
+    from rigidlcp.verify.ranges.witness import steady_check
+
+    run, path, _ = pile_run
+    assert main(["ranges", str(path), "--observables", "mu_g", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)["steady"]
+    assert out["status"]["mu_g"] == ["optimal", "optimal"]
+    lo, hi = out["mu_g"]
+    assert lo - 1e-9 <= out["run"]["mu_g"] <= hi + 1e-9 and lo < hi
+    for w in out["witnesses"].values():
+        res, _ = steady_check(run.system, np.array(w["omega"]), w["V"], np.array(w["R"]),
+                              np.array(w["S"]))
+        assert res <= 1e-9
 
 
 def test_simulate_says_the_detachment_is_forced(tmp_path, capsys):
@@ -117,6 +127,7 @@ def test_ranges_of_an_equal_radii_packing_run_are_the_arrays(tmp_path, capsys):
     lat, pack = out["lattice"]["steady"], out["packing"]["steady"]
     assert lat["status"]["mu_g"] == pack["status"]["mu_g"] == ["optimal", "optimal"]
     assert np.allclose(lat["mu_g"], pack["mu_g"], rtol=1e-9, atol=1e-12)
+    assert lat["mu_g"] == pack["mu_g"]  # bit for bit: per-disk radii all equal r
     assert np.allclose(lat["own_states"]["mu_g"], pack["own_states"]["mu_g"], rtol=1e-9)
 
 

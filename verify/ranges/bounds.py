@@ -168,8 +168,9 @@ def rotation_cap(system: System, dyn: Dynamics) -> float | None:
     """M* with |r alpha_i| <= M* for every disk in every valid steady state (a discrete
     maximum principle), or None when the contact geometry is not of the form it needs.
 
-    With no translation, a_t = T_u ra + b (ra = r alpha; b = u_obs'_t, gamma's part) and, by
-    the torque balance, ra = D T_u^T S with D = diag(r^2 / I) > 0 (verify.ranges.steady). It
+    With no translation, a_t = T_u ra + b (ra_i = r_i alpha_i, each disk's own radius;
+    b = u_obs'_t, gamma's part) and, by the torque balance, ra = D T_u^T S with
+    D = diag(r_i^2 / I_i) > 0 (verify.ranges.steady). It
     needs: every frictional row of T_u has at most two nonzero entries, all of one sign
     eps_beta (disk-disk -(u_i + u_j), plane -V - u_i, wall -u_i), and b_beta = 0 on the
     two-disk rows; then M* = max |b_beta| over the one-disk frictional rows (gamma here).
@@ -185,7 +186,7 @@ def rotation_cap(system: System, dyn: Dynamics) -> float | None:
     contact has |b| <= M* < M, so again sgn a_t = eps_beta sigma_i and the term is <= 0. So
     Phi <= 0: a contradiction. Hence max |ra_i| <= M*.
     """
-    c, p, r = system.c, system.p, system.lattice.radius
+    c, p, r = system.c, system.p, system.lattice.radii
     H = dyn.H.toarray()
     if np.any(H[:c, 2 * p:] != 0):  # a normal row with rotation: not ra = D T_u^T S
         return None
@@ -212,7 +213,7 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
     r alpha unbounded over P, self-stresses not of disjoint nonnegative support, a difference
     d_a unbounded). E x = e: a_n = 0 and no translation (verify.ranges.steady)."""
     c, p, mu = system.c, system.p, system.mu
-    r = system.lattice.radius
+    r = system.lattice.radii
     HT = dyn.H.T.toarray()
     Lra = (r * dyn.Minv[2 * p:])[:, None] * HT[2 * p:]
     m_star = rotation_cap(system, dyn)
@@ -250,7 +251,8 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
         # Power: nu'^T M nu' = nu'^T (H^T lambda + f) with no translation gives
         # sum_i I_i alpha_i^2 = S . a_t - u_obs'^T lambda, and S . a_t <= 0 on every valid
         # steady state (sliding: S = -s mu R, s a_t >= 0; non-sliding: a_t = 0; frictionless:
-        # S = 0), so I_i alpha_i^2 <= max over P of (-u_obs'^T lambda) (= gamma F_g at most).
+        # S = 0), so I_i alpha_i^2 <= max over P of (-u_obs'^T lambda) (= gamma F_g at most), and
+        # |r_i alpha_i| <= r_i sqrt(max / I_i) with each disk's r_i and I_i.
         ext = P.extreme(-np.asarray(dyn.u_obs_dot, float))
         if ext is not None and np.isfinite(ext[1]):
             I_rot = 1.0 / dyn.Minv[2 * p:]

@@ -92,7 +92,7 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
 
     t0 = time.perf_counter()
     system, dyn = form.system, form.dyn
-    c, p, mu, r = system.c, system.p, system.mu, system.lattice.radius
+    c, p, mu, r = system.c, system.p, system.mu, system.lattice.radii
     L = np.asarray(L, float)
     caps = cap_contacts(form)
     if caps is None or form.R_hi is None or not form.proved_for(L):
@@ -102,7 +102,7 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
         return None
     b = np.asarray(dyn.u_obs_dot, float)[c:]
     D = r * r * dyn.Minv[2 * p:]
-    ra = r * alpha_rows(system, dyn)  # r alpha = ra @ x
+    ra = r[:, None] * alpha_rows(system, dyn)  # r alpha = ra @ x
     E, e = _equalities(dyn)
     fr = np.flatnonzero(mu > 0)
     I2 = np.eye(2 * c)

@@ -117,7 +117,7 @@ class _Cases:
         import highspy
 
         system, dyn = form.system, form.dyn
-        c, p, mu, r = system.c, system.p, system.mu, system.lattice.radius
+        c, p, mu, r = system.c, system.p, system.mu, system.lattice.radii
         self.hs, self.c, self.p, self.M = highspy, c, p, M
         fr = self.fric = np.flatnonzero(mu > 0)
         F = fr.size
@@ -127,7 +127,7 @@ class _Cases:
         I2 = np.eye(2 * c)
         self.W = np.asarray(dyn.W)[c + fr]
         self.q = np.asarray(dyn.q, float)[c + fr]
-        ra = r * alpha_rows(system, dyn)
+        ra = r[:, None] * alpha_rows(system, dyn)
         D = r * r * dyn.Minv[2 * p:]
         # power cut: -u_obs' . lambda - sum_i z_i >= 0, z_i >= (2 t ra_i - t^2) / D_i
         pw = np.r_[-np.asarray(dyn.u_obs_dot, float), -np.ones(p)]

@@ -1,17 +1,16 @@
 """Which contact-state sets the velocities admit, decided combinatorially, and a short reason
 when they do not (a cut for verify.ranges.milp's lazy search).
 
-Every tangential velocity is v_t = +-x_i +- x_j in x = (r omega, V) (verify.ranges.steady.
-velocity_box checks it), so the conditions of the states s (s v_t >= 1 sliding, v_t = 0
-non-sliding; V as the formulation's V_mode) are unit two-variable inequalities
+Every tangential velocity is v_t = +-x_i +- x_j in x = (r omega, V), r_i each disk's own radius
+(verify.ranges.steady.velocity_box checks it), so the conditions of the states s (s v_t >= 1
+sliding, v_t = 0 non-sliding; V as the formulation's V_mode) are unit two-variable inequalities
 a_i x_i + a_j x_j <= b. Such a system is feasible iff its doubled constraint graph (a node for
 +x_k and one for -x_k; the inequality is the edge from the node of -a_j x_j to that of a_i x_i
 with weight b, and its mirror; a one-variable a x_i <= b is an edge of weight 2b) has no
-negative cycle (the UTVPI/octagon closure), and then x_k = (d(+x_k) - d(-x_k)) / 2 solves it,
-d the shortest-path distances from a source joined to every node by 0-weight edges. A negative
+negative cycle (the UTVPI/octagon closure), and then x_k = (d(+x_k) - d(-x_k)) / 2 solves it, d
+the shortest-path distances from a source joined to every node by 0-weight edges. A negative
 cycle names the contacts whose states cannot hold together: every valid steady state has
-another state on at least one of them.
-"""
+another state on at least one of them."""
 
 from __future__ import annotations
 

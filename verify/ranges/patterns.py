@@ -174,7 +174,7 @@ def values_of(system: System, wit: SteadyWitness) -> dict[str, np.ndarray]:
     """The literal kinds' values on a witness (states from its v_t, alpha from Newton-Euler)."""
     s = np.asarray(wit.s)
     return {"R": np.asarray(wit.R), "S": np.asarray(wit.S),
-            "ra": system.lattice.radius * np.asarray(wit.alpha),
+            "ra": system.lattice.radii * np.asarray(wit.alpha),
             "sl": (s != 0).astype(float), "y+": (s > 0).astype(float),
             "y-": (s < 0).astype(float)}
 
@@ -298,7 +298,7 @@ def _polish(ext: Formulation, x: np.ndarray) -> np.ndarray | None:
 
 def _witness(ext: Formulation, x: np.ndarray) -> SteadyWitness | None:
     system, c, pd = ext.system, ext.system.c, ext.system.p
-    r = system.lattice.radius
+    r = system.lattice.radii
     y = _polish(ext, x)
     if y is not None:
         u, V = y[2 * c + pd:2 * c + 2 * pd], float(y[2 * c + 2 * pd])

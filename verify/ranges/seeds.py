@@ -59,7 +59,7 @@ def seed_states(form: Formulation) -> list[np.ndarray]:
             u = spin * V
             if V == 0 and np.any(u):
                 continue
-            vt = dyn.velocities(u / system.lattice.radius, V)[system.c:]
+            vt = dyn.velocities(u / system.lattice.radii, V)[system.c:]
             s = np.where((system.mu > 0) & (np.abs(vt) > 1e-12), np.sign(vt), 0).astype(int)
             if any(np.array_equal(s, t) for t in out):
                 continue

@@ -1,7 +1,8 @@
 """Ranges of observables over every valid steady state of a system (docs/mechanics.md, "Valid
 steady states"), by one mixed-integer program per end (scipy.optimize.milp, i.e. HiGHS).
 
-Unknowns: the forces x = [R (c); S (c)], the velocities u = r omega (p) and V, and per frictional
+Unknowns: the forces x = [R (c); S (c)], the velocities u = r omega (p, u_i = r_i omega_i with
+each disk's own radius) and V, and per frictional
 contact two binaries (y+, y-), y0 = 1 - y+ - y- (sliding with v_t > 0, v_t < 0, non-sliding).
 With a = W x + q (models.dynamics) and v = the tangential relative velocities of (omega, V):
 
@@ -55,13 +56,15 @@ class NotSteady(RigidLCPError, ValueError):
 
 
 class NoVelocityBound(RigidLCPError, ValueError):
-    """The tangential velocities are not two-variable unit forms (translating disks, unequal
-    radii): the velocity box of `velocity_box` is not proved."""
+    """The tangential velocities are not two-variable unit forms in u = r omega (e.g. a normal
+    row with a rotation): the velocity box of `velocity_box` is not proved."""
 
 
 def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
-    """(T_u, T_V, OMEGA): v_t = T_u u + T_V V with u = r omega, and a box |u|, |V| <= OMEGA that
-    contains a solution of every feasible system of sign conditions on v_t.
+    """(T_u, T_V, OMEGA): v_t = T_u u + T_V V with u_i = r_i omega_i (each disk's own radius:
+    unequal radii keep the unit forms, v_t = -(r_i omega_i + r_j omega_j) = -(u_i + u_j)), and
+    a box |u|, |V| <= OMEGA that contains a solution of every feasible system of sign
+    conditions on v_t.
 
     Proof: each row of (T_u, T_V) has at most two nonzero entries, each +-1 (checked here;
     models.dynamics: plane -V - u_i, disks -(u_i + u_j), wall -u_i). The conditions v_t = 0,
@@ -73,7 +76,7 @@ def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
     closure). Edge weights are >= -2 and simple paths have <= 2N - 1 edges, so
     -2 (2N - 1) <= d <= 0 and |x_i| <= 2N - 1 < OMEGA = 2N.
     """
-    p, c, r = dyn.p, dyn.c, dyn.system.lattice.radius
+    p, c, r = dyn.p, dyn.c, dyn.system.lattice.radii
     Ht = dyn.H[c:].toarray()
     T_u = Ht[:, 2 * p:] / r
     T_V = dyn.u_obs(1.0)[c:]
@@ -88,7 +91,7 @@ def velocity_box(dyn: Dynamics) -> tuple[np.ndarray, np.ndarray, float]:
 @dataclass
 class Formulation:
     """The MILP's constraint matrix and bounds; columns x = [R, S] (2c) | ra = r alpha (p) |
-    u = r omega (p) | V | y+ (F) | y- (F), F = the frictional contacts."""
+    u = r omega (p, per-disk r_i) | V | y+ (F) | y- (F), F = the frictional contacts."""
 
     system: System
     dyn: Dynamics
@@ -125,7 +128,7 @@ class Formulation:
         """A full column vector for a known state (a MIP start), velocities scaled into the
         normalization (min sliding |v_t| = 1)."""
         sys_, c, p = self.system, self.system.c, self.system.p
-        r = sys_.lattice.radius
+        r = sys_.lattice.radii
         x = np.concatenate([R, S])
         ra = r * self.dyn.accelerations(x)[2 * p:]
         vt = self.dyn.velocities(omega, V)[c:]
@@ -170,11 +173,11 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
               ) -> Formulation:
     """The MILP of the module docstring (no objective), in sparse form: the translational
     force balance per disk (no translation; with it a_n = 0 on every contact, checked below),
-    the torque balance I alpha = -r sum S written for ra = r alpha, and a_t = T_u ra + T_V gamma
-    (the same two-variable form as v_t)."""
+    the torque balance I_i alpha_i = -r_i sum S written for ra_i = r_i alpha_i (per disk), and
+    a_t = T_u ra + T_V gamma (the same two-variable form as v_t)."""
     dyn = Dynamics(system)
     c, p, mu = system.c, system.p, system.mu
-    r = system.lattice.radius
+    r = system.lattice.radii
     fric = np.flatnonzero(mu > 0)
     F = fric.size
     T_u, T_V, OMEGA = velocity_box(dyn)
@@ -225,7 +228,7 @@ def formulate(system: System, box: float | None = None, V_mode: str | None = Non
         add(cols({iR: Mu, iS: sgn * Ef, ycol: sp.diags(big)}, F), -np.inf, big)
     if fb is not None:
         ra_lo, ra_hi = fb.ra_lo, fb.ra_hi
-    else:  # |ra_i| <= r^2 / I sum_{contacts of i} mu U over the force box
+    else:  # |ra_i| <= r_i^2 / I_i sum_{contacts of i} mu U over the force box
         touch = np.abs(HT[2 * p:].toarray())[:, c:] > 0
         ra_hi = r * dyn.Minv[2 * p:] * r * (touch @ (mu * U))
         ra_lo = -ra_hi
@@ -351,7 +354,7 @@ def state_velocities(form: Formulation, s: np.ndarray) -> tuple[np.ndarray, floa
     non-sliding; V as form.V_mode), or None when the kinematics admit no such velocities.
     With gamma = 0 and V0 != 0 the cone point is scaled to V = V0."""
     system, dyn = form.system, form.dyn
-    p, r = system.p, system.lattice.radius
+    p, r = system.p, system.lattice.radii
     T_u, T_V, OMEGA = velocity_box(dyn)
     T = np.column_stack([T_u, T_V])
     fr = form.fric

@@ -286,7 +286,7 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     else:
         vel = state_velocities(form, s)
     if vel is None:  # the LP disagrees: the shortest-path velocities, else the MILP's
-        r = form.system.lattice.radius
+        r = form.system.lattice.radii
         ok, xv = realizable(form, s)
         xv = xv if ok else xm[2 * c + p:2 * c + 2 * p + 1]
         vel = (np.asarray(xv[:p]) / r, float(xv[p]))
