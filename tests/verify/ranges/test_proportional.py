@@ -39,41 +39,12 @@ def _q_parts(system: models.System):
     return acc, a_rel, a0, np.flatnonzero(system.mu > 0)
 
 
-def _pattern_lp(system: models.System, sig: np.ndarray) -> dict:
-    """linprog's arguments over x = [R; S] for the a_t signs sig (+1: a_t >= 0, S = -mu R;
-    -1: a_t <= 0, S = +mu R; 0: a_t = 0, |S| <= mu R) on the frictional contacts, with no
-    translation, a_n = 0, R >= 0, S = 0 where mu = 0."""
-    c, p, mu = system.c, system.p, system.mu
-    acc, a_rel, a0, fr = _q_parts(system)
-    Minv_f = Dynamics(system).Minv * Dynamics(system).f
-    eq, eq_b = [acc[:2 * p], a_rel[:c]], [-Minv_f[:2 * p], -a0[:c]]
-    ub, ub_b = [], []
-    for k, al in enumerate(fr):
-        if sig[k]:
-            row = np.zeros(2 * c)
-            row[c + al], row[al] = 1.0, sig[k] * mu[al]
-            eq.append(row[None])
-            eq_b.append([0.0])
-            ub.append(-sig[k] * a_rel[c + al])
-            ub_b.append(sig[k] * a0[c + al])
-        else:
-            eq.append(a_rel[c + al][None])
-            eq_b.append([-a0[c + al]])
-            for sg in (1, -1):
-                row = np.zeros(2 * c)
-                row[c + al], row[al] = sg, -mu[al]
-                ub.append(row)
-                ub_b.append(0.0)
-    bounds = [(0, None)] * c + [(None, None) if m > 0 else (0, 0) for m in mu]
-    return dict(A_ub=np.array(ub) if ub else None, b_ub=ub_b if ub else None,
-                A_eq=np.vstack(eq), b_eq=np.concatenate(eq_b), bounds=bounds)
-
-
-def _brute(system: models.System, L: np.ndarray, sense: int) -> tuple[str, float]:
-    """("optimal", value) / ("unbounded", inf) of L x over Q: every a_t sign pattern."""
+def _brute(system: models.System, L: np.ndarray, sense: int, pattern_lp) -> tuple[str, float]:
+    """("optimal", value) / ("unbounded", inf) of L x over Q: every a_t sign pattern's LP
+    (conftest's pattern_lp)."""
     best = None
     for sig in itertools.product((1, -1, 0), repeat=_q_parts(system)[3].size):
-        r = linprog(sense * L, **_pattern_lp(system, np.array(sig)), method="highs",
+        r = linprog(sense * L, **pattern_lp(system, np.array(sig)), method="highs",
                     options={"primal_feasibility_tolerance": 1e-10})
         if r.status == 3:
             return "unbounded", np.inf
@@ -109,7 +80,7 @@ def _check_witness(system: models.System, w, V_ref: float | None = None) -> None
     (models.rectangular(2, 1), (0.3, 0.1, 0.0), -0.15),
     (models.rectangular(3, 1), (0.05, 0.1, 0.0), 0.02),
 ])
-def test_ranges_equal_brute_force_over_a_t_patterns(lattice, mu, gamma):
+def test_ranges_equal_brute_force_over_a_t_patterns(q_pattern_lp, lattice, mu, gamma):
     """mu_g and every alpha over all valid steady states (default kinematics: proportional)
     equal the extremes over every a_t sign pattern's LP, written here without velocities."""
     s = models.System(lattice, mu_pp=mu[0], mu_plane=mu[1], mu_wall=mu[2], gamma=gamma)
@@ -120,7 +91,7 @@ def test_ranges_equal_brute_force_over_a_t_patterns(lattice, mu, gamma):
     obs = {"mu_g": g} | {f"alpha[{i}]": row for i, row in enumerate(_alpha_rows(s))}
     for name, L in obs.items():
         for end, sense in ((res.ranges[name].lo, 1), (res.ranges[name].hi, -1)):
-            status, value = _brute(s, L, sense)
+            status, value = _brute(s, L, sense, q_pattern_lp)
             assert end.status == status, (name, end)
             if status == "optimal":
                 assert end.value == pytest.approx(value, abs=1e-9), name
@@ -145,7 +116,8 @@ def test_proportional_equals_lazy_kinematics(lattice, gamma):
             _check_witness(s, ea.witness)
 
 
-def _q_milp_value(system: models.System, L: np.ndarray, sense: int, U: float) -> float:
+def _q_milp_value(system: models.System, L: np.ndarray, sense: int, U: float,
+                  pattern_lp) -> float:
     """The extreme of L over Q with R <= U by an MILP written here (binaries per frictional
     contact: a_t >= 0 with S = -mu R, a_t <= 0 with S = +mu R, or a_t = 0), then the exact LP
     of its a_t pattern: the value."""
@@ -187,7 +159,7 @@ def _q_milp_value(system: models.System, L: np.ndarray, sense: int, U: float) ->
     assert res.status == 0
     y = np.round(res.x[2 * c:]).astype(int)
     sig = y[:F] - y[F:]
-    lp = _pattern_lp(system, sig)
+    lp = pattern_lp(system, sig)
     lp["bounds"] = [(0, U)] * c + list(lp["bounds"][c:])
     r = linprog(sense * L, **lp, method="highs",
                 options={"primal_feasibility_tolerance": 1e-10})
@@ -196,7 +168,7 @@ def _q_milp_value(system: models.System, L: np.ndarray, sense: int, U: float) ->
 
 
 @pytest.mark.parametrize("mu_pp, mu_plane, gamma", [(0.05, 0.1, 0.01), (0.1, 0.2, 0.02)])
-def test_rows_10x1_equal_an_milp_of_Q_written_here(mu_pp, mu_plane, gamma):
+def test_rows_10x1_equal_an_milp_of_Q_written_here(q_pattern_lp, mu_pp, mu_plane, gamma):
     """Fig. 11's 10x1 rows: mu_g and alpha_0, alpha_9 over all valid steady states equal the
     MILP of Q written here (forces boxed by U >= the proved bounds, which loses no extreme of
     an S-observable: docs/mechanics.md's self-stress reduction), and equal the lazy search."""
@@ -215,7 +187,8 @@ def test_rows_10x1_equal_an_milp_of_Q_written_here(mu_pp, mu_plane, gamma):
         for side, sense in (("lo", 1), ("hi", -1)):
             end = getattr(res.ranges[name], side)
             assert end.status == "optimal", (name, end)
-            assert end.value == pytest.approx(_q_milp_value(s, L, sense, U), abs=1e-9), name
+            assert end.value == pytest.approx(_q_milp_value(s, L, sense, U, q_pattern_lp),
+                                              abs=1e-9), name
             assert end.value == pytest.approx(getattr(lazy.ranges[name], side).value,
                                               abs=1e-9)
             _check_witness(s, end.witness)
@@ -251,7 +224,7 @@ def test_not_exact_at_constant_velocity():
 
 @given(gamma=st.floats(0.01, 0.6), mu_pp=st.floats(0.0, 0.5), mu_plane=st.floats(0.01, 0.5),
        lx=st.integers(1, 3))
-def test_every_point_of_Q_is_a_valid_steady_state(gamma, mu_pp, mu_plane, lx):
+def test_every_point_of_Q_is_a_valid_steady_state(q_pattern_lp, gamma, mu_pp, mu_plane, lx):
     """A random point of Q (an LP with a random objective over a random a_t pattern), moved
     at (alpha, gamma), passes steady_check: the reduction's direction (ii)."""
     s = models.System(models.rectangular(lx, 1), mu_pp=mu_pp, mu_plane=mu_plane, mu_wall=0.0,
@@ -260,7 +233,7 @@ def test_every_point_of_Q_is_a_valid_steady_state(gamma, mu_pp, mu_plane, lx):
     fr = _q_parts(s)[3]
     for _ in range(6):
         sig = rng.integers(-1, 2, fr.size)
-        lp = _pattern_lp(s, sig)
+        lp = q_pattern_lp(s, sig)
         lp["bounds"] = [(0, 50.0)] * s.c + list(lp["bounds"][s.c:])
         r = linprog(rng.normal(size=2 * s.c), **lp, method="highs",
                     options={"primal_feasibility_tolerance": 1e-10})

@@ -107,45 +107,18 @@ def test_steady_check_by_hand_on_two_disks():
     assert res_wrong > 1e-3
 
 
-def _brute_force(system: models.System, obs: dict[str, np.ndarray]
+def _brute_force(system: models.System, obs: dict[str, np.ndarray], pattern_lp
                  ) -> dict[str, tuple[float, float]]:
     """{name: (min, max)} of L . x over every sign pattern of a_t (+, -, 0 per frictional
-    contact): one feasibility LP each, then the extremes on the feasible ones, written here
-    from models.dynamics alone (a = W x + q): a_n = 0, no translation, R >= 0, |S| <= mu R,
-    S = 0 where mu = 0; pattern + : a_t >= 0, S = -mu R; - : a_t <= 0, S = +mu R;
-    0 : a_t = 0 (docs/mechanics.md, 'Through proportional velocities'). +-inf where some
-    pattern's LP is unbounded; (inf, -inf) when no pattern is feasible."""
-    dyn = Dynamics(system)
-    c, p, mu = system.c, system.p, system.mu
-    W, q = np.asarray(dyn.W), np.asarray(dyn.q, float)
-    HT = dyn.H.T.toarray()
-    eq0 = [W[:c], HT[:2 * p]]
-    rhs0 = [-q[:c], -dyn.f[:2 * p]]
-    fric = np.flatnonzero(mu > 0)
-    bounds = [(0, None)] * c + [(None, None) if m > 0 else (0, 0) for m in mu]
+    contact): one feasibility LP each, then the extremes on the feasible ones, each LP
+    conftest's pattern_lp (from models.dynamics alone: a_n = 0, no translation, R >= 0,
+    |S| <= mu R, S = 0 where mu = 0; pattern + : a_t >= 0, S = -mu R; - : a_t <= 0,
+    S = +mu R; 0 : a_t = 0; docs/mechanics.md, 'Through proportional velocities'). +-inf
+    where some pattern's LP is unbounded; (inf, -inf) when no pattern is feasible."""
+    c = system.c
     out = {name: (np.inf, -np.inf) for name in obs}
-    for pattern in itertools.product((1, -1, 0), repeat=fric.size):
-        eq, rhs, ub, ubr = list(eq0), list(rhs0), [], []
-        for a, sg in zip(fric, pattern):
-            row = np.zeros(2 * c)
-            if sg:
-                row[c + a], row[a] = 1.0, sg * mu[a]  # S + s mu R = 0
-                eq.append(row[None])
-                rhs.append([0.0])
-                ub.append(-sg * W[c + a])  # s a_t >= 0
-                ubr.append(sg * q[c + a])
-            else:
-                eq.append(W[c + a][None])
-                rhs.append([-q[c + a]])
-                for k in (1.0, -1.0):
-                    row = np.zeros(2 * c)
-                    row[c + a], row[a] = k, -mu[a]
-                    ub.append(row)
-                    ubr.append(0.0)
-        kw = dict(A_eq=np.vstack(eq), b_eq=np.concatenate([np.ravel(v) for v in rhs]),
-                  bounds=bounds, method="highs")
-        if ub:
-            kw.update(A_ub=np.array(ub), b_ub=np.array(ubr))
+    for pattern in itertools.product((1, -1, 0), repeat=int(np.count_nonzero(system.mu > 0))):
+        kw = dict(**pattern_lp(system, pattern), method="highs")
         if linprog(np.zeros(2 * c), **kw).status != 0:
             continue
         for name, L in obs.items():
@@ -161,7 +134,7 @@ def _brute_force(system: models.System, obs: dict[str, np.ndarray]
 
 @pytest.mark.parametrize("n, seed", [(3, 4), (3, 1), pytest.param(4, 1, marks=pytest.mark.slow),
                                      pytest.param(4, 2, marks=pytest.mark.slow)])
-def test_brute_force_over_sign_patterns_of_a_t(n, seed):
+def test_brute_force_over_sign_patterns_of_a_t(q_pattern_lp, n, seed):
     """gamma != 0 (the reduction is exact): steady_ranges against 3^F LPs; (3, 1) has no
     valid steady state by the brute force, and steady_ranges must say so (NotSteady)."""
     pile = deposit(n, seed=seed, radii=(0.7, 1.3), width=2.0 * n)
@@ -172,7 +145,7 @@ def test_brute_force_over_sign_patterns_of_a_t(n, seed):
     obs = {"mu_g": mu_g_vector(system)}
     rot = dyn.Minv[2 * system.p:, None] * dyn.H.T.toarray()[2 * system.p:]
     obs.update({f"alpha[{i}]": rot[i] for i in range(system.p)})
-    brute = _brute_force(system, obs)
+    brute = _brute_force(system, obs, q_pattern_lp)
     if brute["mu_g"][0] > brute["mu_g"][1]:  # no pattern feasible
         with pytest.raises(NotSteady):
             steady_ranges(system, which="alpha", time_limit=30)
