@@ -24,14 +24,20 @@ zero to the accuracy the forward error bound speaks of.)
 ended on one, else {i : v_i / v_s > w_i / s_i}; the system is K_PP y = -k_P over the rows and
 unknowns of u and v_P (v_i = 0 off P). Its solution, refined from the answer with residuals in
 extended precision (np.longdouble, "mixed precision" refinement, Higham 2002 Sec. 12.1), is the
-*polished* answer (for a method that ended on a basis; another answer is judged as it is,
-its bound adding its distance to that exact point); the bound is LAPACK's
+*polished* answer (for a method that ended on a basis; another answer is judged as it is).
+The bound, at the point y returned (the polished one, its v_P clipped at 0, or the answer as
+given, then + its largest v off P / |x|_inf), is LAPACK's (`forward_bound`)
 
     ferr = || |K_PP^-1| (|r| + gamma (|K_PP| |y| + |k_P|)) ||_inf / ||y||_inf + eps,
 
 r the (extended) residual, gamma = (m + 1) eps_ld: how far y may be from the exact solution of
-the pattern's system. A singular K_PP (a continuum of solutions) uses its pseudo-inverse at the
-numerical rank (distance to the nearest exact point), and an inconsistent one has ferr = inf.
+the pattern's system (y - y* = K_PP^-1 r exactly). |K_PP^-1| is formed column by column from an
+LU, never estimated (Hager's estimator, which LAPACK's xGERFS uses, is a lower bound of the norm:
+0.46x, and 2e-16x on a rank-deficient pattern, on cases tests/lcp/test_forward_bound.py and
+docs/performance.md record); one C function computes it for the C acceptance and for this code,
+so lcp.solve and verify.certify report the same number for the same answer and pattern. A
+singular K_PP (a continuum of solutions) uses its pseudo-inverse at the numerical rank (y's
+distance to the refined point added), and an inconsistent one has ferr = inf.
 
 **Accepted** iff berr <= TOL (lcp.residual.TOL = 1e-8) and ferr <= FERR_TOL. lcp.solve (and its
 fast paths, solve_many, the friction and unreduced-MLCP branches) and verify.certify use
