@@ -20,10 +20,13 @@ from hypothesis import strategies as st
 from rigidlcp import lcp
 from rigidlcp.lcp.acceptance.accuracy import FERR_TOL
 from rigidlcp.lcp.io.siconos import read_siconos_lcp
+from rigidlcp.lcp.io.siconos_mlcp import read_siconos_mlcp
+from rigidlcp.lcp.io.text import UnsupportedProblem
 from rigidlcp.verify import certify
 from rigidlcp.verify.strategies import degenerate_lcps, lcps, p_matrices, symmetric_psd
 
 SICONOS_LCP = Path("/work/shared/data/siconos/lcp")
+SICONOS_MLCP = Path("/work/shared/data/siconos/mlcp")
 EPS = float(np.finfo(float).eps)
 
 
@@ -146,3 +149,20 @@ def test_siconos_lcps_bounds_hold_and_certify_reports_the_same():
             sol = lcp.solve(P)
             if sol.status == "solved":
                 assert certify(P, sol, uniqueness="none").forward_error == sol.forward_error
+
+
+@pytest.mark.skipif(not SICONOS_MLCP.is_dir(), reason="Siconos's MLCP files are not here")
+def test_siconos_mlcps_certify_reports_the_bound_lcp_solve_reports():
+    """The unreduced-MLCP route (numpy `assess` on [A C; D B], polished) and verify.certify (the
+    answer as returned, not polished): one number, bit for bit, on every "solved"."""
+    solved = 0
+    for path in sorted(SICONOS_MLCP.glob("*.dat")):
+        try:
+            P = read_siconos_mlcp(path)
+        except UnsupportedProblem:
+            continue
+        sol = lcp.solve(P)
+        if sol.status == "solved":
+            solved += 1
+            assert certify(P, sol, uniqueness="none").forward_error == sol.forward_error
+    assert solved
