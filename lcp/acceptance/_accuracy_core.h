@@ -279,7 +279,7 @@ static int forward_bound(idx m, const double *K, const double *A, const idx *per
 static int assess_one(idx n, const double *M, const double *q, const double *z,
                       const int64_t *a, idx m, double *out, double *res)
 {
-    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
+    const double eps = DBL_EPSILON;
     double mmax = 0.0, qmax = 0.0, norm = 0.0;
     for (idx i = 0; i < n; i++) qmax = dmax(qmax, fabs(q[i]));
     for (idx i = 0; i < n; i++)
