@@ -3,7 +3,8 @@
  * numpy calls). The same steps as the numpy code: the componentwise backward error of z, the
  * pattern's system M_aa y = -q_a refined from z_a with residuals in long double (x86: 64-bit
  * mantissa, numpy's longdouble) on one LU factorization, LAPACK's forward error bound with
- * || |K^-1| g || estimated as xGERFS does (Hager's estimator: O(m^2) per step), and
+ * || |K^-1| g || computed from K^-1's columns (m solves on the LU: O(m^3), not Hager's
+ * estimate, which is a lower bound of it), and
  * the polished point kept when its backward error is not larger.
  *
  * assess(M, q, z, basis, out) -> (code, berr, ferr, refined)
@@ -70,7 +71,40 @@ static PyObject *py_assess(PyObject *self, PyObject *args)
     return Py_BuildValue("iddi", code, res[0], res[1], (int)res[2]);
 }
 
+/* bound(K, k, y) -> (code, ferr): accuracy.py's forward_bound (K m x m, k, y m; float64,
+ * C-contiguous); code 1: singular to working precision or bad buffers (numpy decides). */
+static PyObject *py_bound(PyObject *self, PyObject *args)
+{
+    PyObject *oK, *ok, *oy;
+    if (!PyArg_ParseTuple(args, "OOO", &oK, &ok, &oy)) return NULL;
+    Py_buffer b[3];
+    PyObject *o[3] = {oK, ok, oy};
+    int got = 0;
+    while (got < 3 && PyObject_GetBuffer(o[got], &b[got], PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) == 0)
+        got++;
+    PyErr_Clear();
+    int code = 1;
+    double ferr = 0.0;
+    if (got == 3) {
+        idx m = b[1].len / 8;
+        int fine = b[0].len == m * m * 8 && b[2].len == m * 8 && m <= MAX_M;
+        for (int i = 0; i < 3 && fine; i++) {
+            const char *f = b[i].format ? b[i].format : "B";
+            if (*f == '<' || *f == '=' || *f == '@') f++;
+            fine = b[i].itemsize == 8 && f[0] == 'd' && f[1] == 0;
+        }
+        if (fine)
+            code = bound_one(m, (const double *)b[0].buf, (const double *)b[1].buf,
+                             (const double *)b[2].buf, &ferr);
+    }
+    for (int i = 0; i < got; i++) PyBuffer_Release(&b[i]);
+    return Py_BuildValue("id", code, ferr);
+}
+
 static PyMethodDef methods[] = {
+    {"bound", py_bound, METH_VARARGS,
+     "bound(K, k, y) -> (code, ferr): lcp/acceptance/accuracy.py's forward_bound at y "
+     "(code 1: singular to working precision or not handled, run the numpy code)."},
     {"assess", py_assess, METH_VARARGS,
      "assess(M, q, z, basis, out) -> (code, berr, ferr, refined): lcp/accuracy.py's assess "
      "of an LCP answer on its basis (code 1: not handled, run the numpy code)."},

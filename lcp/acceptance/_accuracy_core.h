@@ -1,6 +1,6 @@
 /* lcp/acceptance/accuracy.py's `assess` of an LCP answer on its basis, in C: the steps (backward
  * error, LU of the pattern's system, refinement with long double residuals, LAPACK's forward
- * error bound by Hager's estimator, the polished point kept when not worse). Included by
+ * error bound with |K^-1| formed from the LU, the polished point kept when not worse). Included by
  * lcp/acceptance/_accuracy_c.c (the binding `assess`) and by lcp/_lemke_c.c (`solve_accept`:
  * the solve and its acceptance in one call), so that both run the same code. The includer
  * defines `idx` (Py_ssize_t) and includes <float.h>, <math.h>, <stdint.h>, <stdlib.h> and
@@ -124,96 +124,6 @@ static double backward_error(idx n, const double *M, const double *q, const doub
 
 #include "_lu_core.h" /* lu, lu_solve: the LU of the pattern's system */
 
-/* || |K^-1| g ||_inf = || diag(g) K^-T ||_1, by Hager's 1-norm estimator (Higham 2002,
- * Alg. 15.4; LAPACK's xLACN2 does the same for xGERFS's FERR): B x = g .* (K^-T x),
- * B^T x = K^-1 (g .* x). x, y: scratch of length m. */
-static double abs_inv_norm(idx m, const double *A, const idx *perm, const double *g,
-                           double *x, double *y)
-{
-    for (idx i = 0; i < m; i++) x[i] = 1.0 / (double)m;
-    double est = 0.0;
-    idx jprev = -1;  /* x = e_jprev, or 1/m everywhere while -1 */
-    for (int it = 0; it < 5; it++) {
-        memcpy(y, x, (size_t)m * sizeof(double));
-        lu_solve(m, A, perm, y, 1);
-        double norm = 0.0;
-        for (idx i = 0; i < m; i++) {
-            y[i] *= g[i];
-            norm += fabs(y[i]);
-        }
-        if (it > 0 && norm <= est) break;
-        est = norm;
-        for (idx i = 0; i < m; i++) x[i] = g[i] * (y[i] >= 0 ? 1.0 : -1.0);
-        lu_solve(m, A, perm, x, 0);  /* z = B^T sign(y) */
-        idx j = 0;
-        double zx = 0.0;
-        for (idx i = 0; i < m; i++) {
-            if (fabs(x[i]) > fabs(x[j])) j = i;
-            zx += x[i] / (double)m;
-        }
-        if (jprev >= 0) zx = x[jprev];
-        if (fabs(x[j]) <= zx) break;
-        for (idx i = 0; i < m; i++) x[i] = 0.0;
-        x[j] = 1.0;
-        jprev = j;
-    }
-    /* Higham's alternative vector: guards the estimate against special structure */
-    for (idx i = 0; i < m; i++)
-        x[i] = (i % 2 ? -1.0 : 1.0) * (1.0 + (double)i / (double)(m > 1 ? m - 1 : 1));
-    lu_solve(m, A, perm, x, 1);
-    double alt = 0.0;
-    for (idx i = 0; i < m; i++) alt += fabs(g[i] * x[i]);
-    alt = 2.0 * alt / (3.0 * (double)m);
-    return dmax(est, alt);
-}
-
-/* An upper bound of || |K^-1| b ||_inf for b >= 0 from the LU of `lu` (K = P^T L U): |K^-1| <=
- * |U^-1| |L^-1| P <= C(U)^-1 C(L)^-1 P elementwise, C(T) the comparison matrix of a triangular
- * T (|T_ii| on the diagonal, -|T_ij| off it; Higham 2002, Sec. 8.2), applied by two
- * substitutions in which every term is >= 0 (so rounding changes the bound by a relative
- * O(m eps) at most). One substitution pair instead of the estimator's five to eleven. x:
- * scratch of length m. */
-static double skeel_bound(idx m, const double *A, const idx *perm, const double *b, double *x)
-{
-    memcpy(x, b, (size_t)m * sizeof(double));
-    permute(m, perm, x);
-    /* C(L)^-1: x[i] += |A[i, j]| x[j] for j = 0, ..., i - 1 in this order; four rows at once
-     * as lu_solve's L (the same numbers, sooner) */
-    idx i = 0;
-    for (; i + 4 <= m; i += 4) {
-        const double *A0 = A + i * m, *A1 = A0 + m, *A2 = A1 + m, *A3 = A2 + m;
-        double x0 = x[i], x1 = x[i + 1], x2 = x[i + 2], x3 = x[i + 3];
-        for (idx j = 0; j < i; j++) {
-            double xj = x[j];
-            x0 += fabs(A0[j]) * xj;
-            x1 += fabs(A1[j]) * xj;
-            x2 += fabs(A2[j]) * xj;
-            x3 += fabs(A3[j]) * xj;
-        }
-        x1 += fabs(A1[i]) * x0;
-        x2 += fabs(A2[i]) * x0;
-        x3 += fabs(A3[i]) * x0;
-        x2 += fabs(A2[i + 1]) * x1;
-        x3 += fabs(A3[i + 1]) * x1;
-        x3 += fabs(A3[i + 2]) * x2;
-        x[i] = x0, x[i + 1] = x1, x[i + 2] = x2, x[i + 3] = x3;
-    }
-    for (; i < m; i++)
-        for (idx j = 0; j < i; j++) x[i] += fabs(A[i * m + j]) * x[j];
-    double top = 0.0;
-    for (i = m - 1; i >= 0; i--) {
-        for (idx j = i + 1; j < m; j++) x[i] += fabs(A[i * m + j]) * x[j];
-        x[i] /= fabs(A[i * m + i]);
-        top = dmax(top, x[i]);
-    }
-    return top;
-}
-
-/* The bound settles Skeel's test when bound m eps <= SKEEL_MARGIN: Hager's estimate (a lower
- * bound of the norm, up to its rounding and the factor 4/3 of its alternative vector) is then
- * far below 1 / (m eps) too, and the test's outcome is the one the estimate would give. */
-#define SKEEL_MARGIN 1e-3
-
 /* out_i = init_i + sum_j |K_ij| x_j (x NULL: + |K_ij|; init NULL: from 0), each row summed
  * for j = 0, 1, ..., m - 1 in this order, four rows at once (independent chains: the same
  * numbers as row by row, sooner). out may be init. */
@@ -274,10 +184,102 @@ static void residual_ld(idx m, const double *K, const double *k, const double *y
     }
 }
 
+/* LAPACK's forward error bound at y of the pattern's system K y + k = 0 (A, perm: K's LU;
+ * rows_i = sum_j |K_ij|), lcp/acceptance/accuracy.py's `forward_bound`:
+ *
+ *     ferr = || |K^-1| (|r| + (m + 1) eps_ld (|K| |y| + |k|)) ||_inf / ||y||_inf + eps,
+ *
+ * r = K y + k in long double. |K^-1| is formed column by column from the LU (column j =
+ * K^-1 e_j; m solves, O(m^3)), so the norm is computed, not estimated: Hager's estimator
+ * (xGERFS's) is a lower bound of it and came out 20 % below on solved problems (issue 23).
+ * Skeel's condition || |K^-1| |K| 1 || comes from the same columns: beyond 1 / (m eps) the
+ * system is singular to working precision and 1 is returned (the numpy code's SVD path
+ * decides), else 0 with *ferr set. r, g: scratch of m doubles, col of 5 m, acc of 2 m. */
+static int forward_bound(idx m, const double *K, const double *A, const idx *perm,
+                         const double *kp, const double *y, const double *rows, double *r,
+                         double *g, double *col, double *acc, double *ferr)
+{
+    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
+    residual_ld(m, K, kp, y, r);
+    double ymax = 0.0;
+    for (idx i = 0; i < m; i++) {
+        col[i] = fabs(y[i]);
+        ymax = dmax(ymax, col[i]);
+    }
+    for (idx i = 0; i < m; i++) g[i] = fabs(kp[i]);
+    abs_row_sums_by4(m, K, col, g, g);  /* g_i = |k_i| + sum_j |K_ij| |y_j| */
+    for (idx i = 0; i < m; i++) g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * g[i];
+    double *sk = acc + m;
+    memset(acc, 0, 2 * (size_t)m * sizeof(double));
+    /* acc += |K^-1 e_j| g_j, sk += |K^-1 e_j| rows_j for j = 0, 1, ..., m - 1 in this order;
+     * the columns four at a time (c4[4 i + b] = column j0 + b: independent chains), each by
+     * lu_solve's substitutions (the same numbers; the L one begun at the first nonzero of
+     * P e_j, the entries above it staying 0 as they would there) */
+    double *c4 = col + m;
+    for (idx j0 = 0; j0 < m; j0 += 4) {
+        idx nb = m - j0 < 4 ? m - j0 : 4, p = m;
+        memset(c4, 0, 4 * (size_t)m * sizeof(double));
+        for (idx b = 0; b < nb; b++) {
+            memset(col, 0, (size_t)m * sizeof(double));
+            col[j0 + b] = 1.0;
+            permute(m, perm, col);
+            idx pb = 0;
+            while (col[pb] == 0.0) pb++;
+            c4[4 * pb + b] = 1.0;
+            p = pb < p ? pb : p;
+        }
+        for (idx i = p + 1; i < m; i++) {
+            const double *Ai = A + i * m;
+            double x0 = c4[4 * i], x1 = c4[4 * i + 1], x2 = c4[4 * i + 2], x3 = c4[4 * i + 3];
+            for (idx l = p; l < i; l++) {
+                const double al = Ai[l], *cl = c4 + 4 * l;
+                x0 -= al * cl[0];
+                x1 -= al * cl[1];
+                x2 -= al * cl[2];
+                x3 -= al * cl[3];
+            }
+            c4[4 * i] = x0, c4[4 * i + 1] = x1, c4[4 * i + 2] = x2, c4[4 * i + 3] = x3;
+        }
+        for (idx i = m - 1; i >= 0; i--) {
+            const double *Ai = A + i * m;
+            double x0 = c4[4 * i], x1 = c4[4 * i + 1], x2 = c4[4 * i + 2], x3 = c4[4 * i + 3];
+            for (idx l = i + 1; l < m; l++) {
+                const double al = Ai[l], *cl = c4 + 4 * l;
+                x0 -= al * cl[0];
+                x1 -= al * cl[1];
+                x2 -= al * cl[2];
+                x3 -= al * cl[3];
+            }
+            const double d = Ai[i];
+            c4[4 * i] = x0 / d, c4[4 * i + 1] = x1 / d, c4[4 * i + 2] = x2 / d,
+            c4[4 * i + 3] = x3 / d;
+        }
+        for (idx b = 0; b < nb; b++) {
+            const double gj = g[j0 + b], rj = rows[j0 + b];
+            for (idx i = 0; i < m; i++) {
+                double c = fabs(c4[4 * i + b]);
+                acc[i] += c * gj;
+                sk[i] += c * rj;
+            }
+        }
+    }
+    double top = 0.0, skeel = 0.0;
+    int finite = 1;
+    for (idx i = 0; i < m; i++) {
+        finite &= isfinite(acc[i]) && isfinite(sk[i]);
+        top = dmax(top, acc[i]);
+        skeel = dmax(skeel, sk[i]);
+    }
+    if (!finite || skeel * (double)m * eps > 1.0) return 1;
+    *ferr = top / dmax(ymax, 1e-300) + eps;
+    if (!isfinite(*ferr)) *ferr = INFINITY;
+    return 0;
+}
+
 static int assess_one(idx n, const double *M, const double *q, const double *z,
                       const int64_t *a, idx m, double *out, double *res)
 {
-    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
+    const double eps = DBL_EPSILON;
     double mmax = 0.0, qmax = 0.0, norm = 0.0;
     for (idx i = 0; i < n; i++) qmax = dmax(qmax, fabs(q[i]));
     for (idx i = 0; i < n; i++)
@@ -318,10 +320,10 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     }
     if (!isfinite(norm)) return 1;
     double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
-    /* one block for the work below: 3 m^2 + 6 m + 1 doubles (K, its LU, Hager's scratch, the
-     * vectors), perm and the sorted pattern (m + 1 entries of 8 bytes each) and the marks (n
+    /* one block for the work below: 2 m^2 + 13 m + 1 doubles (K, its LU, the vectors, the
+     * bound's scratch), perm and the sorted pattern (m + 1 entries of 8 bytes each) and the marks (n
      * bytes); on the stack when it fits (no allocation for small problems) */
-    size_t nd = (size_t)3 * m * m + 6 * (size_t)m + 1, words = nd + 2 * ((size_t)m + 1) +
+    size_t nd = (size_t)2 * m * m + 13 * (size_t)m + 1, words = nd + 2 * ((size_t)m + 1) +
                                                             ((size_t)n + 7) / 8;
     double stackbuf[ASSESS_STACK];
     double *buf = words <= ASSESS_STACK ? stackbuf : (double *)malloc(words * sizeof(double));
@@ -343,8 +345,8 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     double berr = -1.0;  /* of z as given: computed only when needed (below) */
     double ferr = 0.0;
     int refined = 0;
-    double *K = buf, *A = K + m * m, *inv = A + m * m, *kp = inv + m * m, *y = kp + m,
-           *r = y + m, *d = r + m, *g = d + m, *rows = g + m;
+    double *K = buf, *A = K + m * m, *kp = A + m * m, *y = kp + m, *r = y + m, *d = r + m,
+           *g = d + m, *rows = g + m, *col = rows + m, *acc = col + 5 * m;
     for (idx i = 0; i < m; i++) {
         kp[i] = q[a[i]];
         y[i] = z[a[i]];
@@ -373,25 +375,8 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
                 prev = size;
                 if (size <= eps * ymax) break;
             }
-            residual_ld(m, K, kp, y, r);
-            double ymax = 0.0;
-            for (idx i = 0; i < m; i++) {
-                d[i] = fabs(y[i]);
-                ymax = dmax(ymax, d[i]);
-            }
-            for (idx i = 0; i < m; i++) g[i] = fabs(kp[i]);
-            abs_row_sums_by4(m, K, d, g, g);  /* g_i = |k_i| + sum_j |K_ij| |y_j| */
-            for (idx i = 0; i < m; i++)
-                g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * g[i];
-            double bound = abs_inv_norm(m, A, perm, g, d, inv);
-            ferr = bound / dmax(ymax, 1e-300) + eps;
-            /* Skeel's condition || |K^-1| |K| 1 ||: singular to working precision beyond
-             * 1 / (m eps), as the numpy code's test (its SVD path decides then). Its estimate
-             * is needed only when a cheap upper bound does not already settle the test */
-            if (!(skeel_bound(m, A, perm, rows, d) * (double)m * eps <= SKEEL_MARGIN) &&
-                abs_inv_norm(m, A, perm, rows, d, inv) * (double)m * eps > 1.0)
-                code = 1;
-            if (!isfinite(ferr)) ferr = INFINITY;
+            /* the bound at the refined y (exact norm of |K^-1| g; Skeel's singularity test) */
+            if (forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, &ferr)) code = 1;
         }
     }
     if (!code) {
@@ -408,14 +393,32 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
         if (finite && (bp <= 8.0 * (double)n * eps || bp <= berr)) {
             berr = bp;
             refined = 1;
+            /* a y_i < 0 clipped to 0: the bound of the point returned, not of y (the one
+             * verify.certify computes on it) */
+            int clipped = 0;
+            for (idx i = 0; i < m; i++)
+                if (y[i] < 0.0) {
+                    y[i] = 0.0;
+                    clipped = 1;
+                }
+            if (clipped && forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, &ferr))
+                ferr = INFINITY;  /* not finite (the same K passed the test above) */
         } else {
-            double xs = 0.0, gap = 0.0;
+            /* z as given: the bound at z_a itself (lcp/acceptance/accuracy.py's `assess`),
+             * + its entries off the pattern */
+            double xs = 0.0, gap = 0.0, at_z = ferr;
             for (idx i = 0; i < n; i++) xs = dmax(xs, fabs(z[i]));
             xs = dmax(xs, 1e-300);
-            for (idx i = 0; i < m; i++) gap = dmax(gap, fabs(z[a[i]] - y[i]));
+            memcpy(d, y, (size_t)m * sizeof(double));  /* the refined y */
+            for (idx i = 0; i < m; i++) y[i] = z[a[i]];
+            if (!isfinite(ferr) || forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc,
+                                                 &at_z)) {
+                at_z = ferr;  /* not finite: |z_a - y| + the bound of y, as numpy */
+                for (idx i = 0; i < m; i++) gap = dmax(gap, fabs(z[a[i]] - d[i]));
+            }
             for (idx i = 0; i < n; i++)
                 if (!mark[i]) gap = dmax(gap, fabs(z[i]));
-            ferr = ferr + gap / xs;
+            ferr = at_z + gap / xs;
             if (!isfinite(ferr)) ferr = INFINITY;
             memcpy(out, z, (size_t)n * sizeof(double));
         }
@@ -424,6 +427,29 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     res[0] = berr;
     res[1] = ferr;
     res[2] = refined;
+    return code;
+}
+
+/* forward_bound of K y + k = 0 at y, K m x m row-major: the LU here (the same `lu` as
+ * assess_one's, so the same number for the same K and y). Returns 0 (*ferr set) or 1
+ * (singular to working precision, a zero pivot, or no memory: the numpy code decides). */
+static int bound_one(idx m, const double *K, const double *kp, const double *y, double *ferr)
+{
+    if (m == 0) {
+        *ferr = 0.0;
+        return 0;
+    }
+    size_t nd = (size_t)m * m + 10 * (size_t)m;
+    double *buf = (double *)malloc((nd + (size_t)m + 1) * sizeof(double));
+    if (!buf) return 1;
+    double *A = buf, *rows = A + m * m, *r = rows + m, *g = r + m, *col = g + m,
+           *acc = col + 5 * m;
+    idx *perm = (idx *)(buf + nd);
+    memcpy(A, K, (size_t)m * m * sizeof(double));
+    abs_row_sums_by4(m, K, NULL, NULL, rows);
+    int code = lu(m, A, perm) < 0 ? 1 : forward_bound(m, K, A, perm, kp, y, rows, r, g, col,
+                                                      acc, ferr);
+    free(buf);
     return code;
 }
 

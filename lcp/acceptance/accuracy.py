@@ -24,14 +24,20 @@ zero to the accuracy the forward error bound speaks of.)
 ended on one, else {i : v_i / v_s > w_i / s_i}; the system is K_PP y = -k_P over the rows and
 unknowns of u and v_P (v_i = 0 off P). Its solution, refined from the answer with residuals in
 extended precision (np.longdouble, "mixed precision" refinement, Higham 2002 Sec. 12.1), is the
-*polished* answer (for a method that ended on a basis; another answer is judged as it is,
-its bound adding its distance to that exact point); the bound is LAPACK's
+*polished* answer (for a method that ended on a basis; another answer is judged as it is).
+The bound, at the point y returned (the polished one, its v_P clipped at 0, or the answer as
+given, then + its largest v off P / |x|_inf), is LAPACK's (`forward_bound`)
 
     ferr = || |K_PP^-1| (|r| + gamma (|K_PP| |y| + |k_P|)) ||_inf / ||y||_inf + eps,
 
 r the (extended) residual, gamma = (m + 1) eps_ld: how far y may be from the exact solution of
-the pattern's system. A singular K_PP (a continuum of solutions) uses its pseudo-inverse at the
-numerical rank (distance to the nearest exact point), and an inconsistent one has ferr = inf.
+the pattern's system (y - y* = K_PP^-1 r exactly). |K_PP^-1| is formed column by column from an
+LU, never estimated (Hager's estimator, which LAPACK's xGERFS uses, is a lower bound of the norm:
+0.46x, and 2e-16x on a rank-deficient pattern, on cases tests/lcp/test_forward_bound.py and
+docs/performance.md record); one C function computes it for the C acceptance and for this code,
+so lcp.solve and verify.certify report the same number for the same answer and pattern. A
+singular K_PP (a continuum of solutions) uses its pseudo-inverse at the numerical rank (y's
+distance to the refined point added), and an inconsistent one has ferr = inf.
 
 **Accepted** iff berr <= TOL (lcp.residual.TOL = 1e-8) and ferr <= FERR_TOL. lcp.solve (and its
 fast paths, solve_many, the friction and unreduced-MLCP branches) and verify.certify use
@@ -59,7 +65,7 @@ _EPS_LD = float(np.finfo(np.longdouble).eps)
 FERR_TOL = 1e-6
 #: Refinement steps at most (each one LU solve with an extended-precision residual).
 STEPS = 5
-#: Above this size |K_PP^-1| is not formed: the bound uses Hager-Higham's 1-norm estimator.
+#: Up to this size the bound runs in C (lcp/acceptance/_accuracy_core.h: forward_bound).
 _EXPLICIT = 400
 
 
@@ -133,42 +139,43 @@ def _residual_ld(Kp: np.ndarray, kp: np.ndarray, y: np.ndarray) -> np.ndarray:
     return (Kp.astype(ld) @ y.astype(ld) + kp.astype(ld)).astype(float)
 
 
-def _abs_inv_norm(inv_apply, m: int, g: np.ndarray, inv: np.ndarray | None) -> float:
-    """|| |K^-1| g ||_inf, exactly from an explicit inverse, else estimated (Hager-Higham)."""
-    if inv is not None:
-        return float(np.max(np.abs(inv) @ g))
-    from scipy.sparse.linalg import LinearOperator, onenormest
+def forward_bound(Kp: np.ndarray, kp: np.ndarray, y: np.ndarray) -> float | None:
+    """LAPACK's forward error bound at y of K_PP y = -k_P (module doc), with |K_PP^-1| formed
+    from an LU (not estimated: Hager's estimator is a lower bound of the norm, 20 % below on
+    solved problems, issue 23). None when K_PP is singular to working precision (Skeel's
+    || |K^-1| |K| 1 ||_inf beyond 1 / (m eps)). In C when the extension is built (the same
+    function the C acceptance calls: lcp.solve and verify.certify compute one number), else
+    numpy with the same formula."""
+    m = kp.size
+    if m == 0:
+        return 0.0
+    if _accuracy_c is not None and m <= _EXPLICIT:
+        code, ferr = _accuracy_c.bound(np.ascontiguousarray(Kp, dtype=float),
+                                       np.ascontiguousarray(kp, dtype=float),
+                                       np.ascontiguousarray(y, dtype=float))
+        return None if code else ferr
+    absK = np.abs(Kp)
+    with np.errstate(all="ignore"):
+        inv = _inverse(Kp, absK, m)
+        if inv is None:
+            return None
+        r = _residual_ld(Kp, kp, y)
+        g = np.abs(r) + (m + 1) * _EPS_LD * (absK @ np.abs(y) + np.abs(kp))
+        ferr = float(np.max(np.abs(inv) @ g)) / max(float(np.max(np.abs(y))), 1e-300) + _EPS
+    return ferr if np.isfinite(ferr) else np.inf
 
-    # || |X| g ||_inf = || X diag(g) ||_inf = || diag(g) X^T ||_1
-    op = LinearOperator((m, m), dtype=float,
-                        matvec=lambda t: g * inv_apply(np.ravel(t), True),
-                        rmatvec=lambda t: inv_apply(g * np.ravel(t), False))
-    return float(onenormest(op))
 
-
-def _inverse(Kp: np.ndarray, absK: np.ndarray, m: int):
-    """(K^-1, None) for m <= _EXPLICIT, (None, LU) above; (None, None) when K is singular to
-    working precision (|K^-1| |K| beyond 1 / (m eps), or a zero pivot)."""
-    if m <= _EXPLICIT:
-        try:
-            inv = np.linalg.inv(Kp)
-        except np.linalg.LinAlgError:
-            return None, None
-        if not np.all(np.isfinite(inv)) or (
-                float(np.max(np.abs(inv) @ absK.sum(axis=1))) * m * _EPS > 1.0):
-            return None, None
-        return inv, None
-    import warnings
-
-    from scipy.linalg import lu_factor
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        lu = lu_factor(Kp, check_finite=False)
-    diag = np.abs(np.diag(lu[0]))
-    if not (np.all(np.isfinite(lu[0])) and diag.min() > m * _EPS * diag.max()):
-        return None, None
-    return None, lu
+def _inverse(Kp: np.ndarray, absK: np.ndarray, m: int) -> np.ndarray | None:
+    """K^-1 (formed: |K^-1| g is computed, not estimated), or None when K is singular to
+    working precision (|K^-1| |K| beyond 1 / (m eps), or not finite)."""
+    try:
+        inv = np.linalg.inv(Kp)
+    except np.linalg.LinAlgError:
+        return None
+    if not np.all(np.isfinite(inv)) or (
+            float(np.max(np.abs(inv) @ absK.sum(axis=1))) * m * _EPS > 1.0):
+        return None
+    return inv
 
 
 def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, float]:
@@ -178,27 +185,18 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
     m = kp.size
     if m == 0:
         return y0, 0.0
-    from scipy.linalg import lu_solve  # cheap import, done on first use
-
     y = np.array(y0, dtype=float)
     absK = np.abs(Kp)
     with np.errstate(all="ignore"):
-        inv, lu = _inverse(Kp, absK, m)
-        singular = False
-        if inv is not None:
-            def solve(rhs, trans=False):
-                return (inv.T if trans else inv) @ rhs
-        elif lu is not None:
-            def solve(rhs, trans=False):
-                return lu_solve(lu, rhs, trans=1 if trans else 0, check_finite=False)
-        else:  # singular to working precision: pseudo-inverse at the numerical rank
-            singular = True
+        inv = _inverse(Kp, absK, m)
+        singular = inv is None
+        if singular:  # singular to working precision: pseudo-inverse at the numerical rank
             U, sv, Vt = np.linalg.svd(Kp)
             keep = sv > max(Kp.shape) * _EPS * (sv[0] if sv.size else 0.0)
             inv = (Vt[keep].T / sv[keep]) @ U[:, keep].T
 
-            def solve(rhs, trans=False):
-                return (inv.T if trans else inv) @ rhs
+        def solve(rhs):
+            return inv @ rhs
         if not np.all(np.isfinite(y)):
             y = -solve(kp)
         prev = np.inf
@@ -212,6 +210,9 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
             prev = size
             if size <= _EPS * float(np.max(np.abs(y))):
                 break
+        fb = None if singular else forward_bound(Kp, kp, y)
+        if fb is not None:
+            return y, fb
         r = _residual_ld(Kp, kp, y)
         g = np.abs(r) + (m + 1) * _EPS_LD * (absK @ np.abs(y) + np.abs(kp))
         if singular:  # consistent to rounding? else no exact point of this pattern
@@ -219,7 +220,7 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
             if np.any(np.abs(r) > 1e3 * m * _EPS * np.maximum(scale, 1e-300)):
                 return y, np.inf
         ynorm = max(float(np.max(np.abs(y))), 1e-300)
-        ferr = _abs_inv_norm(solve, m, g, inv) / ynorm + _EPS
+        ferr = float(np.max(np.abs(inv) @ g)) / ynorm + _EPS
     return y, (ferr if np.isfinite(ferr) else np.inf)
 
 
@@ -252,13 +253,23 @@ def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
         bp = backward_error(K, k, xp, nu)
         if bp <= max(berr, 8 * x.size * _EPS):  # not larger, or at rounding level
             x, berr, refined = xp, bp, True
-    if not refined:  # the answer as given: |x - y| + the bound of y (triangle inequality)
+            if np.any(xp[idx] != y):  # a v_i < 0 clipped: the bound of the point returned
+                at_x = forward_bound(Kp, kp, xp[idx])
+                with np.errstate(all="ignore"):
+                    ferr = at_x if at_x is not None else ferr + float(
+                        np.max(np.abs(xp[idx] - y))) / max(float(np.max(np.abs(xp))), 1e-300)
+    if not refined:  # the answer as given: the bound at x_P itself (else, on a singular
+        # system, |x - y| + the bound of y: triangle inequality), + its v's off the pattern
         with np.errstate(all="ignore"):
             xs = max(float(np.max(np.abs(x), initial=0.0)), 1e-300)
             off = np.setdiff1d(np.arange(x.size - nu), P)
-            gap = max(float(np.max(np.abs(x[idx] - y), initial=0.0)),
-                      float(np.max(np.abs(x[nu:][off]), initial=0.0)))
-            ferr = ferr + gap / xs
+            at_x = (forward_bound(Kp, kp, x[idx]) if np.all(np.isfinite(x)) and np.isfinite(ferr)
+                    else None)
+            gap = float(np.max(np.abs(x[nu:][off]), initial=0.0))
+            if at_x is None:
+                gap = max(gap, float(np.max(np.abs(x[idx] - y), initial=0.0)))
+                at_x = ferr
+            ferr = at_x + gap / xs
         ferr = ferr if np.isfinite(ferr) else np.inf
     return Accuracy(berr=berr, ferr=ferr, pattern=P, refined=refined, u=x[:nu], v=x[nu:])
 
