@@ -327,7 +327,7 @@ def assert_exact_solution_near(M: np.ndarray, q: np.ndarray, sol) -> None:
             zQ[i] = y[k, 0]
     wQ = [sum((MQ[i][j] * zQ[j] for j in range(n)), fmpq(0)) + qQ[i] for i in range(n)]
     assert all(v >= 0 for v in zQ) and all(wQ[i] >= 0 for i in range(n) if i not in P)
-    z_star = np.array([float(v) for v in zQ])
+    z_star = np.array([float(Fraction(int(v.p), int(v.q))) for v in zQ])  # flint 0.6: no float()
     err = float(np.max(np.abs(sol.z - z_star)))
     assert err <= sol.forward_error * float(np.max(np.abs(z_star))), err
 
