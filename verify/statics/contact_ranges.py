@@ -175,7 +175,7 @@ def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.n
     """Whether S = +-mu R with R > 0 is attainable at each of `contacts` (forceset's
     docstring), the LPs solved and the verdicts left unknown (a "no" rests on checked LP
     answers: optima in P certified by their duals on the face, or checked rays, or HiGHS's
-    "infeasible" for the face, taken as it is (not checked, as before); when an
+    "infeasible" for the face with a checked Farkas certificate, verify.statics.ends; when an
     answer fails its check after the retries of verify.statics.ends, and no other answer
     says "yes", the contact is appended to `unsure` and its verdict is False there, but
     unknown); hi_R: (c,) max R (NaN: unknown); seen: (c,) contacts already found at the

@@ -19,6 +19,10 @@ the check fails it tries, in order:
    "unbounded" with a ray that fails its check (cost . r = -5.5e-9 of |r| = 2e3) on a bounded
    LP (n 5, seed 5, mu 1.0).
 
+An optimum's dual certificate must also hold beyond the simplex's tolerance (`_dual_exact`:
+exactly on small piles, else to rounding), and a sliding LP's "infeasible" needs a checked
+Farkas certificate for its face (`_infeasible`).
+
 Else the end is unknown: `Unknown` names the failed check and its measure against its
 tolerance, for the JSON and the summary.
 """

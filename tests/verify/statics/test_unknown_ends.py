@@ -145,7 +145,7 @@ def test_an_unbounded_answer_without_a_checked_ray_is_solved_again():
 def test_a_sliding_lp_that_fails_warm_is_solved_cold():
     """n 17, seed 16, mu 1.015625 (the deep profile, after the fix above): the warm sliding LP
     of contact 33 with S = -mu R imposed ends "failed" (no answer); it is solved cold (HiGHS:
-    that face is empty, taken as it is, as a warm "infeasible" is), not left unknown."""
+    that face is empty, with its Farkas certificate checked), not left unknown."""
     fs = analyse(_pile(17, 16, 1.015625))
     assert fs.exists and fs.unchecked == 0 and not np.any(fs.sliding_unknown)
     assert fs.retried >= 1 and not fs.unknown
