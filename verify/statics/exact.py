@@ -136,7 +136,7 @@ def face_radius(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> f
     of y): no point of the face has sum R below the returned radius (0: no claim). On the
     face, sum R g_n + S g_t >= -sum R max(C y) over the other rows, so b . y < 0 bounds sum R
     below by -b . y / max(C y); C y is taken with a bound on its rounding added (8 eps |C| |y|,
-    at most 6 terms a row)."""
+    at most 6 terms a row), -b . y with its own taken off (3p eps |b| . |y|, with room)."""
     C = cone_rows(prob)
     mask = np.ones(C.shape[0], dtype=bool)
     mask[list(equal)] = False
@@ -144,7 +144,8 @@ def face_radius(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> f
     err = 8 * np.finfo(float).eps * (abs(C) @ np.abs(y))
     best = 0.0
     for s in (1.0, -1.0):
-        gap = -s * float(prob.b @ y) * (1 - 1e-12)
+        gap = -s * float(prob.b @ y) - 4 * prob.p * np.finfo(float).eps * float(
+            np.abs(prob.b) @ np.abs(y))
         worst = float(np.max((s * (C @ y) + err)[mask], initial=0.0))
         if gap > 0:
             best = max(best, np.inf if worst <= 0 else gap / worst)
