@@ -317,7 +317,7 @@ def _infeasible(prob: StaticProblem, lp: DualForceLP | ForceLP,
         np.flatnonzero(prob.mu == 0)[j - 2 * k]) for j in fixed)
     if has_ray and exact.face_empty(prob, np.asarray(values, dtype=float), rows):
         return None
-    y = exact.face_farkas_lp(prob, rows)  # no ray, or one that fails: a Farkas LP of our own
-    if y is not None and exact.face_empty(prob, y, rows):
+    # no ray, or one that fails: Farkas LPs of our own
+    if any(exact.face_empty(prob, y, rows) for y in exact.face_farkas_lp(prob, rows)):
         return None
     return Evidence("farkas", np.nan, 0.0, "infeasible")

@@ -191,19 +191,49 @@ def face_empty(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> bo
     for s in (1.0, -1.0):
         ys = s * y / top
         g = (C @ ys)[mask]
-        if first_exact(keep, bq, np.flatnonzero(g > -1e-9),
-                       [small_rational(v) for v in ys]) is not None:
-            return True
+        J = np.flatnonzero(g > -1e-9)
+        # free unknowns as small fractions, else as the doubles themselves: a thin certificate
+        # (n 2, seed 0, mu 0.99999: b . y = -5e-6 with |y| = 1, from entries 5.00005e-6 that
+        # a denominator <= 10^6 rounds away) needs their digits
+        for start in ([small_rational(v) for v in ys], [rational(v) for v in ys]):
+            if first_exact(keep, bq, J, start) is not None:
+                return True
     return False
 
 
-def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> np.ndarray | None:
-    """y of min b . y, C y <= 0 on the cone rows not in `equal`, |y|_inf <= 1
-    (verify.statics.farkas.farkas_lp: IPM with crossover, a vertex), or None: a Farkas
-    certificate for the face, to check with face_empty."""
+def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> list[np.ndarray]:
+    """Candidate Farkas certificates for the face of P with the cone rows `equal` made
+    equalities, to check with face_empty: y of min b . y, C y <= 0 on the other rows,
+    |y|_inf <= 1 (verify.statics.farkas.farkas_lp: IPM with crossover, a vertex), and y of
+    C y <= 0 on those rows with b . y <= -1 (|y|_inf <= 1e12; HiGHS's dual simplex, zero
+    objective). The second normalisation keeps a thin certificate above the LP's tolerance:
+    with |y| <= 1 the first had b . y = -5e-6 and violated a row by 5e-11 < its tolerance 1e-10,
+    where the face is empty exactly (n 2, seed 0, mu 0.99999: 1 - mu = 1e-5)."""
+    import highspy
+
+    from rigidlcp.lcp.quiet import new_highs
+
     from .farkas import farkas_lp
 
     C = cone_rows(prob)
     mask = np.ones(C.shape[0], dtype=bool)
     mask[list(equal)] = False
-    return farkas_lp(prob, C[mask], True)
+    out = [y for y in [farkas_lp(prob, C[mask], True)] if y is not None]
+    rows = sp.vstack([C[mask], sp.csr_matrix(np.asarray(prob.b, dtype=float)[None, :])],
+                     format="csc")
+    m, n = rows.shape
+    lp = highspy.HighsLp()
+    lp.num_col_, lp.num_row_ = n, m
+    lp.col_cost_ = np.zeros(n)
+    lp.col_lower_, lp.col_upper_ = np.full(n, -1e12), np.full(n, 1e12)
+    lp.row_lower_ = np.full(m, -highspy.kHighsInf)
+    lp.row_upper_ = np.r_[np.zeros(m - 1), -1.0]
+    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (rows.indptr, rows.indices,
+                                                                     rows.data)
+    h = new_highs(presolve="off", simplex_strategy=1, primal_feasibility_tolerance=1e-10)
+    h.passModel(lp)
+    h.run()
+    if h.getModelStatus() == highspy.HighsModelStatus.kOptimal:
+        out.append(np.asarray(h.getSolution().col_value, dtype=float))
+    return out
