@@ -20,6 +20,7 @@ Both are dense rational row reductions: `EXACT_MAX_ROWS` bounds their size.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from fractions import Fraction
 
 import numpy as np
@@ -201,14 +202,15 @@ def face_empty(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> bo
     return False
 
 
-def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> list[np.ndarray]:
-    """Candidate Farkas certificates for the face of P with the cone rows `equal` made
-    equalities, to check with face_empty: y of min b . y, C y <= 0 on the other rows,
-    |y|_inf <= 1 (verify.statics.farkas.farkas_lp: IPM with crossover, a vertex), and y of
-    C y <= 0 on those rows with b . y <= -1 (|y|_inf <= 1e12; HiGHS's dual simplex, zero
-    objective). The second normalisation keeps a thin certificate above the LP's tolerance:
-    with |y| <= 1 the first had b . y = -5e-6 and violated a row by 5e-11 < its tolerance 1e-10,
-    where the face is empty exactly (n 2, seed 0, mu 0.99999: 1 - mu = 1e-5)."""
+def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> Iterator[np.ndarray]:
+    """Candidate Farkas certificates (yielded one by one: the second LP only when asked) for
+    the face of P with the cone rows `equal` made equalities, to check with face_empty:
+    y of min b . y, C y <= 0 on the other rows, |y|_inf <= 1 (farkas.farkas_lp: IPM with
+    crossover, a vertex), then y of C y <= 0 on those rows with b . y <= -1 (|y|_inf <= 1e12;
+    HiGHS's dual simplex, zero objective). The second normalisation keeps a thin certificate
+    above the LP's tolerance: with |y| <= 1 the first had b . y = -5e-6 and violated a row by
+    5e-11, under its tolerance 1e-10, where the face is empty exactly (n 2, seed 0,
+    mu 0.99999: 1 - mu = 1e-5)."""
     import highspy
 
     from rigidlcp.lcp.quiet import new_highs
@@ -218,7 +220,9 @@ def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> list[np.ndarr
     C = cone_rows(prob)
     mask = np.ones(C.shape[0], dtype=bool)
     mask[list(equal)] = False
-    out = [y for y in [farkas_lp(prob, C[mask], True)] if y is not None]
+    y = farkas_lp(prob, C[mask], True)
+    if y is not None:
+        yield y
     rows = sp.vstack([C[mask], sp.csr_matrix(np.asarray(prob.b, dtype=float)[None, :])],
                      format="csc")
     m, n = rows.shape
@@ -235,5 +239,4 @@ def face_farkas_lp(prob: StaticProblem, equal: tuple[int, ...]) -> list[np.ndarr
     h.passModel(lp)
     h.run()
     if h.getModelStatus() == highspy.HighsModelStatus.kOptimal:
-        out.append(np.asarray(h.getSolution().col_value, dtype=float))
-    return out
+        yield np.asarray(h.getSolution().col_value, dtype=float)

@@ -351,7 +351,8 @@ def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word(monkeypatch):
             continue
         assert abs(lam[c + a] - prob.mu[a] * lam[a]) <= 1e-9 * lam[a], col
         tried += 1
-        for y in exact.face_farkas_lp(prob, (a,)) + list(rng.standard_normal((3, 3 * prob.p))):
+        ys = list(exact.face_farkas_lp(prob, (a,))) + list(rng.standard_normal((3, 3 * prob.p)))
+        for y in ys:
             assert not exact.face_empty(prob, y, (a,)), a
     assert tried > 0
     monkeypatch.setattr(exact, "face_empty", lambda *a: False)
