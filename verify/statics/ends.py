@@ -17,7 +17,11 @@ the check fails it tries, in order:
 3. a cold LP: a new ForceLP (primal simplex from the slack basis), its answer checked the same
    way (and its basis re-solved if needed); HiGHS's warm primal simplex has answered
    "unbounded" with a ray that fails its check (cost . r = -5.5e-9 of |r| = 2e3) on a bounded
-   LP (n 5, seed 5, mu 1.0).
+   LP (n 5, seed 5, mu 1.0);
+4. for a range LP, a cold dual simplex (DualForceLP): warm and cold, the primal simplex
+   answered "unbounded" for max R of contact 2 (n 9, seed 342, mu 0.99999, the primal's
+   chunk) with rays whose descent, 9e-12 and 4e-11 of their size, fails its check; the cold
+   dual finds the end 835822.16, certified exactly (linprog: 835822.16).
 
 An optimum's dual certificate must also hold beyond the simplex's tolerance (`_dual_exact`:
 exactly on small piles, else to rounding), and a sliding LP's "infeasible" needs a checked
@@ -80,8 +84,8 @@ class Evidence:
 class Settled:
     """An end: status "optimal" (lam: a checked optimum), "unbounded" (a checked ray) or
     "unknown" (evidence: the last try's failed check); lps: LPs solved; how: the try that
-    settled it ("warm", "basis", "ray LP", "cold", "cold basis"; "" when unknown); first: the warm
-    answer's evidence when a retry was needed."""
+    settled it ("warm", "basis", "ray LP", "cold", "cold basis", "cold dual"; "" when
+    unknown); first: the warm answer's evidence when a retry was needed."""
 
     status: str
     lam: np.ndarray | None
@@ -147,6 +151,14 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
         got = _rebasis(prob, fresh, cost, fixed)
         if got is not None:
             return Settled(status, got, lps, how="cold basis", first=ev)
+    if cold is None and not fixed:  # 4. a cold dual simplex (the range LPs)
+        dual = DualForceLP(prob, ForceLP(prob))
+        status, lam = dual.solve(cost)
+        lps += 1
+        ev3 = judge(prob, dual, cost, status, lam)
+        if ev3 is None:
+            return Settled(status, lam, lps, how="cold dual", first=ev)
+        ev2 = ev3
     return Settled("unknown", None, lps, evidence=ev2, how="", first=ev)
 
 

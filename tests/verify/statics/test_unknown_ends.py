@@ -358,3 +358,22 @@ def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word(monkeypatch):
     monkeypatch.setattr(exact, "face_empty", lambda *a: False)
     doubt = analyse(system)
     assert doubt.sliding_unknown[19] and not doubt.sliding[19] and doubt.unchecked >= 1
+
+
+def test_an_unbounded_answer_whose_rays_fail_cold_is_solved_by_the_cold_dual():
+    """n 9, seed 342, mu 0.99999 (the deep profile, after the fixes above), contacts 1..c-1 by
+    a warm primal simplex: max R of contact 2 is "unbounded" warm and cold with rays whose
+    descent (9e-12, 4e-11 of their size) fails its check, and our ray LP finds none; it was
+    unknown. The cold dual simplex's optimum passes every check (its certificate exactly):
+    the end is a checked number, equal to linprog's."""
+    system = _pile(9, 342, 0.99999)
+    fs = analyse(system, ranges=False)
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    lp.solve(np.zeros(prob.n))
+    unknown: list = []
+    _, hi, _, unchecked = ranges_of(prob, lp, fs.implicit, np.arange(1, prob.c),
+                                    Witnesses.of(prob, fs.solution), unknown=unknown)
+    assert unchecked == 0 and not unknown
+    want = _linprog_end(prob, 2, -1.0)
+    assert np.isfinite(hi[1]) and abs(hi[1] - want) <= 1e-7 * want
