@@ -17,7 +17,15 @@ the check fails it tries, in order:
 3. a cold LP: a new ForceLP (primal simplex from the slack basis), its answer checked the same
    way (and its basis re-solved if needed); HiGHS's warm primal simplex has answered
    "unbounded" with a ray that fails its check (cost . r = -5.5e-9 of |r| = 2e3) on a bounded
-   LP (n 5, seed 5, mu 1.0).
+   LP (n 5, seed 5, mu 1.0);
+4. for a range LP, a cold dual simplex (DualForceLP): warm and cold, the primal simplex
+   answered "unbounded" for max R of contact 2 (n 9, seed 342, mu 0.99999, the primal's
+   chunk) with rays whose descent, 9e-12 and 4e-11 of their size, fails its check; the cold
+   dual finds the end 835822.16, certified exactly (linprog: 835822.16).
+
+An optimum's dual certificate must also hold beyond the simplex's tolerance (`_dual_exact`:
+exactly on small piles, else to rounding), and a sliding LP's "infeasible" needs a checked
+Farkas certificate for its face (`_infeasible`).
 
 Else the end is unknown: `Unknown` names the failed check and its measure against its
 tolerance, for the JSON and the summary.
@@ -31,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from . import exact
 from .model import (
     BALANCE_TOL,
     DUAL_TOL,
@@ -44,6 +53,9 @@ from .model import (
 
 #: The tolerance of the primal ray's check (ForceLP.ray_checked's default).
 RAY_TOL = 1e-9
+#: A dual certificate not checked exactly (`_dual_exact`) must have its reduced costs
+#: >= -ROUND_TOL max(1, |y|): rounding, not the simplex's tolerance (DUAL_TOL).
+ROUND_TOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -72,8 +84,8 @@ class Evidence:
 class Settled:
     """An end: status "optimal" (lam: a checked optimum), "unbounded" (a checked ray) or
     "unknown" (evidence: the last try's failed check); lps: LPs solved; how: the try that
-    settled it ("warm", "basis", "ray LP", "cold", "cold basis"; "" when unknown); first: the warm
-    answer's evidence when a retry was needed."""
+    settled it ("warm", "basis", "ray LP", "cold", "cold basis", "cold dual"; "" when
+    unknown); first: the warm answer's evidence when a retry was needed."""
 
     status: str
     lam: np.ndarray | None
@@ -111,13 +123,13 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
            as_is: tuple[str, ...] = ()) -> Settled:
     """min cost . lambda over P (on the face with the `fixed` cone columns at 0) by lp, checked,
     with the retries of the module docstring; cold() builds the cold LP (default: a new
-    ForceLP of prob); as_is: statuses returned as HiGHS gives them, unchecked (the sliding
-    LPs' "infeasible": that face of P is empty)."""
+    ForceLP of prob); as_is: the statuses taken as answers besides "optimal" and "unbounded"
+    (the sliding LPs' "infeasible": that face of P is empty), each with its check (an
+    "infeasible" by a Farkas certificate: `_infeasible`)."""
     status, lam = lp.solve(cost)
     lps = 1
-    if status in as_is:
-        return Settled(status, lam, lps)
-    ev = judge(prob, lp, cost, status, lam, fixed)
+    ev = _infeasible(prob, lp, fixed) if status in as_is else judge(prob, lp, cost, status,
+                                                                     lam, fixed)
     if ev is None:
         return Settled(status, lam, lps)
     if status == "optimal":
@@ -131,15 +143,22 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
     fresh = cold() if cold is not None else ForceLP(prob)
     status, lam = fresh.solve(cost)
     lps += 1
-    if status in as_is:
-        return Settled(status, lam, lps, how="cold", first=ev)
-    ev2 = judge(prob, fresh, cost, status, lam, fixed)
+    ev2 = _infeasible(prob, fresh, fixed) if status in as_is else judge(prob, fresh, cost,
+                                                                         status, lam, fixed)
     if ev2 is None:
         return Settled(status, lam, lps, how="cold", first=ev)
     if status == "optimal":
         got = _rebasis(prob, fresh, cost, fixed)
         if got is not None:
             return Settled(status, got, lps, how="cold basis", first=ev)
+    if cold is None and not fixed:  # 4. a cold dual simplex (the range LPs)
+        dual = DualForceLP(prob, ForceLP(prob))
+        status, lam = dual.solve(cost)
+        lps += 1
+        ev3 = judge(prob, dual, cost, status, lam)
+        if ev3 is None:
+            return Settled(status, lam, lps, how="cold dual", first=ev)
+        ev2 = ev3
     return Settled("unknown", None, lps, evidence=ev2, how="", first=ev)
 
 
@@ -190,7 +209,7 @@ def judge(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray, stat
         for name, value, tol in checks:
             if not value <= tol:
                 return Evidence(name, value, tol, status)
-        return None
+        return _dual_exact(prob, lp, cost, lam, fixed, infeasible)
     if status == "unbounded":
         last = _last(lp)
         if not isinstance(last, ForceLP):
@@ -227,20 +246,11 @@ def _rebasis(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
     check with its own y, else None (also when the basis is not square or is singular)."""
     from scipy.sparse.linalg import splu
 
-    last, primal = _last(lp), _primal(lp)
-    basic = last.hs.HighsBasisStatus.kBasic
-    basis = last.h.getBasis()
-    m = prob.A.shape[0]
-    if isinstance(last, DualForceLP):  # its rows are the cone coordinates: active = nonbasic
-        if any(s != basic for s in basis.col_status):
-            return None
-        cols = np.array([n for n, s in enumerate(basis.row_status) if s != basic], dtype=int)
-    else:  # the balance rows are equalities: a basic row is a rank defect
-        if any(s == basic for s in basis.row_status):
-            return None
-        cols = np.array([n for n, s in enumerate(basis.col_status) if s == basic], dtype=int)
-    if cols.size != m:
+    primal = _primal(lp)
+    basis = _basis_columns(prob, lp)
+    if basis is None or basis[1].size:
         return None
+    cols = basis[0]
     KB = sp.csc_matrix(primal.KT.T)[:, cols]
     try:
         lu = splu(sp.csc_matrix(KB))
@@ -254,3 +264,72 @@ def _rebasis(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
         return None
     lam = primal.T @ w
     return lam if judge(prob, primal, cost, "optimal", lam, fixed, y) is None else None
+
+
+def _basis_columns(prob: StaticProblem, lp: DualForceLP | ForceLP
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The last optimal basis as (its cone-coordinate columns, the balance rows whose y is 0):
+    ForceLP: its basic columns and its basic rows (a redundant balance row's slack); DualForceLP:
+    its nonbasic rows and its nonbasic columns (a free y at 0). None unless they add up to one
+    equation per balance row."""
+    last = _last(lp)
+    basic = last.hs.HighsBasisStatus.kBasic
+    basis = last.h.getBasis()
+    if isinstance(last, DualForceLP):  # its rows are the cone coordinates: active = nonbasic
+        zero = np.array([n for n, s in enumerate(basis.col_status) if s != basic], dtype=int)
+        cols = np.array([n for n, s in enumerate(basis.row_status) if s != basic], dtype=int)
+    else:  # the balance rows are equalities: a basic row is a rank defect
+        zero = np.array([n for n, s in enumerate(basis.row_status) if s == basic], dtype=int)
+        cols = np.array([n for n, s in enumerate(basis.col_status) if s == basic], dtype=int)
+    return (cols, zero) if cols.size + zero.size == prob.A.shape[0] else None
+
+
+def _dual_exact(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
+                lam: np.ndarray, fixed: tuple[int, ...], infeasible: float) -> Evidence | None:
+    """The dual check of an optimum whose float checks passed, beyond DUAL_TOL: None when
+
+    * exactly: verify.statics.exact's dual_bound (the basis' y solved in rationals, every
+      reduced cost >= 0 exactly, after at most exact.MAX_PIVOTS pivots) gives a bound b . y
+      within DUAL_TOL of the force scale of the value (P of at most exact.EXACT_MAX_ROWS
+      balance rows), or else
+    * in floats, y's dual infeasibility (dual_defects: -min d / max(1, |y|)) is at most
+      ROUND_TOL: then every ray r >= 0 of P (K r = 0) has cost . T r >= -ROUND_TOL max(1, |y|)
+      sum r, to the rounding of d; a ray shallower than that is not excluded
+      (docs/packings.md, "Still open"). DUAL_TOL alone let a slope of 4e-6 through where the
+      exact check finds none: n 13, seed 592, mu 1.078125.
+
+    Else the evidence "dual exact" (its value: the exact bound's gap, NaN when there is
+    none)."""
+    gap = np.nan
+    if prob.A.shape[0] <= exact.EXACT_MAX_ROWS:
+        basis = _basis_columns(prob, lp)
+        bound = None if basis is None else exact.dual_bound(prob, cost, *basis, fixed)
+        if bound is not None:
+            obj = float(np.asarray(cost, dtype=float) @ lam)
+            gap = abs(obj - float(bound)) / max(prob.scale, abs(obj))
+            if gap <= DUAL_TOL:
+                return None
+    if infeasible <= ROUND_TOL:
+        return None
+    return Evidence("dual exact", gap, DUAL_TOL, "optimal")
+
+
+def _infeasible(prob: StaticProblem, lp: DualForceLP | ForceLP,
+                fixed: tuple[int, ...]) -> Evidence | None:
+    """None when the LP's "infeasible" for the face of P with the `fixed` cone columns at 0
+    carries a checked Farkas certificate (HiGHS's dual ray, verify.statics.exact's
+    face_empty), else the evidence "farkas" (also when the LP's status is another)."""
+    last = _last(lp)
+    if not isinstance(last, ForceLP) or last.h.getModelStatus() != \
+            last.hs.HighsModelStatus.kInfeasible:
+        return Evidence("LP status", np.nan, 0.0, "infeasible")
+    _, has_ray, values = last.h.getDualRay()
+    k = prob.fric.size
+    rows = tuple(int(prob.fric[j]) if j < k else prob.c + j - k if j < 2 * k else int(
+        np.flatnonzero(prob.mu == 0)[j - 2 * k]) for j in fixed)
+    if has_ray and exact.face_empty(prob, np.asarray(values, dtype=float), rows):
+        return None
+    # no ray, or one that fails: Farkas LPs of our own
+    if any(exact.face_empty(prob, y, rows) for y in exact.face_farkas_lp(prob, rows)):
+        return None
+    return Evidence("farkas", np.nan, 0.0, "infeasible")

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
@@ -23,7 +23,8 @@ from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 
 
 def _unfiltered_ends(prob: StaticProblem) -> tuple[np.ndarray, np.ndarray]:
-    """Every end by its own LP (linprog, cone rows as rows, no warm start, no filter)."""
+    """Every end by its own LP (linprog, cone rows as rows, no warm start, no filter); NaN
+    where linprog fails on each of its methods (status 4)."""
     bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
               for lo, hi in zip(prob.lb, prob.ub)]
     lo, hi = np.zeros(prob.n), np.zeros(prob.n)
@@ -31,14 +32,20 @@ def _unfiltered_ends(prob: StaticProblem) -> tuple[np.ndarray, np.ndarray]:
         for sgn, out in ((1.0, lo), (-1.0, hi)):
             e = np.zeros(prob.n)
             e[k] = sgn
-            res = linprog(e, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
-                          b_eq=prob.b, bounds=bounds, method="highs")
-            assert res.status in (0, 3), res.message
-            out[k] = res.x[k] if res.status == 0 else -sgn * np.inf
+            for method in ("highs", "highs-ds", "highs-ipm"):
+                res = linprog(e, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
+                              b_eq=prob.b, bounds=bounds, method=method)
+                if res.status != 4:  # 4: the reference's own numerical failure (HiGHS's
+                    break  # "Solve error": n 11, seed 110, mu 0.99999): try another method
+            assert res.status in (0, 3, 4), res.message
+            # NaN: no reference for this end (linprog failed on every method); not compared
+            out[k] = res.x[k] if res.status == 0 else -sgn * np.inf if res.status == 3 else np.nan
     return lo, hi
 
 
 def _same(got: np.ndarray, want: np.ndarray, scale: float) -> None:
+    known = ~np.isnan(want)  # NaN: linprog, the reference, failed there
+    got, want = got[known], want[known]
     inf = ~np.isfinite(want)
     assert np.array_equal(got[inf], want[inf]), np.flatnonzero(inf)
     assert np.all(np.abs(got[~inf] - want[~inf]) <= 1e-7 * scale), np.max(
@@ -107,6 +114,7 @@ def test_two_worker_processes_give_the_serial_ranges(n, seed, mu):
 @settings(max_examples=6)
 @given(n=st.integers(3, 12), seed=st.integers(0, 10**4), mu=st.floats(0.1, 1.0),
        through_dual=st.booleans())
+@example(n=11, seed=110, mu=0.99999, through_dual=True)  # linprog's "Solve error" (retried)
 def test_dual_bound_certifies_the_optimum_and_refuses_a_cost_it_does_not_bound(n, seed, mu,
                                                                               through_dual):
     """ForceLP.certified (row duals) and DualForceLP.certified (the dual LP's optimum): the y

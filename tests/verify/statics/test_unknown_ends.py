@@ -8,6 +8,7 @@ reported as "unknown" with its evidence in the JSON and the command's text.
 from __future__ import annotations
 
 import json
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -18,7 +19,7 @@ from scipy.optimize import linprog
 from rigidlcp import models
 from rigidlcp.cli.main import main
 from rigidlcp.models.deposition import deposit
-from rigidlcp.verify.statics import contact_ranges, ends
+from rigidlcp.verify.statics import contact_ranges, ends, exact
 from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of
 from rigidlcp.verify.statics.forceset import analyse
 from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
@@ -144,7 +145,7 @@ def test_an_unbounded_answer_without_a_checked_ray_is_solved_again():
 def test_a_sliding_lp_that_fails_warm_is_solved_cold():
     """n 17, seed 16, mu 1.015625 (the deep profile, after the fix above): the warm sliding LP
     of contact 33 with S = -mu R imposed ends "failed" (no answer); it is solved cold (HiGHS:
-    that face is empty, taken as it is, as a warm "infeasible" is), not left unknown."""
+    that face is empty, with its Farkas certificate checked), not left unknown."""
     fs = analyse(_pile(17, 16, 1.015625))
     assert fs.exists and fs.unchecked == 0 and not np.any(fs.sliding_unknown)
     assert fs.retried >= 1 and not fs.unknown
@@ -255,25 +256,65 @@ def test_an_end_whose_check_fails_is_unknown_in_the_json_and_the_text(tmp_path, 
     assert "unknown: 1 range ends" in text and f"max R of contact {a}, dual gap 0.001" in text
 
 
-# --- found by the last deep run, not fixed (docs/packings.md, "Still open") -------------------
+# --- found by the deep run: a tolerance-level certificate, now checked exactly ------------------
 
-@pytest.mark.xfail(strict=True, reason="a dual certificate within DUAL_TOL x |y| can hide a "
-                   "ray of slope 4e-6 (docs/packings.md, Still open)")
-def test_a_bounded_end_is_not_certified_past_a_shallow_ray():
-    """n 13, seed 592, mu 1.078125: analyse reports max R of contact 12 = 2639.1, certified;
-    the cold primal simplex and linprog say unbounded, and the ray LP finds a descent of
-    slope 4.3e-6 whose vertex misses the sign check by 1.4e-8."""
+def _exact_lower_bound(system: models.System, cost: np.ndarray, y) -> Fraction:
+    """b . y, after checking in Fractions, from models.Dynamics alone, that y (rational, one per
+    balance row) certifies min cost . lambda >= b . y on P: z = cost - H y has z_R >= mu |z_S|
+    at every contact (z_S = anything where mu = 0 is not allowed here: z_R >= 0, S = 0 there),
+    so cost . lambda = b . y + z . lambda >= b . y for every lambda in P (b = -f)."""
+    dyn = models.Dynamics(system)
+    H = dyn.H.tocoo()  # (2c x 3p): lambda's rows
+    c = system.c
+    z = [Fraction(float(v)) for v in cost]
+    for i, j, v in zip(H.row, H.col, H.data):
+        z[i] -= Fraction(float(v)) * y[j]
+    for a in range(c):
+        mu = Fraction(float(system.mu[a]))
+        assert z[a] - mu * abs(z[c + a]) >= 0 if mu > 0 else z[a] >= 0 and z[c + a] == 0, a
+    return sum((-Fraction(float(f)) * yi for f, yi in zip(dyn.f, y)), Fraction(0))
+
+
+def test_a_bounded_end_is_not_certified_past_a_shallow_ray(monkeypatch):
+    """n 13, seed 592, mu 1.078125: max R of contact 12 = 2639.1 was certified by a dual y whose
+    reduced costs were >= -1e-8 |y| only, which a ray of slope 4.3e-6 (the ray LP's, missing
+    its sign check by 1.4e-8; HiGHS's cold primal simplex and linprog say "unbounded") could
+    hide behind. The end is now certified exactly: the optimal basis' y, solved in rationals,
+    has every reduced cost >= 0 exactly, so no ray of the stored P raises R of contact 12 (the
+    float rays are rounding); its bound, re-checked here in Fractions from models.Dynamics,
+    is the reported end. A basis certified for one objective certifies no wrong bound for the
+    opposite one."""
     system = _pile(13, 592, 1.078125)
-    fs = analyse(system)
-    assert fs.hi[12] == _linprog_end(StaticProblem(system), 12, -1.0) or np.isnan(fs.hi[12])
+    prob = StaticProblem(system)
+    seen = []
+    real = exact.dual_bound
+
+    def recorded(prob, cost, basic, zero=(), fixed=()):
+        got = real(prob, cost, basic, zero, fixed, want_y=True)
+        if cost[12] < 0 and not fixed:
+            seen.append((basic, zero, got))
+        return None if got is None else got[0]
+
+    monkeypatch.setattr(exact, "dual_bound", recorded)
+    fs = analyse(system)  # the warm LPs' optimum (cold, HiGHS says "unbounded")
+    basic, zero, got = seen[-1]
+    assert got is not None and fs.unchecked == 0
+    bound = _exact_lower_bound(system, -np.eye(prob.n)[12], got[1])
+    assert bound == got[0]
+    assert np.isfinite(fs.hi[12]) and abs(fs.hi[12] + float(bound)) <= 1e-9 * fs.hi[12]
+    other = real(prob, np.eye(prob.n)[12], basic, zero)
+    assert other is None or float(other) <= fs.lo[12] + 1e-9 * max(1.0, abs(fs.lo[12]))
 
 
-@pytest.mark.xfail(strict=True, reason="a sliding face LP's 'infeasible' is taken unchecked "
-                   "(docs/packings.md, Still open)")
-def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word():
+def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word(monkeypatch):
     """n 13, seed 1, mu 0.99999, contact 0 by the dual LP, 1-25 by a warm primal simplex (as
-    test_contact_ranges's chunks): both sliding LPs of contact 19 answer "infeasible" warm,
-    so it "cannot slide", but the serial run has a checked optimum with S = mu R, R > 0."""
+    test_contact_ranges's chunks): both sliding LPs of contact 19 answer "infeasible" warm.
+    That answer now needs a checked Farkas certificate, and it has one: both faces S = +-mu R
+    of contact 19 are empty, exactly (for the stored data). The serial run said "can slide"
+    from a witness within 1e-9 of its largest force (2.8e8 weights) of the bound, where
+    mu R - |S| was 6% of R: the witness must now be at the bound to 1e-9 of the contact's own
+    R, and both runs agree that contact 19 cannot slide. With the certificate check refused,
+    the verdict is unknown, not "cannot slide"."""
     system = _pile(13, 1, 0.99999)
     serial = analyse(system)
     fs = analyse(system, ranges=False)
@@ -291,4 +332,48 @@ def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word():
         hi[ch] = hi_x[:len(ch)]
     got = np.concatenate([contact_ranges.sliding_of(prob, primal[x], fs.implicit, hi, wit.seen,
                                                     ch)[0] for x, ch in enumerate(chunks)])
-    assert serial.sliding[19] and got[19]
+    assert serial.unchecked == 0 and not serial.sliding[19] and not got[19]
+    k = int(np.flatnonzero(prob.fric == 19)[0])
+    for row in (19, c + k):  # S - mu R <= 0 made an equality, then -S - mu R <= 0
+        assert any(exact.face_empty(prob, y, (row,)) for y in exact.face_farkas_lp(prob, (row,)))
+    # a face holding a point of P far from its tolerances (R > 0.1 weights, forces < 1e3
+    # weights) has no certificate: neither the Farkas LP's y nor random ones pass face_empty
+    rng = np.random.default_rng(1)
+    tried = 0
+    for a in range(c):
+        face = ForceLP(prob)
+        col = face.set_cone_row(int(np.flatnonzero(prob.fric == a)[0]), True)
+        e = np.zeros(prob.n)
+        e[a] = -1.0
+        status, lam = face.solve(e)
+        if status != "optimal" or not (lam[a] > 0.1 * prob.scale and _in_P(system, lam)
+                                       and np.max(np.abs(lam)) < 1e3 * prob.scale):
+            continue
+        assert abs(lam[c + a] - prob.mu[a] * lam[a]) <= 1e-9 * lam[a], col
+        tried += 1
+        ys = list(exact.face_farkas_lp(prob, (a,))) + list(rng.standard_normal((3, 3 * prob.p)))
+        for y in ys:
+            assert not exact.face_empty(prob, y, (a,)), a
+    assert tried > 0
+    monkeypatch.setattr(exact, "face_empty", lambda *a: False)
+    doubt = analyse(system)
+    assert doubt.sliding_unknown[19] and not doubt.sliding[19] and doubt.unchecked >= 1
+
+
+def test_an_unbounded_answer_whose_rays_fail_cold_is_solved_by_the_cold_dual():
+    """n 9, seed 342, mu 0.99999 (the deep profile, after the fixes above), contacts 1..c-1 by
+    a warm primal simplex: max R of contact 2 is "unbounded" warm and cold with rays whose
+    descent (9e-12, 4e-11 of their size) fails its check, and our ray LP finds none; it was
+    unknown. The cold dual simplex's optimum passes every check (its certificate exactly):
+    the end is a checked number, equal to linprog's."""
+    system = _pile(9, 342, 0.99999)
+    fs = analyse(system, ranges=False)
+    prob = StaticProblem(system)
+    lp = ForceLP(prob)
+    lp.solve(np.zeros(prob.n))
+    unknown: list = []
+    _, hi, _, unchecked = ranges_of(prob, lp, fs.implicit, np.arange(1, prob.c),
+                                    Witnesses.of(prob, fs.solution), unknown=unknown)
+    assert unchecked == 0 and not unknown
+    want = _linprog_end(prob, 2, -1.0)
+    assert np.isfinite(hi[1]) and abs(hi[1] - want) <= 1e-7 * want
