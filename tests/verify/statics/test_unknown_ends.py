@@ -142,13 +142,33 @@ def test_an_unbounded_answer_without_a_checked_ray_is_solved_again():
     _agree(prob, lo, hi, [3, c + 3])
 
 
-def test_a_sliding_lp_that_fails_warm_is_solved_cold():
+def test_a_sliding_lp_that_fails_warm_is_solved_cold(monkeypatch):
     """n 17, seed 16, mu 1.015625 (the deep profile, after the fix above): the warm sliding LP
-    of contact 33 with S = -mu R imposed ends "failed" (no answer); it is solved cold (HiGHS:
-    that face is empty, with its Farkas certificate checked), not left unknown."""
+    of contact 33 with S = -mu R imposed ends "failed" (no answer) with highspy 1.16; it is
+    solved cold (HiGHS: that face is empty, with its Farkas certificate checked), not left
+    unknown. highspy 1.10 (the lowest pyproject allows) answers it warm: the retry is then
+    asserted only where a warm sliding LP did fail (recorded here), the outcome always."""
+    warm = []  # the first (warm) status of every sliding LP
+    real = contact_ranges.settle
+
+    def spy(prob, lp, cost, *args, **kwargs):
+        if kwargs.get("cold") is not None:
+            solve = lp.solve
+
+            def first(c):
+                out = solve(c)
+                warm.append(out[0])
+                lp.solve = solve
+                return out
+            lp.solve = first
+        return real(prob, lp, cost, *args, **kwargs)
+
+    monkeypatch.setattr(contact_ranges, "settle", spy)
     fs = analyse(_pile(17, 16, 1.015625))
     assert fs.exists and fs.unchecked == 0 and not np.any(fs.sliding_unknown)
-    assert fs.retried >= 1 and not fs.unknown
+    assert not fs.unknown and warm
+    if "failed" in warm:
+        assert fs.retried >= 1
 
 
 def test_an_unbounded_end_whose_highs_ray_misses_its_check_gets_a_ray_of_its_own():
