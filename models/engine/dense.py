@@ -26,7 +26,6 @@ from rigidlcp.models.event import (
 from rigidlcp.models.selection import Selection, select
 from rigidlcp.models.system import System
 
-from .closed import closed_solution
 from .loop import TRANSLATION_FACTOR, Outcome
 
 #: How an event's particular solution is chosen when it is not unique (see `DenseBackend`;
@@ -110,6 +109,8 @@ class DenseBackend:
         if self.closed_search and residual <= self.check_tol * scale and leaves_regime(
                 ep, es, residual):
             self.closed_searched += 1
+            from .closed import closed_solution  # scipy.optimize only when a run would stop
+
             found = closed_solution(ep, scale, self.check_tol)
             note = found.message
             if found.status == "found":  # checked again by the engine's own acceptance
