@@ -87,7 +87,12 @@ static PyObject *solution(PyObject *z, PyObject *w, long long pivots, double raw
     int ok = v[4] && v[5] && v[7] && v[12] && v[13];
     for (int k = 0; ok && k < 14; k++) ok = PyDict_SetItem(d, s_keys[k], v[k]) == 0;
     if (ok) sol = PyObject_CallOneArg(s_new, s_cls); /* object.__new__(Solution) */
-    if (sol && PyObject_GenericSetDict(sol, d, NULL) < 0) Py_CLEAR(sol);
+    if (sol) { /* its fields into its own __dict__: replacing the dict (GenericSetDict) is not
+                  seen by Python 3.13's inline attribute values */
+        PyObject *own = PyObject_GenericGetDict(sol, NULL);
+        if (!own || PyDict_Update(own, d) < 0) Py_CLEAR(sol);
+        Py_XDECREF(own);
+    }
     Py_XDECREF(v[4]);
     Py_XDECREF(v[5]);
     Py_XDECREF(v[7]);
