@@ -26,7 +26,14 @@ from fractions import Fraction
 import numpy as np
 import scipy.sparse as sp
 
-from .farkas import RADIUS_WEIGHTS, cone_rows, first_exact, rational, small_rational
+from .farkas import (
+    RADIUS_WEIGHTS,
+    cone_rows,
+    exact_cone_rows,
+    first_exact,
+    rational,
+    small_rational,
+)
 from .model import StaticProblem
 
 #: Largest number of balance rows (3 per disk) of an exact check (a dense rational solve: 0.08
@@ -160,7 +167,6 @@ def face_empty(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> bo
     farkas.RADIUS_WEIGHTS times the weight (the standard of farkas.check), else exactly,
     b . y < 0 and C y <= 0 on the other rows for the stored data (module docstring), on P
     of at most EXACT_MAX_ROWS balance rows."""
-    from flint import fmpq
 
     m = prob.A.shape[0]
     y = np.asarray(y, dtype=float)
@@ -172,18 +178,7 @@ def face_empty(prob: StaticProblem, y: np.ndarray, equal: tuple[int, ...]) -> bo
         return True
     if m > EXACT_MAX_ROWS:
         return False
-    c, mu = prob.c, prob.mu
-    H = sp.coo_matrix(prob.A.T)
-    Hq = [[fmpq(0)] * m for _ in range(2 * c)]
-    for i, j, v in zip(H.row, H.col, H.data):
-        Hq[int(i)][int(j)] = rational(v)
-    rows = []  # C exactly (farkas.exact_certificate)
-    for a in range(c):
-        mq = rational(mu[a])
-        rows.append([-hn + mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
-    for a in np.flatnonzero(mu > 0):
-        mq = rational(mu[a])
-        rows.append([-hn - mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
+    rows = exact_cone_rows(prob)  # C exactly
     keep = [r for n, r in enumerate(rows) if n not in set(equal)]
     bq = [rational(v) for v in prob.b]
     C = cone_rows(prob)

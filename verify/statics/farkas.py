@@ -186,10 +186,9 @@ def small_rational(x: float):
     return fmpq(f.numerator, f.denominator)
 
 
-def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e-9
-                      ) -> Certificate | None:
-    """A rational y near the float y with the nearly active cone rows exactly active, checked
-    exactly: C y <= 0 and b . y < 0 for the stored (float) H, b, mu (module docstring)."""
+def exact_cone_rows(prob: StaticProblem) -> list[list]:
+    """The cone rows C of `cone_rows` in rationals: -H_n + mu H_t for every contact, then
+    -H_n - mu H_t where mu > 0 (one list of fmpq per row, one entry per balance row)."""
     from flint import fmpq
 
     c, mu, m = prob.c, prob.mu, prob.A.shape[0]
@@ -197,13 +196,21 @@ def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e
     Hq = [[fmpq(0)] * m for _ in range(2 * c)]
     for i, j, v in zip(H.row, H.col, H.data):
         Hq[int(i)][int(j)] = rational(v)
-    rows = []  # C exactly: -H_n + mu H_t, then -H_n - mu H_t where mu > 0
+    rows = []
     for a in range(c):
         mq = rational(mu[a])
         rows.append([-hn + mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
     for a in np.flatnonzero(mu > 0):
         mq = rational(mu[a])
         rows.append([-hn - mq * ht for hn, ht in zip(Hq[a], Hq[c + a])])
+    return rows
+
+
+def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e-9
+                      ) -> Certificate | None:
+    """A rational y near the float y with the nearly active cone rows exactly active, checked
+    exactly: C y <= 0 and b . y < 0 for the stored (float) H, b, mu (module docstring)."""
+    rows = exact_cone_rows(prob)
     bq = [rational(v) for v in prob.b]
     y = np.asarray(y, dtype=float) / float(np.max(np.abs(y)))
     g = cone_rows(prob) @ y
