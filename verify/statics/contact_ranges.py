@@ -6,11 +6,12 @@ the previous optimum) checked to lie in P and certified by the dual's optimum y 
 `DualForceLP.certified`; an infinite end by HiGHS's primal ray of ForceLP,
 `ForceLP.ray_checked`); an answer failing its check is retried (its basis solved again, then
 a cold LP: verify.statics.ends) and, when no retry passes, the end is unknown: NaN in lo / hi,
-listed with the evidence in `unknown`, never a number nor +-inf. Or the end is a bound that
-holds on all of P and is attained at a checked point of P, so needs no LP: min R = 0 (R >= 0)
-when some checked point has R = 0, and max S = mu max R (S <= mu R) or min S = -mu max R when
-one has S = +-mu max R. Witness values are within 1e-9 of the force scale of the bound, as LP
-optima are.
+listed with the evidence in `unknown`, never a number nor +-inf. Or the end needs no LP
+(verify.statics.range_ends, which also orders the LPs): a bound that holds on all of P and is
+attained at a checked point of P (min R = 0 when some checked point has R = 0, max S = mu max R
+or min S = -mu max R when one has S = +-mu max R; witness values within 1e-9 of the force
+scale of the bound, as LP optima are), or an optimal basis kept from an earlier LP that is
+optimal for this end too, with the same check as an LP's optimum.
 
 With jobs > 1 the contacts are cut into chunks solved by `jobs` worker processes, each holding
 its own LPs of P warm from chunk to chunk; the witnesses found so far (by every worker)
@@ -30,39 +31,13 @@ import numpy as np
 from rigidlcp import models
 from rigidlcp.lcp.errors import InvalidInput
 
-from .ends import Evidence, Unknown, settle
+from .ends import Unknown, settle
 from .hull import ZERO
 from .model import DualForceLP, ForceLP, StaticProblem
+from .range_ends import Vertices, Witnesses, at_bound, ranges_of
 
-
-@dataclass
-class Witnesses:
-    """Per contact, over the checked points of P met so far: the smallest R (r_min), the
-    largest and smallest S (s_max, s_min), and whether |S| = mu R with R > 0 (seen)."""
-
-    r_min: np.ndarray
-    s_max: np.ndarray
-    s_min: np.ndarray
-    seen: np.ndarray
-
-    @classmethod
-    def of(cls, prob: StaticProblem, lam: np.ndarray) -> Witnesses:
-        c = prob.c
-        return cls(lam[:c].copy(), lam[c:].copy(), lam[c:].copy(), at_bound(prob, lam))
-
-    def add(self, prob: StaticProblem, lam: np.ndarray) -> None:
-        c = prob.c
-        self.seen |= at_bound(prob, lam)
-        np.minimum(self.r_min, lam[:c], out=self.r_min)
-        np.maximum(self.s_max, lam[c:], out=self.s_max)
-        np.minimum(self.s_min, lam[c:], out=self.s_min)
-
-    def merge(self, other: Witnesses) -> None:
-        """Each entry is attained at some checked point, so the best of two is too."""
-        self.seen |= other.seen
-        np.minimum(self.r_min, other.r_min, out=self.r_min)
-        np.maximum(self.s_max, other.s_max, out=self.s_max)
-        np.minimum(self.s_min, other.s_min, out=self.s_min)
+__all__ = ["Ranges", "Vertices", "Witnesses", "at_bound", "contact_ranges", "lp_count",
+           "ranges_of", "sliding_of"]
 
 
 @dataclass
@@ -83,90 +58,10 @@ class Ranges:
     retried: int = 0
 
 
-def at_bound(prob: StaticProblem, lam: np.ndarray) -> np.ndarray:
-    """Contacts at the Coulomb bound with R > 0 at a checked point of P (|S| >= mu R up to
-    1e-9 of the contact's own R or the largest weight, R > ZERO x scale): witnesses that they
-    can slide. (Up to 1e-9 of the largest force of the point, as before, a contact with
-    mu R - |S| = 0.118 = 0.06 R counted as sliding beside forces of 2.8e8 weights, where
-    that face of P is empty, proved exactly: n 13, seed 1, mu 0.99999; docs/packings.md.)"""
-    c, mu = prob.c, prob.mu
-    R, S = lam[:c], lam[c:]
-    tol = 1e-9 * np.maximum(prob.scale, np.abs(R))
-    return (mu > 0) & (R > ZERO * prob.scale) & (np.abs(S) >= mu * R - tol)
-
-
 def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
     """The most range LPs `contact_ranges` may need (the progress total)."""
     todo = [a for a in range(prob.c) if implicit[a] != "R=0"]
     return 2 * len(todo) + 2 * sum(1 for a in todo if prob.mu[a] > 0 and not implicit[a])
-
-
-def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str],
-              contacts: np.ndarray, wit: Witnesses, step: Callable[[int], None] | None = None,
-              unknown: list[Unknown] | None = None, retried: list[int] | None = None
-              ) -> tuple[np.ndarray, np.ndarray, int, int]:
-    """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S; NaN: unknown),
-    LPs solved, ends reported unknown (their check failed after the retries; appended to
-    `unknown` with their evidence, indices in P's [R; S]); wit is updated with every checked
-    optimum; retried[0] counts the answers settled by a retry. step(n): called with the
-    number of ends settled (by LP or filter) after each contact."""
-    c, n, mu = prob.c, prob.n, prob.mu
-    m = len(contacts)
-    lo, hi = np.zeros(2 * m), np.zeros(2 * m)
-    lps = 0
-    found: list[Unknown] = []
-
-    def bound(k: int, sgn: float) -> float:
-        nonlocal lps
-        e = np.zeros(n)
-        e[k] = sgn
-        end = settle(prob, lp, e)
-        lps += end.lps
-        if retried is not None:
-            retried[0] += end.retried
-        if end.status == "unbounded":
-            return -sgn * np.inf
-        if end.status == "unknown":
-            found.append(Unknown(int(k), "min" if sgn > 0 else "max", end.evidence))
-            return np.nan
-        wit.add(prob, end.lam)
-        return float(end.lam[k])
-
-    def tol() -> float:
-        return 1e-9 * prob.scale
-
-    for x, a in enumerate(contacts):
-        kind, ends = implicit[a], 0
-        if kind == "R=0":  # R = S = 0 on all of P
-            if step:
-                step(0)
-            continue
-        hi[x] = bound(a, -1.0)
-        lo[x] = max(float(wit.r_min[a]), 0.0) if wit.r_min[a] <= ZERO * prob.scale else \
-            bound(a, 1.0)  # R = 0 attained: min R = 0
-        ends += 2
-        if mu[a] > 0 and kind:  # S = +- mu R on all of P
-            sg = mu[a] if kind == "S=+muR" else -mu[a]
-            lo[m + x], hi[m + x] = ((sg * lo[x], sg * hi[x]) if sg > 0 else
-                                    (sg * hi[x], sg * lo[x]))
-            for side, v in (("min", lo[m + x]), ("max", hi[m + x])):
-                if np.isnan(v):  # S = +-mu R of an unknown end of R: unknown too
-                    found.append(Unknown(c + int(a), side, Evidence(
-                        "from R", np.nan, 0.0, "S = +-mu R of an unknown R end")))
-        elif mu[a] > 0:
-            top = mu[a] * hi[x]
-            hi[m + x] = (min(float(wit.s_max[a]), top)
-                         if np.isfinite(top) and wit.s_max[a] >= top - tol()
-                         else bound(c + a, -1.0))
-            lo[m + x] = (max(float(wit.s_min[a]), -top)
-                         if np.isfinite(top) and wit.s_min[a] <= -top + tol()
-                         else bound(c + a, 1.0))
-            ends += 2
-        if step:
-            step(ends)
-    if unknown is not None:
-        unknown.extend(found)
-    return lo, hi, lps, len(found)
 
 
 def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.ndarray,
@@ -279,7 +174,7 @@ def _start(system: models.System) -> None:
     lp.solve(np.zeros(prob.n))
     dual = DualForceLP(prob, lp)
     dual.solve(np.zeros(prob.n))
-    _WORKER.update(prob=prob, lp=lp, dual=dual)
+    _WORKER.update(prob=prob, lp=lp, dual=dual, vertices=Vertices(prob, lp.nw))
 
 
 def _range_chunk(task):
@@ -287,7 +182,7 @@ def _range_chunk(task):
     unknown: list[Unknown] = []
     retried = [0]
     lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["dual"], implicit, contacts,
-                                       wit, None, unknown, retried)
+                                       wit, None, unknown, retried, _WORKER["vertices"])
     return contacts, lo, hi, lps, unchecked, wit, unknown, retried[0]
 
 

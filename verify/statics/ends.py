@@ -85,7 +85,8 @@ class Settled:
     """An end: status "optimal" (lam: a checked optimum), "unbounded" (a checked ray) or
     "unknown" (evidence: the last try's failed check); lps: LPs solved; how: the try that
     settled it ("warm", "basis", "ray LP", "cold", "cold basis", "cold dual"; "" when
-    unknown); first: the warm answer's evidence when a retry was needed."""
+    unknown; "vertex": a kept basis, `at_basis`; "kept start": the LP again from a kept basis,
+    verify.statics.range_ends); first: the warm answer's evidence when a retry was needed."""
 
     status: str
     lam: np.ndarray | None
@@ -197,9 +198,10 @@ def ray_lp(prob: StaticProblem, primal: ForceLP, cost: np.ndarray,
 
 def judge(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray, status: str,
           lam: np.ndarray | None, fixed: tuple[int, ...] = (),
-          y: np.ndarray | None = None) -> Evidence | None:
+          y: np.ndarray | None = None, basis: np.ndarray | None = None) -> Evidence | None:
     """None when lp's last answer passes its check (module docstring), else the evidence; y:
-    the dual certificate to read (default: the LP's own)."""
+    the dual certificate to read (default: the LP's own); basis: the basic cone columns that
+    gave lam and y (default: the LP's last basis), for the exact dual check."""
     if status == "optimal":
         checks = [("balance", prob.backward_error(lam), BALANCE_TOL),
                   ("laws", prob.law_error(lam), BALANCE_TOL)]
@@ -209,7 +211,7 @@ def judge(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray, stat
         for name, value, tol in checks:
             if not value <= tol:
                 return Evidence(name, value, tol, status)
-        return _dual_exact(prob, lp, cost, lam, fixed, infeasible)
+        return _dual_exact(prob, lp, cost, lam, fixed, infeasible, basis)
     if status == "unbounded":
         last = _last(lp)
         if not isinstance(last, ForceLP):
@@ -244,14 +246,51 @@ def _rebasis(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
              fixed: tuple[int, ...]) -> np.ndarray | None:
     """The last optimal basis solved again (module docstring, 1.): lambda when it passes the
     check with its own y, else None (also when the basis is not square or is singular)."""
-    from scipy.sparse.linalg import splu
-
-    primal = _primal(lp)
     basis = _basis_columns(prob, lp)
     if basis is None or basis[1].size:
         return None
-    cols = basis[0]
-    KB = sp.csc_matrix(primal.KT.T)[:, cols]
+    got = _solve_basis(prob, _primal(lp), basis[0], cost)
+    if got is None:
+        return None
+    lam, y = got
+    return lam if judge(prob, _primal(lp), cost, "optimal", lam, fixed, y,
+                        basis[0]) is None else None
+
+
+def at_basis(prob: StaticProblem, lp: DualForceLP | ForceLP, cols: np.ndarray,
+             cost: np.ndarray) -> Settled | None:
+    """min cost . lambda over P settled without an LP at a basis kept from an earlier optimum
+    (cols: its basic cone columns, `basis_of`): its vertex w_B = K_B^-1 b and y = K_B^-T c_B by
+    one sparse LU, the same check as an LP's answer (`judge`: in P, dual feasible, no gap,
+    and the exact or rounding-level dual check on this basis). A Settled "optimal" with
+    lps 0 and how "vertex" when it passes, else None (the basis is not optimal for cost)."""
+    got = _solve_basis(prob, _primal(lp), cols, cost)
+    if got is None:
+        return None
+    lam, y = got
+    primal = _primal(lp)
+    d = np.asarray(primal.TT @ np.asarray(cost, dtype=float)) - primal.KT @ y
+    if float(np.min(d, initial=0.0)) < -ROUND_TOL * max(1.0, float(np.max(np.abs(y)))):
+        return None  # a reduced cost < 0: not optimal (cheaply, before the full check)
+    if judge(prob, primal, cost, "optimal", lam, (), y, cols) is not None:
+        return None
+    return Settled("optimal", lam, 0, how="vertex")
+
+
+def basis_of(prob: StaticProblem, lp: DualForceLP | ForceLP) -> np.ndarray | None:
+    """The basic cone columns of lp's last optimum when they form a square basis of the
+    balance rows (for `at_basis`), else None."""
+    basis = _basis_columns(prob, lp)
+    return None if basis is None or basis[1].size else basis[0]
+
+
+def _solve_basis(prob: StaticProblem, primal: ForceLP, cols: np.ndarray, cost: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray] | None:
+    """(lambda = T w with w_B = K_B^-1 b, y = K_B^-T c_B) of the basis `cols` by one sparse
+    LU, or None when K_B is singular or the values are not finite."""
+    from scipy.sparse.linalg import splu
+
+    KB = primal.K[:, cols]
     try:
         lu = splu(sp.csc_matrix(KB))
     except RuntimeError:  # singular
@@ -262,8 +301,7 @@ def _rebasis(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
     y = lu.solve(c[cols], trans="T")
     if not (np.all(np.isfinite(w)) and np.all(np.isfinite(y))):
         return None
-    lam = primal.T @ w
-    return lam if judge(prob, primal, cost, "optimal", lam, fixed, y) is None else None
+    return primal.T @ w, y
 
 
 def _basis_columns(prob: StaticProblem, lp: DualForceLP | ForceLP
@@ -285,7 +323,8 @@ def _basis_columns(prob: StaticProblem, lp: DualForceLP | ForceLP
 
 
 def _dual_exact(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
-                lam: np.ndarray, fixed: tuple[int, ...], infeasible: float) -> Evidence | None:
+                lam: np.ndarray, fixed: tuple[int, ...], infeasible: float,
+                cols: np.ndarray | None = None) -> Evidence | None:
     """The dual check of an optimum whose float checks passed, beyond DUAL_TOL: None when
 
     * exactly: verify.statics.exact's dual_bound (the basis' y solved in rationals, every
@@ -299,10 +338,10 @@ def _dual_exact(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray
       exact check finds none: n 13, seed 592, mu 1.078125.
 
     Else the evidence "dual exact" (its value: the exact bound's gap, NaN when there is
-    none)."""
+    none). cols: the basis of lam (default: lp's last basis)."""
     gap = np.nan
     if prob.A.shape[0] <= exact.EXACT_MAX_ROWS:
-        basis = _basis_columns(prob, lp)
+        basis = _basis_columns(prob, lp) if cols is None else (cols, np.zeros(0, dtype=int))
         bound = None if basis is None else exact.dual_bound(prob, cost, *basis, fixed)
         if bound is not None:
             obj = float(np.asarray(cost, dtype=float) @ lam)

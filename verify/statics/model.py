@@ -135,6 +135,15 @@ class ForceLP:
         self.cols = np.arange(nw, dtype=np.int32)
         self.TT = sp.csr_matrix(self.T.T)
         self.KT = sp.csr_matrix((prob.A @ self.T).T)  # the balance rows' transpose, in w
+        self._K: sp.csc_matrix | None = None
+
+    @property
+    def K(self) -> sp.csc_matrix:
+        """The balance rows in cone coordinates, K = A T, by columns (built once): the
+        bases' columns are cut from it (verify.statics.ends)."""
+        if self._K is None:
+            self._K = sp.csc_matrix(self.KT.T)
+        return self._K
 
     def solve(self, cost: np.ndarray) -> tuple[str, np.ndarray | None]:
         """("optimal", lambda) | ("unbounded", None) | ("infeasible", None) | ("failed", None)."""
@@ -282,6 +291,20 @@ class DualForceLP:
             return "optimal", self.primal.T @ w
         self.last = self.primal
         return self.primal.solve(cost)
+
+    def set_basis(self, cols: np.ndarray) -> None:
+        """Start the next solve from the basis of a vertex of P: `cols`, its basic cone columns
+        (one per balance row), are the dual LP's tight rows (nonbasic at their upper bound),
+        every y basic. Any vertex of P is a dual feasible start for every cost."""
+        st = self.hs.HighsBasisStatus
+        basis = self.hs.HighsBasis()
+        rows = [st.kBasic] * self.nw
+        for j in np.asarray(cols, dtype=int):
+            rows[j] = st.kUpper
+        basis.col_status = [st.kBasic] * self.prob.A.shape[0]
+        basis.row_status = rows
+        basis.valid = True
+        self.h.setBasis(basis)
 
     def certified(self, cost: np.ndarray, lam: np.ndarray, tol: float = DUAL_TOL) -> bool:
         """ForceLP.certified, with y the dual LP's optimum."""

@@ -19,7 +19,7 @@ from scipy.optimize import linprog
 from rigidlcp import models
 from rigidlcp.cli.main import main
 from rigidlcp.models.deposition import deposit
-from rigidlcp.verify.statics import contact_ranges, ends, exact
+from rigidlcp.verify.statics import contact_ranges, ends, exact, range_ends
 from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of
 from rigidlcp.verify.statics.forceset import analyse
 from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
@@ -206,18 +206,26 @@ def test_every_reported_end_has_an_independently_checked_witness(n, seed, mu):
         return
     prob = StaticProblem(system)
     answers = []
-    real = contact_ranges.settle
+    real, kept = contact_ranges.settle, range_ends.at_basis
 
     def recorded(*args, **kw):
         out = real(*args, **kw)
         answers.append(out)
         return out
 
-    contact_ranges.settle = recorded
+    def recorded_kept(*args, **kw):  # an end settled at a kept optimal basis, no LP
+        out = kept(*args, **kw)
+        if out is not None:
+            answers.append(out)
+        return out
+
+    contact_ranges.settle = range_ends.settle = recorded
+    range_ends.at_basis = recorded_kept
     try:
         r = contact_ranges.contact_ranges(prob, None, fs.implicit, fs.solution)
     finally:
-        contact_ranges.settle = real
+        contact_ranges.settle = range_ends.settle = real
+        range_ends.at_basis = kept
     points = [fs.solution] + [a.lam for a in answers if a.status == "optimal"]
     assert all(_in_P(system, lam) for lam in points)
     assert all(a.evidence is not None for a in answers if a.status == "unknown")
@@ -252,10 +260,10 @@ def test_an_end_whose_check_fails_is_unknown_in_the_json_and_the_text(tmp_path, 
     a = next(n for n, ct in enumerate(before["contacts"]) if ct["R"][1] is not None)
     real = ends.judge
 
-    def refuse(prob, lp, cost, status, lam, fixed=(), y=None):
+    def refuse(prob, lp, cost, status, lam, fixed=(), y=None, basis=None):
         if cost[a] < 0 and status == "optimal":
             return ends.Evidence("dual gap", 1e-3, ends.DUAL_TOL, status)
-        return real(prob, lp, cost, status, lam, fixed, y)
+        return real(prob, lp, cost, status, lam, fixed, y, basis)
 
     monkeypatch.setattr(ends, "judge", refuse)
     assert main(args + ["--json"]) == 0
