@@ -3,7 +3,7 @@ test; it prints a markdown table).
 
     python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
                                   [--arrays 100] [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
-                                  [--jobs 1] [--sample 1000:64]
+                                  [--jobs 1] [--sample 1000:64[:8]]
 
 deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
@@ -11,9 +11,13 @@ ranges N: the whole analysis: also the range of every R and S and the sliding co
 range LPs in --jobs worker processes (verify.statics.contact_ranges).
 arrays L: existence and dimension of the L x L rectangular and triangular arrays written as
 packings (`models.make_packing`: packings that stand, where deposited piles at scale fall).
-sample N:K: the ranges of K contacts spread evenly over an N-disk pile (one warm DualForceLP
-as in `analyse`, in this process), and the whole pile's range LPs extrapolated from them
-(c / K times the time): an estimate where the whole run takes too long.
+sample N:K[:B]: the ranges of K contacts of an N-disk pile (one warm DualForceLP as in
+`analyse`, in this process, the LPs ordered and kept bases tried as in
+verify.statics.range_ends), and the whole pile's range LPs extrapolated from them (c / K times
+the time): an estimate where the whole run takes too long. The K contacts are spread evenly
+over the contacts (B = K, the default), or are B clusters of K / B contacts each, the nearest
+(by their first disk's centre) to B contacts at evenly spread heights: neighbours, whose
+optima the ordered LPs reuse, as in the whole pile.
 Wall-clock seconds and CPU seconds (process time, worker processes included) of one run each.
 """
 
@@ -27,7 +31,7 @@ import numpy as np
 
 from rigidlcp import models
 from rigidlcp.models.deposition import deposit
-from rigidlcp.verify.statics.contact_ranges import Witnesses, ranges_of
+from rigidlcp.verify.statics.contact_ranges import Vertices, Witnesses, ranges_of
 from rigidlcp.verify.statics.forceset import analyse
 from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 
@@ -48,22 +52,40 @@ def _timed(fn):
     return out, time.perf_counter() - t, _cpu() - c
 
 
-def _sample(system: models.System, k: int) -> tuple[str, float, float]:
-    """The ranges of k contacts spread over the pile, and the whole pile's extrapolated."""
+def _picks(prob: StaticProblem, k: int, blocks: int) -> np.ndarray:
+    """k contacts: spread evenly over the contacts' indices (blocks = k), or `blocks` clusters
+    of the k / blocks contacts nearest to contacts at evenly spread heights (module
+    docstring)."""
+    if blocks >= k:
+        return np.unique(np.linspace(0, prob.c - 1, k).round().astype(int))
+    lat = prob.system.lattice
+    where = np.asarray(lat.x, dtype=float)[np.asarray(lat.i)]
+    by_height = np.argsort(where[:, 1], kind="stable")
+    centres = by_height[np.linspace(0, prob.c - 1, blocks).round().astype(int)]
+    size = max(1, k // blocks)
+    near = [np.argsort(np.sum((where - where[a]) ** 2, axis=1), kind="stable")[:size]
+            for a in centres]
+    return np.unique(np.concatenate(near))
+
+
+def _sample(system: models.System, k: int, blocks: int) -> tuple[str, float, float]:
+    """The ranges of k contacts of the pile (`_picks`), and the whole pile's extrapolated."""
     fs = analyse(system, ranges=False)
     if not fs.exists:
         return f"no equilibrium ({fs.exists})", 0.0, 0.0
     prob = StaticProblem(system)
     lp = DualForceLP(prob, ForceLP(prob))
     lp.solve(np.zeros(prob.n))
-    picks = np.unique(np.linspace(0, prob.c - 1, k).round().astype(int))
+    picks = _picks(prob, k, blocks)
     wit = Witnesses.of(prob, fs.solution)
+    kept = Vertices(prob, lp.primal.nw)
     (_, _, lps, unchecked), wall, cpu = _timed(
-        lambda: ranges_of(prob, lp, fs.implicit, picks, wit))
+        lambda: ranges_of(prob, lp, fs.implicit, picks, wit, vertices=kept))
     f = prob.c / picks.size
-    return (f"{picks.size} of {prob.c} contacts: {lps} LPs ({unchecked} unchecked), "
-            f"{cpu / max(lps, 1):.3f} CPU s per LP; whole pile ~{lps * f:.0f} LPs, "
-            f"~{cpu * f:.1f} CPU s"), wall, cpu
+    where = "spread" if blocks >= k else f"in {blocks} clusters"
+    return (f"{picks.size} of {prob.c} contacts ({where}): {lps} LPs ({unchecked} unchecked, "
+            f"{kept.settled} ends at kept bases), {cpu / max(lps, 1):.3f} CPU s per LP; whole "
+            f"pile ~{lps * f:.0f} LPs, ~{cpu * f:.1f} CPU s"), wall, cpu
 
 
 def main() -> int:
@@ -76,12 +98,14 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--radii", default="0.8:1.2")
     ap.add_argument("--jobs", type=int, default=1, help="worker processes of the range LPs")
-    ap.add_argument("--sample", default="", help="N:K (see above)")
+    ap.add_argument("--sample", default="", help="N:K[:B] (see above)")
     args = ap.parse_args()
     radii = tuple(float(v) for v in args.radii.split(":"))
     print(f"radii {radii[0]}:{radii[1]}, seed {args.seed}, mu = {args.mu} on every contact, "
           f"range LPs in {args.jobs} process(es)\n")
     sample = tuple(int(v) for v in args.sample.split(":")) if args.sample else None
+    if sample and len(sample) == 2:
+        sample = (*sample, sample[1])
     print("| task | disks | contacts | result | wall s | CPU s |")
     print("|---|---|---|---|---|---|")
     piles = {}
@@ -118,10 +142,10 @@ def main() -> int:
             print(f"| existence + dimension, {kind} {L}x{L} array | {pk.p} | {pk.c} | {result} "
                   f"| {wall:.2f} | {cpu:.2f} |", flush=True)
     if sample:
-        n, k = sample
+        n, k, blocks = sample
         pile = piles[n]
         system = models.System(pile, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
-        result, wall, cpu = _sample(system, k)
+        result, wall, cpu = _sample(system, k, blocks)
         print(f"| ranges, sample | {n} | {pile.c} | {result} | {wall:.2f} | {cpu:.2f} |")
     return 0
 

@@ -34,7 +34,7 @@ from rigidlcp.lcp.errors import InvalidInput
 from .ends import Unknown, settle
 from .hull import ZERO
 from .model import DualForceLP, ForceLP, StaticProblem
-from .range_ends import Vertices, Witnesses, at_bound, ranges_of
+from .range_ends import Vertices, Witnesses, at_bound, ranges_of, spatial_order
 
 __all__ = ["Ranges", "Vertices", "Witnesses", "at_bound", "contact_ranges", "lp_count",
            "ranges_of", "sliding_of"]
@@ -202,7 +202,8 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
     sliding = np.zeros(c, dtype=bool)
     out = Ranges(lo, hi, sliding, sliding_unknown=np.zeros(c, dtype=bool))
     size = max(1, min(64, c // (8 * jobs)))  # small chunks: balance, and fresh witnesses
-    chunks = [np.arange(s, min(s + size, c)) for s in range(0, c, size)]
+    order = spatial_order(prob)  # neighbours in a chunk: their optima settle or start others
+    chunks = [order[s:s + size] for s in range(0, c, size)]
     # spawn: fresh interpreters, no inherited threads or locks (HiGHS, BLAS) from this one
     with ProcessPoolExecutor(max_workers=min(jobs, len(chunks)), initializer=_start,
                              initargs=(prob.system,),

@@ -18,9 +18,10 @@ An end is settled, in this order of preference, by
 
 The next LP is the end whose best known value the last optimum comes closest to (its regret:
 value at the last optimum minus the best value at any checked point, relative to that value
-or to the force scale), the nearest contact first on a tie: the dual simplex then restarts
-near its optimum (about a third fewer pivots than contact after contact on deposited piles,
-docs/packings.md). An S end waits for its contact's max R, so that bound 1 can settle it.
+or to the force scale), the nearest contact (by its first disk's centre) first on a tie: the
+dual simplex then restarts near its optimum (about a third fewer pivots than contact after
+contact on deposited piles, docs/packings.md). An S end waits for its contact's max R, so
+that bound 1 can settle it.
 """
 
 from __future__ import annotations
@@ -162,7 +163,9 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
     found: list[Unknown] = []
     tol = 1e-9 * prob.scale
     last_lam: np.ndarray | None = None
-    last_a = contacts[0] if m else 0
+    last_x = 0
+    lat = prob.system.lattice
+    where = np.asarray(lat.x, dtype=float)[np.asarray(lat.i)[contacts]]  # the contacts' disks
 
     def settle_end(e: int, value: float) -> None:
         out[e] = value
@@ -193,7 +196,8 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
             best = wit.best(k_of[cand], sgn[cand])
             now = sgn[cand] * last_lam[k_of[cand]]
             regret = (now - best) / np.maximum(np.abs(best), prob.scale)
-            e = int(cand[np.lexsort((np.abs(a_of[cand] - last_a), regret))[0]])
+            near = np.sum((where[x_of[cand]] - where[last_x]) ** 2, axis=1)
+            e = int(cand[np.lexsort((near, regret))[0]])
         k, s = int(k_of[e]), float(sgn[e])
         cost = np.zeros(prob.n)
         cost[k] = s
@@ -224,7 +228,7 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
             else:
                 vertices.add(end.lam, None)
                 last_lam = None
-        last_a = a_of[e]
+        last_x = x_of[e]
         if end.status == "unbounded":
             settle_end(e, -s * np.inf)
         elif end.status == "unknown":
@@ -246,6 +250,21 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
     if unknown is not None:
         unknown.extend(found)
     return lo, hi, lps, len(found)
+
+
+def spatial_order(prob: StaticProblem) -> np.ndarray:
+    """The contacts in a serpentine over the pile (by their first disk's centre: bands two
+    largest diameters high, left to right then right to left), so that a run of consecutive
+    contacts is a patch of neighbours (the chunks of verify.statics.contact_ranges' workers;
+    contact indices follow the kind and the deposition order, across the whole width)."""
+    lat = prob.system.lattice
+    where = np.asarray(lat.x, dtype=float)[np.asarray(lat.i, dtype=int)]
+    if where.shape[0] == 0:
+        return np.zeros(0, dtype=int)
+    radii = np.asarray(lat.radii if lat.radii is not None else [lat.radius], dtype=float)
+    band = np.floor((where[:, 1] - where[:, 1].min()) / (4.0 * float(radii.max()))).astype(int)
+    along = np.where(band % 2 == 0, where[:, 0], -where[:, 0])
+    return np.lexsort((along, band))
 
 
 def _nw(lp: DualForceLP | ForceLP) -> int:

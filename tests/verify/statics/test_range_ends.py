@@ -145,3 +145,21 @@ def test_the_last_optimum_is_not_offered_again():
     v.add(lam2, ends.basis_of(prob, lp))
     assert np.array_equal(v.candidate(0, -1.0), np.flatnonzero(np.unpackbits(
         v.masks[0], count=v.nw)))
+
+
+def test_the_workers_chunks_are_patches_of_neighbours():
+    """spatial_order: a permutation of the contacts whose bands (by the first disk's height)
+    never go down, and whose direction along a band alternates."""
+    from rigidlcp.verify.statics.range_ends import spatial_order
+
+    system = _pile(60, 2, 0.5)
+    prob = StaticProblem(system)
+    order = spatial_order(prob)
+    assert np.array_equal(np.sort(order), np.arange(prob.c))
+    lat = system.lattice
+    where = np.asarray(lat.x)[np.asarray(lat.i)][order]
+    band = np.floor((where[:, 1] - where[:, 1].min()) / (4 * float(np.max(lat.radii))))
+    assert np.all(np.diff(band) >= 0)
+    for b in np.unique(band):
+        x = where[band == b, 0]
+        assert np.all(np.diff(x) >= 0) if b % 2 == 0 else np.all(np.diff(x) <= 0)
