@@ -86,7 +86,10 @@ def cap_contacts(form: Formulation) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     """min over the cases Z of the certified bound of min L . x (module docstring); None when
     it does not apply (no proved force box, no rotation cap, no cap contact, more than
-    MAX_CAP cap contacts, or L weighs an R whose bound is not proved)."""
+    MAX_CAP cap contacts, or L weighs an R whose bound is not proved). The cases are visited in
+    Gray-code order: from one case to the next one cap contact enters or leaves Z, so only its
+    rows (a), (b), its entry of (c) and (c)'s bound change and each LP starts from the
+    previous one's basis; every case is still bounded by its own certificate."""
     import highspy
 
     t0 = time.perf_counter()
