@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rigidlcp import models
 from rigidlcp.verify.ranges import steady_ranges
@@ -219,3 +221,39 @@ def test_cap_split_bound_is_the_least_case_minimum(lattice, gamma):
         assert res.bound >= least - 1e-8 * max(1.0, abs(least))
         worst = tuple(k in res.worst for k in beta)
         assert mins[worst] is not None and mins[worst] <= res.bound + 1e-8
+
+
+@settings(max_examples=15)
+@given(lx=st.integers(1, 4), ly=st.integers(1, 2), mu_pp=st.sampled_from([0.05, 0.1, 0.3]),
+       mu_plane=st.sampled_from([0.1, 0.2, 0.5]),
+       gamma=st.sampled_from([-0.2, -0.05, 0.02, 0.16]), seed=st.integers(0, 2 ** 16))
+def test_cap_split_bound_is_the_least_case_minimum_on_random_systems(lx, ly, mu_pp, mu_plane,
+                                                                     gamma, seed):
+    """The same on random small arrays and a random observable of S (the force box is proved
+    for it), against the 2^n cases solved cold here."""
+    from itertools import product
+
+    from rigidlcp.lcp.errors import RigidLCPError
+
+    system = models.System(models.rectangular(lx, ly), mu_pp=mu_pp, mu_plane=mu_plane,
+                           mu_wall=0.0, gamma=gamma)
+    try:
+        form = formulate(system)
+    except RigidLCPError:  # no steady state with every contact closed: nothing to bound
+        return
+    c = system.c
+    L = np.zeros(2 * c)
+    L[c:] = np.random.default_rng(seed).normal(size=c) * (system.mu > 0)
+    res = cap_split_bound(form, L)
+    if res is None:
+        return
+    beta = cap_contacts(form)[0]
+    mins = [_cap_case_min(form, L, np.array(z)) for z in product((False, True),
+                                                                 repeat=beta.size)]
+    least = min((v for v in mins if v is not None), default=np.inf)
+    assert res.cases == len(mins)
+    if np.isfinite(least):
+        assert res.bound <= least + 1e-9 * max(1.0, abs(least))
+        assert res.bound >= least - 1e-7 * max(1.0, abs(least))
+    else:
+        assert res.bound == np.inf or res.bound <= least
