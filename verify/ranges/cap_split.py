@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
-from itertools import product
 
 import numpy as np
 import scipy.sparse as sp
@@ -87,7 +86,10 @@ def cap_contacts(form: Formulation) -> tuple[np.ndarray, np.ndarray, np.ndarray,
 def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     """min over the cases Z of the certified bound of min L . x (module docstring); None when
     it does not apply (no proved force box, no rotation cap, no cap contact, more than
-    MAX_CAP cap contacts, or L weighs an R whose bound is not proved)."""
+    MAX_CAP cap contacts, or L weighs an R whose bound is not proved). The cases are visited in
+    Gray-code order: from one case to the next one cap contact enters or leaves Z, so only its
+    rows (a), (b), its entry of (c) and (c)'s bound change and each LP starts from the
+    previous one's basis; every case is still bounded by its own certificate."""
     import highspy
 
     t0 = time.perf_counter()
@@ -117,23 +119,26 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
     rows_b = eps[:, None] * ra[disk]  # (b)
     Ad = np.vstack([*base, rows_a, rows_b, np.zeros((1, 2 * c))])  # last: (c), per case
     ia, ib, ic = Ad.shape[0] - 2 * n - 1, Ad.shape[0] - n - 1, Ad.shape[0] - 1
-    row_lo = np.r_[base_lo, np.zeros(n), -b[beta], -np.inf]
-    row_hi = np.r_[base_hi, np.zeros(n), -b[beta], np.inf]
+    row_lo = np.r_[base_lo, np.zeros(n), np.full(n, -np.inf), -np.inf]  # the case Z = {}
+    row_hi = np.r_[base_hi, np.zeros(n), np.full(n, np.inf), np.inf]
     _load(h, highspy, L, Ad, row_lo, row_hi, lb, ub)
-    free = np.full(n, np.inf)
+    # the constraint matrix for the certificates, with row (c)'s entries stored (updated per
+    # case in place: no new sparse matrix per case)
+    Ad[ic, c + beta] = 1.0
+    A = sp.csr_matrix(Ad)
+    Ad[ic, c + beta] = 0.0
+    row_c = A.indptr[ic] + np.searchsorted(A.indices[A.indptr[ic]:A.indptr[ic + 1]], c + beta)
+    A.data[row_c] = 0.0
+    z = np.zeros(n, dtype=bool)
     best, worst, cases, empty = np.inf, (), 0, 0
-    for z in product((False, True), repeat=n):
-        z = np.array(z)
-        row_lo[ia:ia + n] = np.where(z, -free, 0.0)
-        row_hi[ia:ia + n] = np.where(z, free, 0.0)
-        row_lo[ib:ib + n] = np.where(z, -b[beta], -free)
-        row_hi[ib:ib + n] = np.where(z, -b[beta], free)
-        Ad[ic, c + beta] = np.where(z, -np.sign(b[beta]), 0.0)
-        row_lo[ic] = M * float(np.sum(1.0 / D[np.unique(disk[z])])) if z.any() else -np.inf
-        for i in range(ia, ic + 1):  # one by one: highspy 1.10 has no changeRowsBounds
-            h.changeRowBounds(i, float(row_lo[i]), float(row_hi[i]))
-        for k in range(n):
-            h.changeCoeff(ic, int(c + beta[k]), float(Ad[ic, c + beta[k]]))
+    for g in range(2 ** n):  # Gray code: one cap contact changes from one case to the next
+        if g:
+            k = int((g & -g).bit_length() - 1)
+            z[k] = not z[k]
+            _set_case(h, z, k, ia, ib, ic, c + int(beta[k]), -b[beta[k]],
+                      -np.sign(b[beta[k]]), row_lo, row_hi, A, row_c)
+            row_lo[ic] = M * float(np.sum(1.0 / D[np.unique(disk[z])])) if z.any() else -np.inf
+            h.changeRowBounds(ic, float(row_lo[ic]), float(row_hi[ic]))
         with quiet_highs():
             h.run()
         if h.getModelStatus() not in (highspy.HighsModelStatus.kOptimal,
@@ -141,12 +146,26 @@ def cap_split_bound(form: Formulation, L: np.ndarray) -> CapSplitBound | None:
             h.clearSolver()  # warm start in trouble: once more from scratch
             with quiet_highs():
                 h.run()
-        bound = certified_result(h, highspy, L, sp.csr_matrix(Ad), row_lo, row_hi, lb, ub)[0]
+        bound = certified_result(h, highspy, L, A, row_lo, row_hi, lb, ub)[0]
         cases += 1
         empty += bound == np.inf
         if bound < best:
             best, worst = bound, tuple(int(beta[k]) for k in np.flatnonzero(z))
     return CapSplitBound(float(best), worst, cases, empty, time.perf_counter() - t0)
+
+
+def _set_case(h, z: np.ndarray, k: int, ia: int, ib: int, ic: int, col: int, rhs_b: float,
+              coef: float, row_lo: np.ndarray, row_hi: np.ndarray, A: sp.csr_matrix,
+              row_c: np.ndarray) -> None:
+    """Cap contact k (column `col` of its S) into Z (z[k]) or out of it: its rows (a) and (b)
+    and its entry of row (c), in HiGHS, in the row bounds and in A (for the certificate)."""
+    inf = np.inf
+    row_lo[ia + k], row_hi[ia + k] = (-inf, inf) if z[k] else (0.0, 0.0)
+    row_lo[ib + k], row_hi[ib + k] = (rhs_b, rhs_b) if z[k] else (-inf, inf)
+    for i in (ia + k, ib + k):
+        h.changeRowBounds(i, float(row_lo[i]), float(row_hi[i]))
+    A.data[row_c[k]] = coef if z[k] else 0.0
+    h.changeCoeff(ic, col, float(A.data[row_c[k]]))
 
 
 def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],

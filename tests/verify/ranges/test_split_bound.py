@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rigidlcp import models
 from rigidlcp.verify.ranges import steady_ranges
@@ -153,3 +155,105 @@ def test_cap_split_on_fig9_below_a_checked_witness():
             if steady_check(system, vel[0], vel[1], x[:c], x[c:], form.dyn)[0] <= 1e-8:
                 met.append(float(L @ x))
     assert met and res.bound <= min(met)
+
+
+def _cap_case_min(form, L, z):
+    """min L . x over cap_split's case Z (z: a mask over the cap contacts), written here from
+    the docstring with scipy's linprog, cold: None when the case is empty."""
+    from itertools import chain
+
+    from scipy.optimize import linprog
+
+    from rigidlcp.verify.ranges.observables import alpha_rows
+    from rigidlcp.verify.ranges.steady import _equalities
+
+    system, dyn = form.system, form.dyn
+    c, p, mu, r = system.c, system.p, system.mu, system.lattice.radii
+    beta, disk, eps, M = cap_contacts(form)
+    b = np.asarray(dyn.u_obs_dot, float)[c:]
+    ra = r[:, None] * alpha_rows(system, dyn)
+    E, e = _equalities(dyn)
+    I2 = np.eye(2 * c)
+    fr = np.flatnonzero(mu > 0)
+    A_ub = list(chain(-(mu[fr, None] * I2[fr] - I2[c + fr]), -(mu[fr, None] * I2[fr] + I2[c + fr]),
+                      ra, -ra))
+    b_ub = list(chain(np.zeros(2 * fr.size), np.full(2 * p, M)))
+    A_eq, b_eq = list(E), list(e)
+    for k in range(beta.size):
+        if z[k]:  # (b): the disk at the cap
+            A_eq.append(eps[k] * ra[disk[k]])
+            b_eq.append(-b[beta[k]])
+        else:  # (a): sliding with s = sgn b
+            A_eq.append(mu[beta[k]] * np.sign(b[beta[k]]) * I2[beta[k]] + I2[c + beta[k]])
+            b_eq.append(0.0)
+    if z.any():  # (c)
+        D = r * r * dyn.Minv[2 * p:]
+        row = np.zeros(2 * c)
+        row[c + beta[z]] = np.sign(b[beta[z]])
+        A_ub.append(row)
+        b_ub.append(-M * float(np.sum(1.0 / D[np.unique(disk[z])])))
+    res = linprog(L, A_ub=np.array(A_ub), b_ub=np.array(b_ub), A_eq=np.array(A_eq),
+                  b_eq=np.array(b_eq), bounds=list(zip(form.lb[:2 * c], form.ub[:2 * c])),
+                  method="highs")
+    assert res.status in (0, 2), res.message
+    return None if res.status == 2 else float(res.fun)
+
+
+@pytest.mark.parametrize("lattice, gamma", [(models.rectangular(3, 2), 0.16),
+                                            (models.rectangular(4, 1), -0.1)])
+def test_cap_split_bound_is_the_least_case_minimum(lattice, gamma):
+    """The cases are visited in Gray-code order, each from the previous one's LP (one cap
+    contact changed): the bound equals the least minimum over all 2^n cases, each solved here
+    cold and independently, to the certificate's margin; the worst case attains it."""
+    from itertools import product
+
+    system = models.System(lattice, mu_pp=0.1, mu_plane=0.2, mu_wall=0.0, gamma=gamma)
+    form = formulate(system)
+    beta = cap_contacts(form)[0]
+    for L in (mu_g_vector(system), -mu_g_vector(system)):
+        res = cap_split_bound(form, L)
+        mins = {z: _cap_case_min(form, L, np.array(z)) for z in product((False, True),
+                                                                         repeat=beta.size)}
+        least = min(v for v in mins.values() if v is not None)
+        assert res.cases == len(mins)
+        assert res.empty <= sum(v is None for v in mins.values())
+        assert res.bound <= least + 1e-12
+        assert res.bound >= least - 1e-8 * max(1.0, abs(least))
+        worst = tuple(k in res.worst for k in beta)
+        assert mins[worst] is not None and mins[worst] <= res.bound + 1e-8
+
+
+@settings(max_examples=15)
+@given(lx=st.integers(1, 4), ly=st.integers(1, 2), mu_pp=st.sampled_from([0.05, 0.1, 0.3]),
+       mu_plane=st.sampled_from([0.1, 0.2, 0.5]),
+       gamma=st.sampled_from([-0.2, -0.05, 0.02, 0.16]), seed=st.integers(0, 2 ** 16))
+def test_cap_split_bound_is_the_least_case_minimum_on_random_systems(lx, ly, mu_pp, mu_plane,
+                                                                     gamma, seed):
+    """The same on random small arrays and a random observable of S (the force box is proved
+    for it), against the 2^n cases solved cold here."""
+    from itertools import product
+
+    from rigidlcp.lcp.errors import RigidLCPError
+
+    system = models.System(models.rectangular(lx, ly), mu_pp=mu_pp, mu_plane=mu_plane,
+                           mu_wall=0.0, gamma=gamma)
+    try:
+        form = formulate(system)
+    except RigidLCPError:  # no steady state with every contact closed: nothing to bound
+        return
+    c = system.c
+    L = np.zeros(2 * c)
+    L[c:] = np.random.default_rng(seed).normal(size=c) * (system.mu > 0)
+    res = cap_split_bound(form, L)
+    if res is None:
+        return
+    beta = cap_contacts(form)[0]
+    mins = [_cap_case_min(form, L, np.array(z)) for z in product((False, True),
+                                                                 repeat=beta.size)]
+    least = min((v for v in mins if v is not None), default=np.inf)
+    assert res.cases == len(mins)
+    if np.isfinite(least):
+        assert res.bound <= least + 1e-9 * max(1.0, abs(least))
+        assert res.bound >= least - 1e-7 * max(1.0, abs(least))
+    else:
+        assert res.bound == np.inf or res.bound <= least
