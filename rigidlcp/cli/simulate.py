@@ -41,13 +41,18 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--packing", metavar="FILE", default=None,
                    help="disks from a packing file (.csv/.npz/LAMMPS dump, docs/packings.md) "
                    "instead of --lattice/--lx/--ly")
+    from rigidlcp.cli.packing_options import add_packing_options
+
+    add_packing_options(g)  # --left, --right, --gap-tol: read as `rigidlcp forceset` reads
 
 
 def system_from_args(args, array_defaults: tuple | None = None):
     """The System of the options; with --packing, refused when --lattice/--lx/--ly differ from
     the command's own `array_defaults` (default ARRAY_DEFAULTS, simulate's 10 x 4 rect)."""
+    from rigidlcp.cli.packing_options import refuse_without_packing
     from rigidlcp.models.system import make_system
 
+    refuse_without_packing(args)
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
         refuse_array_options(args, array_defaults or ARRAY_DEFAULTS)
         from rigidlcp.models.system import System
@@ -75,9 +80,9 @@ def packing_of(args):
     """The lattice of --packing FILE, read once (kept on args for system_from_args)."""
     lat = getattr(args, "_packing_lattice", None)
     if lat is None:
-        from rigidlcp.models.packing_io import read_packing
+        from rigidlcp.cli.packing_options import read_packing_args
 
-        lat = args._packing_lattice = read_packing(args.packing)
+        lat = args._packing_lattice = read_packing_args(args.packing, args)
     return lat
 
 

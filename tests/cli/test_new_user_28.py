@@ -66,3 +66,48 @@ def test_an_interrupted_bench_says_how_to_resume(tmp_path, monkeypatch, capsys):
     assert "--resume finishes it" in _one_line_error(capsys, "bench")
     assert main([*base, "--resume"]) == 0
     assert len((out / "results.csv").read_text().splitlines()) == 3
+
+
+@pytest.fixture
+def typed(tmp_path):
+    """Three unit disks typed by hand: the top one's height 2.732 for 1 + sqrt(3) overlaps its
+    supports by 4.4e-5 (docs/packings.md: `forceset --gap-tol 1e-4` accepts them)."""
+    path = tmp_path / "typed.csv"
+    path.write_text("x,y,r\n1,1,1\n3,1,1\n2,2.732,1\n")
+    return path
+
+
+def _contacts(out: str) -> int:
+    """The number of contacts a command's summary states ("N contacts", or timestep's
+    transmitting T + not transmitting NT)."""
+    import re
+
+    found = re.search(r"(\d+) contacts", out)
+    if found:
+        return int(found.group(1))
+    rows = dict(line.split(None, 1) for line in out.splitlines() if line.strip())
+    return int(rows["T"]) + int(rows["NT"])
+
+
+@pytest.mark.parametrize("command", ["simulate", "timestep", "nullspace"])
+def test_packing_commands_read_a_packing_as_forceset_does(command, typed, tmp_path, capsys):
+    """`forceset typed.csv --gap-tol 1e-4` worked, but `simulate --packing typed.csv` refused
+    the overlap with no way out (no --gap-tol: "unrecognized arguments"), and the walls of a
+    packing could not be moved (--left/--right). Every --packing command reads the file with
+    the same options, and the overlap's refusal names --gap-tol."""
+    extra = {"simulate": ["--no-progress", "--t-max", "1"],
+             "timestep": ["--no-progress", "--t-max", "0.1"], "nullspace": []}[command]
+    assert main([command, "--packing", str(typed), *extra]) == 2
+    assert "--gap-tol G accepts overlaps" in _one_line_error(capsys, command)
+    assert main([command, "--packing", str(typed), "--gap-tol", "1e-4", *extra]) == 0
+    assert _contacts(capsys.readouterr().out) == 7  # plane 2, walls 2, disks 3
+    assert main([command, "--packing", str(typed), "--gap-tol", "1e-4", "--left", "none",
+                 "--right", "none", *extra]) in (0, 1)  # 1: simulate's run may detach
+    assert _contacts(capsys.readouterr().out) == 5  # no walls
+
+
+@pytest.mark.parametrize("option", [["--gap-tol", "1e-4"], ["--left", "none"]])
+def test_packing_options_without_a_packing_are_refused(option, capsys):
+    """--gap-tol or --left on an array would be silently ignored: refused by name."""
+    assert main(["simulate", *option, "--no-progress"]) == 2
+    assert "give --packing FILE" in _one_line_error(capsys, "simulate")
