@@ -134,7 +134,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
     print(_box_line(lat, disks, left, right))
     if fs.exists is None:
         print(f"existence undecided: {fs.undecided}")
-        return 0
+        return _written(out, fs, args)
     if not fs.exists:
         print("no equilibrium: Farkas certificate checked " + (
             "in exact rational arithmetic" if fs.exact else
@@ -145,7 +145,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
             print(f"it moves only disks {shown}{more} (the others held fixed)")
         elif fs.moving is not None:
             print(f"it moves every disk ({lat.p})")
-        return 0
+        return _written(out, fs, args)
     print(f"equilibrium exists (checked: balance residual {fs.residuals[0]:.2e}, laws "
           f"{fs.residuals[1]:.2e}); dimension of the admissible set: {fs.dimension}"
           + (" (unique forces)" if fs.dimension == 0 else ""))
@@ -164,6 +164,22 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         print(f"{e['samples']} uniform samples ({e['sampler']}), each checked: largest "
               f"residuals {e['residuals'][0]:.2e} (balance), {e['residuals'][1]:.2e} (laws); "
               f"force fluctuation {e['fluctuation']:.4g} <R>; samples.npz, pf.png")
+    return _written(out, fs, args)
+
+
+def _written(out, fs, args) -> int:
+    """Say what --out holds (the text output only: --json prints one object), and why
+    forceset.png is missing when it is: there is no equilibrium to draw, or no ranges."""
+    if out is not None:
+        names = ["forceset.json"]
+        if fs.exists and not args.no_ranges:
+            names.append("forceset.png")
+        if fs.exists and args.samples:
+            names += ["samples.npz", "pf.png"]
+        why = ("" if len(names) > 1 else " (no forceset.png: no equilibrium to draw)"
+               if fs.exists is False else " (no forceset.png: existence undecided)"
+               if fs.exists is None else " (no forceset.png: --no-ranges)")
+        print(f"written: {', '.join(str(out / n) for n in names)}{why}")
     return 0
 
 

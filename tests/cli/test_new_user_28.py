@@ -111,3 +111,25 @@ def test_packing_options_without_a_packing_are_refused(option, capsys):
     """--gap-tol or --left on an array would be silently ignored: refused by name."""
     assert main(["simulate", *option, "--no-progress"]) == 2
     assert "give --packing FILE" in _one_line_error(capsys, "simulate")
+
+
+THREE = "x,y,r\n1,1,1\n3,1,1\n2,2.7320508075688772,1\n"  # docs/packings.md's three disks
+
+
+@pytest.mark.parametrize("extra, files, why", [
+    ([], ["forceset.json", "forceset.png"], ""),
+    (["--no-ranges"], ["forceset.json"], "(no forceset.png: --no-ranges)"),
+    (["--mu-pp", "0", "--mu-plane", "0", "--mu-wall", "0", "--left", "none", "--right",
+      "none"], ["forceset.json"], "(no forceset.png: no equilibrium to draw)"),
+])
+def test_forceset_out_says_what_it_wrote(extra, files, why, tmp_path, capsys):
+    """`forceset FILE --out DIR` printed the analysis and nothing about DIR: the figure was
+    there to find, or silently absent (no equilibrium: nothing to draw). The last line names
+    the files, and the reason when forceset.png is not among them."""
+    (tmp_path / "three.csv").write_text(THREE)
+    out = tmp_path / "fs"
+    assert main(["forceset", str(tmp_path / "three.csv"), "--out", str(out), *extra]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last == f"written: {', '.join(str(out / f) for f in files)}" + (
+        f" {why}" if why else "")
+    assert sorted(p.name for p in out.iterdir()) == sorted(files)
