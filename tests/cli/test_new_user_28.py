@@ -133,3 +133,40 @@ def test_forceset_out_says_what_it_wrote(extra, files, why, tmp_path, capsys):
     assert last == f"written: {', '.join(str(out / f) for f in files)}" + (
         f" {why}" if why else "")
     assert sorted(p.name for p in out.iterdir()) == sorted(files)
+
+
+def test_packings_md_three_disks_output_is_what_forceset_prints(tmp_path, capsys):
+    """docs/packings.md shows `rigidlcp forceset three.csv ...`'s output; it had drifted (a
+    balance residual of 3.46e-14 where the code prints 2.22e-16). The block is compared line
+    by line, the residual's digits left out (rounding, platform-dependent) but bounded."""
+    import re
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "packings.md").read_text()
+    start = doc.index("`rigidlcp forceset three.csv --mu-pp 0.5")
+    block = doc[doc.index("```\n", start) + 4:]
+    block = block[:block.index("```")].strip().splitlines()
+    (tmp_path / "three.csv").write_text(THREE)
+    assert main(["forceset", str(tmp_path / "three.csv"), "--mu-pp", "0.5", "--mu-plane",
+                 "0.5", "--mu-wall", "0.5"]) == 0
+    got = capsys.readouterr().out.strip().splitlines()
+    residual = re.compile(r"balance residual ([0-9.e+-]+)")
+
+    def masked(lines):
+        return [residual.sub("balance residual R", line) for line in lines]
+
+    assert masked(got) == masked(block)
+    assert float(residual.search("\n".join(got)).group(1)) <= 1e-13
+    assert float(residual.search("\n".join(block)).group(1)) <= 1e-13
+
+
+def test_forceset_json_diameter_of_an_unbounded_set_is_null_null(tmp_path, capsys):
+    """docs/packings.md said the diameter's upper end is null for an unbounded set; its lower
+    end is null too (the widest range is infinite, so is the diameter): the doc now says so."""
+    import json
+
+    (tmp_path / "three.csv").write_text(THREE)
+    assert main(["forceset", str(tmp_path / "three.csv"), "--mu-pp", "0.5", "--mu-plane",
+                 "0.5", "--mu-wall", "0.5", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert any(c["R"][1] is None for c in d["contacts"]) and d["diameter"] == [None, None]
