@@ -170,3 +170,34 @@ def test_forceset_json_diameter_of_an_unbounded_set_is_null_null(tmp_path, capsy
                  "0.5", "--mu-wall", "0.5", "--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert any(c["R"][1] is None for c in d["contacts"]) and d["diameter"] == [None, None]
+
+
+def test_ranges_counts_its_ends(tmp_path, capsys):
+    """`rigidlcp ranges` ran its MILPs (up to 14 min on a 10 x 4 run) with no progress at all
+    after the first line: steady_ranges now reports each end, and the command draws a bar
+    (`--no-progress`: none); the result is the same either way."""
+    import json
+
+    from rigidlcp import models
+    from rigidlcp.models.runio import save_run
+    from rigidlcp.verify.ranges import steady_ranges
+
+    system = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                           gamma=0.1)
+    run = models.simulate(system, seed=1, progress=False)
+    assert run.status == "steady"
+    calls: list = []
+    steady_ranges(run, which="alpha", time_limit=30,
+                  progress=lambda done, total, name: calls.append((done, total, name)))
+    # mu_g and alpha of each of the 2 disks, two ends each, in order
+    assert [c[:2] for c in calls] == [(k, 6) for k in range(1, 7)]
+    assert [c[2] for c in calls[::2]] == ["mu_g", "alpha[0]", "alpha[1]"]
+    path = save_run(run, tmp_path / "two")
+    assert main(["ranges", str(path), "--json", "--time-limit", "30"]) == 0
+    cap = capsys.readouterr()
+    assert "range ends" in cap.err
+    with_bar = json.loads(cap.out)["steady"]
+    assert main(["ranges", str(path), "--json", "--time-limit", "30", "--no-progress"]) == 0
+    cap = capsys.readouterr()
+    assert "range ends" not in cap.err
+    assert json.loads(cap.out)["steady"]["mu_g"] == with_bar["mu_g"]
