@@ -201,3 +201,18 @@ def test_ranges_counts_its_ends(tmp_path, capsys):
     cap = capsys.readouterr()
     assert "range ends" not in cap.err
     assert json.loads(cap.out)["steady"]["mu_g"] == with_bar["mu_g"]
+
+
+def test_a_runs_json_names_its_npz(tmp_path, capsys):
+    """`simulate --out run5` writes run5.npz and run5.json; `ranges run5.json` (the file a
+    user opens to read) said only "not a run file"."""
+    from rigidlcp import models
+    from rigidlcp.models.runio import save_run
+
+    system = models.System(models.rectangular(1, 1), gamma=0.1)
+    save_run(models.simulate(system, seed=1, progress=False), tmp_path / "run5")
+    for command in (["ranges"], ["plot", "--out", str(tmp_path / "figs")], ["certify-run"]):
+        assert main([command[0], str(tmp_path / "run5.json"), *command[1:]]) == 2
+        err = _one_line_error(capsys, command[0])
+        assert err.endswith(f"is the metadata of a run: give its data file, "
+                            f"{tmp_path / 'run5.npz'}")
