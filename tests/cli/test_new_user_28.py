@@ -216,3 +216,20 @@ def test_a_runs_json_names_its_npz(tmp_path, capsys):
         err = _one_line_error(capsys, command[0])
         assert err.endswith(f"is the metadata of a run: give its data file, "
                             f"{tmp_path / 'run5.npz'}")
+
+
+@pytest.mark.parametrize("header, says", [
+    ("x y r", "fields are separated by commas, this line by spaces or tabs"),
+    ("x\ty\tr", "fields are separated by commas, this line by spaces or tabs"),
+    ("X,Y,R", "names are case-sensitive, got 'X', 'Y', 'R'"),
+    ("x,y,radius", "name the radius column r"),
+    ("x,y,diameter", "give the radius as a column r (half the diameter)"),
+])
+def test_a_csv_header_says_what_is_wrong(header, says, tmp_path, capsys):
+    """A researcher's own file, whitespace-separated or with 'radius' or 'X,Y,R': refused as
+    "missing x, y, r" while the line visibly had them. The refusal now says what differs."""
+    f = tmp_path / "mine.csv"
+    sep = "\t" if "\t" in header else " " if " " in header else ","
+    f.write_text(header + "\n" + sep.join(["1", "1", "1"]) + "\n")
+    assert main(["forceset", str(f)]) == 2
+    assert _one_line_error(capsys, "forceset").endswith(": " + says)
