@@ -233,3 +233,15 @@ def test_a_csv_header_says_what_is_wrong(header, says, tmp_path, capsys):
     f.write_text(header + "\n" + sep.join(["1", "1", "1"]) + "\n")
     assert main(["forceset", str(f)]) == 2
     assert _one_line_error(capsys, "forceset").endswith(": " + says)
+
+
+def test_a_relative_set_folder_names_the_current_folder(tmp_path, monkeypatch):
+    """docs/bench.md's script passes "tests/data/siconos", the repository's folder: run from
+    elsewhere it was "not a name ... nor a directory", with no word on where it was looked
+    for."""
+    from rigidlcp.bench.problem_sets import get_set
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match="read from the current folder") as exc:
+        get_set("tests/data/siconos")
+    assert str(tmp_path) in str(exc.value)
