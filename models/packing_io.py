@@ -228,8 +228,11 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
             else "diameter"}
     missing = [v for v in need.values() if v not in names]
     if missing:
+        other = [n for n in ("xs", "ys", "xu", "yu", "xsu", "ysu") if n in names]
+        hint = (f": this dump has {', '.join(other)}; write the coordinates x y (e.g. "
+                "`dump 1 all custom N file id x y z radius`)" if other else "")
         raise InvalidFile(f"{path} line {start + 1}: the ATOMS columns must include x, y and "
-                          f"radius or diameter (missing {', '.join(missing)})")
+                          f"radius or diameter (missing {', '.join(missing)}){hint}")
     if "mass" in names:
         need["m"] = "mass"
     cols = {c: [] for c in need}

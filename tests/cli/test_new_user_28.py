@@ -245,3 +245,14 @@ def test_a_relative_set_folder_names_the_current_folder(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match="read from the current folder") as exc:
         get_set("tests/data/siconos")
     assert str(tmp_path) in str(exc.value)
+
+
+def test_a_lammps_dump_of_scaled_coordinates_says_so(tmp_path, capsys):
+    """LAMMPS's default `dump atom` writes scaled xs ys: refused as "missing x, y" with no word
+    on what the file has instead and how to dump x y."""
+    f = tmp_path / "scaled.dump"
+    f.write_text("ITEM: TIMESTEP\n0\nITEM: NUMBER OF ATOMS\n1\nITEM: BOX BOUNDS ff ff pp\n"
+                 "0 2\n0 2\n-1 1\nITEM: ATOMS id type xs ys zs radius\n1 1 0.5 0.5 0 1\n")
+    assert main(["forceset", str(f)]) == 2
+    err = _one_line_error(capsys, "forceset")
+    assert "(missing x, y): this dump has xs, ys; write the coordinates x y" in err
