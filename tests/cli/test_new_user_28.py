@@ -256,3 +256,18 @@ def test_a_lammps_dump_of_scaled_coordinates_says_so(tmp_path, capsys):
     assert main(["forceset", str(f)]) == 2
     err = _one_line_error(capsys, "forceset")
     assert "(missing x, y): this dump has xs, ys; write the coordinates x y" in err
+
+
+def test_bench_says_how_to_compare_a_method_of_ones_own(tmp_path, capsys):
+    """`rigidlcp bench --methods mine` (a method registered in the user's own module) listed
+    the built-in methods and nothing on how to bench one's own: the command line cannot
+    import it; the message points to the script of docs/bench.md."""
+    from pathlib import Path
+
+    assert main(["bench", "--set", "random-p", "--methods", "mine", "--out",
+                 str(tmp_path / "b"), "--no-siconos"]) == 2
+    err = _one_line_error(capsys, "bench")
+    assert "a method of your own: register it in a script that calls run_bench" in err
+    doc = (Path(__file__).parents[2] / "docs" / "bench.md").read_text()
+    assert "## A test double" in doc and "from rigidlcp.bench.harness import run_bench" in doc
+    assert not (tmp_path / "b").exists()
