@@ -271,3 +271,35 @@ def test_bench_says_how_to_compare_a_method_of_ones_own(tmp_path, capsys):
     doc = (Path(__file__).parents[2] / "docs" / "bench.md").read_text()
     assert "## A test double" in doc and "from rigidlcp.bench.harness import run_bench" in doc
     assert not (tmp_path / "b").exists()
+
+
+def test_certify_run_of_a_time_stepping_run_is_refused_in_one_line(tmp_path, capsys):
+    """`rigidlcp certify-run` on a run of `rigidlcp timestep` ended in a traceback (KeyError
+    'states'): its step impulses are no event solution, every certificate was rejected, and a
+    rejected certificate had no "states" question. Refused by name now, nothing written."""
+    out = tmp_path / "ts_cert"
+    assert main(["timestep", "--lx", "2", "--ly", "1", "--t-max", "0.05", "--out",
+                 str(tmp_path / "ts"), "--no-progress"]) in (0, 1)
+    capsys.readouterr()
+    assert main(["certify-run", str(tmp_path / "ts.npz"), "--out", str(out),
+                 "--no-progress"]) == 2
+    assert "a time-stepping run (moreau-jean" in _one_line_error(capsys, "certify-run")
+    assert not out.exists()
+
+
+def test_a_rejected_staged_certificate_asks_every_question():
+    """A solution that fails the residual check gets "no verdict" on each question, the
+    contact states' included (certify_event read verdicts["states"] and crashed)."""
+    import numpy as np
+
+    from rigidlcp import models
+    from rigidlcp.verify.certificates import certify_stages
+    from rigidlcp.verify.certificates.run import QUESTIONS
+
+    system = models.System(models.rectangular(2, 1), gamma=0.1)
+    ep = models.event_problem(system, models.initial_state(system, seed=1))
+    cert = certify_stages(ep, np.full(ep.lcp.n, 7.0))
+    assert not cert.accepted
+    for name in QUESTIONS:
+        v = cert.verdicts[name]
+        assert v.verdict == "unknown" and v.stage == "residual"
