@@ -303,3 +303,15 @@ def test_a_rejected_staged_certificate_asks_every_question():
     for name in QUESTIONS:
         v = cert.verdicts[name]
         assert v.verdict == "unknown" and v.stage == "residual"
+
+
+@pytest.mark.parametrize("extra", [["--h", "0.01"], ["--ensemble", "face-min-norm,none"]])
+def test_compare_integrators_titles_a_packing_as_a_packing(extra, tmp_path, capsys):
+    """`compare-integrators --packing` printed "packing 3x5" (a lattice's lx x ly, meaningless
+    for a packing) and "first-row modes " with nothing after it."""
+    (tmp_path / "three.csv").write_text(THREE)
+    assert main(["compare-integrators", "--packing", str(tmp_path / "three.csv"),
+                 "--t-max", "3", "--no-progress", *extra]) in (0, 1)
+    out = capsys.readouterr().out
+    assert out.startswith("packing of 3 disks, mu_pp 0.1")
+    assert "first-row modes" not in out
