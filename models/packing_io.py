@@ -198,6 +198,9 @@ def _read_npz(path: Path) -> Disks:
                               "y, r [, m, I])")
         arrays = {c: np.asarray(data[c]) for c in REQUIRED + OPTIONAL if c in files}
         walls = {k: float(data[k]) for k in ("left", "right") if k in files}
+    if arrays["x"].ndim != 1:  # e.g. centres as one (N, 2) array: "like x" would not help
+        raise InvalidFile(f"{path}: array 'x' must be 1-D, one abscissa per disk (the "
+                          f"ordinates in array 'y'), got shape {arrays['x'].shape}")
     p = arrays["x"].size
     cols = {}
     for c, a in arrays.items():

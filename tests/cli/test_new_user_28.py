@@ -315,3 +315,16 @@ def test_compare_integrators_titles_a_packing_as_a_packing(extra, tmp_path, caps
     out = capsys.readouterr().out
     assert out.startswith("packing of 3 disks, mu_pp 0.1")
     assert "first-row modes" not in out
+
+
+def test_an_npz_of_centres_as_one_array_says_x_must_be_1d(tmp_path, capsys):
+    """A packing .npz whose 'x' held the centres as an (N, 2) array was refused as "array 'x'
+    must be 4 numbers (like x)": x compared with itself."""
+    import numpy as np
+
+    f = tmp_path / "centres.npz"
+    np.savez(f, x=[[1.0, 1.0], [3.0, 1.0]], y=[1.0, 1.0], r=[1.0, 1.0])
+    assert main(["forceset", str(f)]) == 2
+    err = _one_line_error(capsys, "forceset")
+    assert err.endswith("array 'x' must be 1-D, one abscissa per disk (the ordinates in array "
+                        "'y'), got shape (2, 2)")
