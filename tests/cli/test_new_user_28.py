@@ -328,3 +328,11 @@ def test_an_npz_of_centres_as_one_array_says_x_must_be_1d(tmp_path, capsys):
     err = _one_line_error(capsys, "forceset")
     assert err.endswith("array 'x' must be 1-D, one abscissa per disk (the ordinates in array "
                         "'y'), got shape (2, 2)")
+
+
+def test_inertia_with_a_packing_is_refused_in_command_line_words(typed, capsys):
+    """`simulate --packing F --inertia 0.3` answered "pass inertia=None" (Python's words)."""
+    assert main(["simulate", "--packing", str(typed), "--gap-tol", "1e-4", "--inertia", "0.3",
+                 "--no-progress"]) == 2
+    err = _one_line_error(capsys, "simulate")
+    assert "leave --inertia out" in err and "inertia=None" not in err
