@@ -336,3 +336,28 @@ def test_inertia_with_a_packing_is_refused_in_command_line_words(typed, capsys):
                  "--no-progress"]) == 2
     err = _one_line_error(capsys, "simulate")
     assert "leave --inertia out" in err and "inertia=None" not in err
+
+
+def test_fuzz_says_how_to_fuzz_a_method_of_ones_own(capsys):
+    """`rigidlcp fuzz --methods mine` listed the built-in methods only."""
+    assert main(["fuzz", "--count", "1", "--methods", "mine"]) == 2
+    assert "a method of your own: register it in your script and call " \
+        "rigidlcp.bench.fuzz.run_fuzz" in _one_line_error(capsys, "fuzz")
+
+
+def test_run_fuzz_judges_a_method_registered_by_the_caller(monkeypatch):
+    """What the hint says works: a registered method is fuzzed by run_fuzz."""
+    from rigidlcp import lcp
+    from rigidlcp.bench.fuzz import run_fuzz
+    from rigidlcp.lcp import api, registry
+
+    api._load_builtin_methods()
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+
+    @lcp.register("mine-28", accepts="any", description="test: pivoting")
+    def mine(M, q):
+        z = lcp.solve(lcp.LCP(M, q), method="pivoting").z
+        return lcp.Solution(z=z, w=M @ z + q, status="solved", method="mine-28")
+
+    result = run_fuzz(4, seed=3, classes=("P",), methods=("mine-28",))
+    assert {m for (_, m) in result["table"]} == {"mine-28"}
