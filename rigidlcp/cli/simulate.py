@@ -56,8 +56,8 @@ def system_from_args(args, array_defaults: tuple | None = None):
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
         refuse_array_options(args, array_defaults or ARRAY_DEFAULTS)
         if args.inertia is not None:  # the library's refusal speaks Python (inertia=None)
-            raise ValueError("--inertia: a packing file gives every disk's moment of inertia "
-                             "(its column I, else m r^2 / 2): leave --inertia out")
+            raise ValueError("--inertia: the packing gives every disk's moment of inertia "
+                             "(its file's column I, else m r^2 / 2): leave --inertia out")
         from rigidlcp.models.system import System
 
         return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
