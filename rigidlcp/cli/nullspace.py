@@ -142,15 +142,9 @@ def packing_lattice(path: str, args: argparse.Namespace | None = None):
     """The geometry of a packing file (read with the --left, --right, --gap-tol of args), or
     of the system of a run saved by `rigidlcp simulate --out` (RUN.npz with its RUN.json: an
     array or a packing)."""
-    from pathlib import Path
-
     from rigidlcp.cli.packing_options import read_packing_args
 
-    if Path(path).suffix.lower() == ".npz" and Path(path).with_suffix(".json").is_file():
-        from rigidlcp.models.runio import load_run
-
-        return load_run(path).system.lattice
-    return read_packing_args(path, args or argparse.Namespace())
+    return read_packing_args(path, args or argparse.Namespace(), runs=True)
 
 
 def _print_null_space(ns, states: str, loops) -> None:

@@ -40,12 +40,31 @@ def refuse_without_packing(args: argparse.Namespace) -> None:
                          "array has its own walls and exact contacts)")
 
 
-def read_packing_args(path, args: argparse.Namespace):
+def is_run(path) -> bool:
+    """Whether `path` is a run saved by `rigidlcp simulate --out` (RUN.npz beside RUN.json)."""
+    from pathlib import Path
+
+    return Path(path).suffix.lower() == ".npz" and Path(path).with_suffix(".json").is_file()
+
+
+def read_packing_args(path, args: argparse.Namespace, runs: bool = False):
     """The Lattice of the packing file `path` with the options of `args` (missing ones at
     their defaults); an overlap beyond --gap-tol is refused with what accepts it, or with why
-    nothing does (interpenetration beyond models.packing.MAX_GAP_TOL)."""
+    nothing does (interpenetration beyond models.packing.MAX_GAP_TOL). runs: a run saved by
+    `rigidlcp simulate --out` (RUN.npz beside its RUN.json) gives its own geometry (the
+    options, which would change it, are then refused)."""
     from rigidlcp.models.packing import GAP_TOL, MAX_GAP_TOL, Overlap
     from rigidlcp.models.packing_io import read_disks, read_packing
+
+    if runs and is_run(path):
+        from rigidlcp.models.runio import load_run
+
+        given = [f"--{n.replace('_', '-')}" for n in ("left", "right", "gap_tol")
+                 if getattr(args, n, None) is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)}: {path} is a run, whose geometry (walls, "
+                             "contacts) was fixed when it was simulated")
+        return load_run(path).system.lattice
 
     gap_tol = getattr(args, "gap_tol", None)
     gap_tol = GAP_TOL if gap_tol is None else gap_tol

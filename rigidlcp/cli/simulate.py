@@ -85,7 +85,7 @@ def packing_of(args):
     if lat is None:
         from rigidlcp.cli.packing_options import read_packing_args
 
-        lat = args._packing_lattice = read_packing_args(args.packing, args)
+        lat = args._packing_lattice = read_packing_args(args.packing, args, runs=True)
     return lat
 
 
@@ -98,9 +98,11 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
     from rigidlcp.models.lattice import MAX_DISKS
 
     if getattr(args, "packing", None):  # its disks count, not the array options' defaults
+        from rigidlcp.cli.packing_options import is_run
         from rigidlcp.models.packing_io import read_disks
 
-        p = len(read_disks(args.packing).r)  # cheap first: c >= p before contacts are found
+        # cheap first: c >= p before contacts are found (a run's geometry is read whole)
+        p = packing_of(args).p if is_run(args.packing) else len(read_disks(args.packing).r)
         check_dense_memory(p, f"{what} of a packing of {p} disks (at least {p} contacts)",
                            instead=instead or SPARSE_INSTEAD)
         lat = packing_of(args)  # then its own contacts

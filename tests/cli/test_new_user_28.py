@@ -361,3 +361,29 @@ def test_run_fuzz_judges_a_method_registered_by_the_caller(monkeypatch):
 
     result = run_fuzz(4, seed=3, classes=("P",), methods=("mine-28",))
     assert {m for (_, m) in result["table"]} == {"mine-28"}
+
+
+def test_every_packing_command_takes_a_runs_geometry(tmp_path, capsys):
+    """`nullspace --packing RUN.npz` read a run's geometry, while `forces --packing RUN.npz`
+    and `simulate --packing RUN.npz` refused it ("a run ..., not a packing"). All take it now;
+    the same run again from it gives the same steady mu_g, and the options that would change
+    its geometry are refused."""
+    import json
+
+    from rigidlcp.models.deposition import deposit
+    from rigidlcp.models.packing_io import write_packing
+
+    pile = write_packing(tmp_path / "p5.csv", deposit(12, seed=5, radii=(0.8, 1.2), width=6.0))
+    mu = ["--mu-pp", "0.1", "--mu-plane", "0.1", "--mu-wall", "0.1", "--seed", "1"]
+    assert main(["simulate", "--packing", str(pile), *mu, "--out", str(tmp_path / "run5"),
+                 "--no-progress", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    run = str(tmp_path / "run5.npz")
+    assert main(["simulate", "--packing", run, *mu, "--no-progress", "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["status"] == first["status"] == "steady"
+    assert again["mu_g"] == first["mu_g"]
+    assert main(["forces", "--packing", run, "--out", str(tmp_path / "f")]) == 0
+    capsys.readouterr()
+    assert main(["simulate", "--packing", run, "--gap-tol", "1e-3", "--no-progress"]) == 2
+    assert "is a run, whose geometry" in _one_line_error(capsys, "simulate")
