@@ -100,8 +100,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
 
             bars.append(new_bar(total=total, desc="force ranges", unit="LP"))
         bars[0].total = total
-        bars[0].n = done
-        bars[0].refresh()
+        bars[0].update(done - bars[0].n)  # drawn at most every mininterval, not per LP
 
     fs = analyse(system, ranges=not args.no_ranges, progress=progress if show else None,
                  jobs=args.jobs)

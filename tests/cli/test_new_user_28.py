@@ -387,3 +387,24 @@ def test_every_packing_command_takes_a_runs_geometry(tmp_path, capsys):
     capsys.readouterr()
     assert main(["simulate", "--packing", run, "--gap-tol", "1e-3", "--no-progress"]) == 2
     assert "is a run, whose geometry" in _one_line_error(capsys, "simulate")
+
+
+def test_forceset_progress_is_not_redrawn_at_every_lp(tmp_path, capsys, monkeypatch):
+    """The range bar was redrawn after every LP (an explicit refresh): 800 LPs of a 100-disk
+    pile wrote about 200 bars into a log (stderr redirected) in 5 s. Now tqdm's rate limit
+    applies (mininterval, 0.1 s by default; an hour here, so that only the first and last
+    draws remain, whatever the machine's speed)."""
+    import rigidlcp.models.progress as progress
+    from rigidlcp.models.deposition import deposit
+    from rigidlcp.models.packing_io import write_packing
+
+    real = progress.new_bar
+    monkeypatch.setattr(progress, "new_bar", lambda **kw: real(mininterval=3600, **kw))
+
+    pile = write_packing(tmp_path / "p.csv", deposit(100, seed=2, radii=(0.8, 1.2),
+                                                     width=20.0))
+    assert main(["forceset", str(pile), "--mu-pp", "0.3", "--mu-plane", "0.3", "--mu-wall",
+                 "0.3"]) == 0
+    cap = capsys.readouterr()
+    assert "200 contacts" in cap.out and "dimension of the admissible set: 100" in cap.out
+    assert 1 <= cap.err.count("force ranges:") <= 3
