@@ -70,7 +70,7 @@ def read_packing_args(path, args: argparse.Namespace, runs: bool = False):
     gap_tol = GAP_TOL if gap_tol is None else gap_tol
     left, right = wall(getattr(args, "left", None)), wall(getattr(args, "right", None))
     try:
-        return read_packing(path, left=left, right=right, gap_tol=gap_tol)
+        lat = read_packing(path, left=left, right=right, gap_tol=gap_tol)
     except Overlap as exc:  # a hand-written file rounds its centres: say what accepts it
         r = read_disks(path).r
         s = min(r[exc.i], r[exc.j]) if exc.j >= 0 else r[exc.i]
@@ -79,3 +79,21 @@ def read_packing_args(path, args: argparse.Namespace, runs: bool = False):
                 f"{exc.overlap / s:.3g} of the radius: the disks interpenetrate, beyond what "
                 f"any --gap-tol accepts (at most {MAX_GAP_TOL:g}): not rigid disks in contact")
         raise Overlap(f"{exc}; {hint}", exc.i, exc.j, exc.overlap) from None
+    warn_if_off_the_plane(lat)
+    return lat
+
+
+def warn_if_off_the_plane(lat) -> None:
+    """On stderr, when no disk touches the plane y = 0: a DEM frame whose bottom is elsewhere
+    (the frame is not moved) reads as a pile floating above the plane, with no equilibrium."""
+    import sys
+
+    import numpy as np
+
+    from rigidlcp.models.lattice import PLANE
+
+    if lat.p and not np.any(lat.j == PLANE):
+        low = float(np.min(lat.x[:, 1] - lat.radii))
+        print(f"warning: no disk touches the plane y = 0 (the lowest disk's bottom is at y = "
+              f"{low:.6g}): the file's frame is not moved; shift y so that the bottom is 0",
+              file=sys.stderr, flush=True)

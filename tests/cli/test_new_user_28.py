@@ -408,3 +408,20 @@ def test_forceset_progress_is_not_redrawn_at_every_lp(tmp_path, capsys, monkeypa
     cap = capsys.readouterr()
     assert "200 contacts" in cap.out and "dimension of the admissible set: 100" in cap.out
     assert 1 <= cap.err.count("force ranges:") <= 3
+
+
+@pytest.mark.parametrize("command", [["forceset"], ["simulate", "--no-progress", "--packing"]])
+def test_a_pile_above_the_plane_is_named(command, tmp_path, capsys):
+    """A DEM frame whose bottom is not y = 0 (the frame is not moved): forceset said "no
+    equilibrium" (a checked Farkas certificate: the pile floats) with no word on why; a
+    warning now says that no disk touches the plane, and where the lowest bottom is."""
+    f = tmp_path / "lifted.csv"
+    f.write_text(THREE.replace(",1,1\n", ",6,1\n").replace("2.7320508075688772",
+                                                          "7.7320508075688772"))
+    main([*command, str(f)])
+    err = capsys.readouterr().err
+    assert ("warning: no disk touches the plane y = 0 (the lowest disk's bottom is at y = 5)"
+            in err)
+    (tmp_path / "three.csv").write_text(THREE)
+    main([*command, str(tmp_path / "three.csv")])
+    assert "no disk touches the plane" not in capsys.readouterr().err
