@@ -148,13 +148,14 @@ def packing_lattice(path: str, args: argparse.Namespace | None = None):
 
 
 def _print_null_space(ns, states: str, loops) -> None:
+    from rigidlcp.cli.packing_options import walls_text
     from rigidlcp.cli.simulate import title
 
     sysm = ns.system
     lat = sysm.lattice
     n_t = int(ns.normal.sum())
     n_ns = int((ns.tangential == 0).sum())
-    print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+    print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts{walls_text(lat)}; mu_pp = "
           f"{sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
     print(f"states: {states} ({n_t} T, {lat.c - n_t} NT; {n_ns} NS, {lat.c - n_ns} sliding or "
           "frictionless)")

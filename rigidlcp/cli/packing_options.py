@@ -97,3 +97,15 @@ def warn_if_off_the_plane(lat) -> None:
         print(f"warning: no disk touches the plane y = 0 (the lowest disk's bottom is at y = "
               f"{low:.6g}): the file's frame is not moved; shift y so that the bottom is 0",
               file=sys.stderr, flush=True)
+
+
+def walls_text(lat) -> str:
+    """"; left wall x = 0, right wall x = 4" for a packing (its walls come from options, the
+    file or the tight box: worth saying), "" for an array (walls at its ends)."""
+    if lat.regular:
+        return ""
+
+    def side(name: str, at) -> str:
+        return f"no {name} wall" if at is None else f"{name} wall x = {at:g}"
+
+    return f"; {side('left', lat.left)}, {side('right', lat.right)}"

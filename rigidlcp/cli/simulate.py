@@ -244,8 +244,10 @@ def cmd_simulate(args) -> int:
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
+        from rigidlcp.cli.packing_options import walls_text
+
         lat = system.lattice
-        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts{walls_text(lat)}; mu_pp = "
               f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
               f"gamma = {system.gamma} g, V0 = {system.V0}")
         rows = [("status", run.status), ("message", run.message)]

@@ -425,3 +425,14 @@ def test_a_pile_above_the_plane_is_named(command, tmp_path, capsys):
     (tmp_path / "three.csv").write_text(THREE)
     main([*command, str(tmp_path / "three.csv")])
     assert "no disk touches the plane" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("command", [["simulate", "--no-progress"], ["nullspace"]])
+def test_a_packings_walls_are_in_the_summary(command, tmp_path, capsys):
+    """`simulate --packing` did not say where the walls were (the file's box, the options, or
+    the tight box around the disks, which makes the outermost disks touch them); forceset
+    did. The first line now names them."""
+    (tmp_path / "three.csv").write_text(THREE)
+    main([*command, "--packing", str(tmp_path / "three.csv"), "--left", "none"])
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("packing: 3 disks, 6 contacts; no left wall, right wall x = 4; ")
