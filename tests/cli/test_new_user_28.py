@@ -436,3 +436,17 @@ def test_a_packings_walls_are_in_the_summary(command, tmp_path, capsys):
     main([*command, "--packing", str(tmp_path / "three.csv"), "--left", "none"])
     first = capsys.readouterr().out.splitlines()[0]
     assert first.startswith("packing: 3 disks, 6 contacts; no left wall, right wall x = 4; ")
+
+
+def test_timestep_says_what_it_ran(tmp_path, capsys):
+    """`rigidlcp timestep` printed its summary with no line on the system (simulate's first
+    line: the array or packing, its contacts, walls, friction and driving)."""
+    (tmp_path / "three.csv").write_text(THREE)
+    assert main(["timestep", "--packing", str(tmp_path / "three.csv"), "--t-max", "0.05",
+                 "--mu-pp", "0.3", "--no-progress"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first == ("packing: 3 disks, 7 contacts; left wall x = 0, right wall x = 4; "
+                     "mu_pp = 0.3, mu_plane = 0.2, mu_wall = 0.0, gamma = 0.1 g, V0 = 0.0")
+    assert main(["timestep", "--lx", "2", "--ly", "1", "--t-max", "0.05",
+                 "--no-progress"]) == 0
+    assert capsys.readouterr().out.startswith("rect 2x1: 2 disks, 5 contacts; mu_pp = 0.1")
