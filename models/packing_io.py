@@ -143,7 +143,8 @@ def _read_csv(path: Path, lines: list[str]) -> Disks:
             missing = [c for c in REQUIRED if c not in header]
             if missing:
                 raise InvalidFile(f"{path} line {k}: the header must name the columns x, y, r "
-                                  f"(missing {', '.join(missing)}; got {line[:60]!r})")
+                                  f"(missing {', '.join(missing)}; got {line[:60]!r})"
+                                  + _header_hint(line, header, missing))
             dup = [c for c in set(header) if header.count(c) > 1 and c]
             if dup:
                 raise InvalidFile(f"{path} line {k}: column {dup[0]!r} named twice")
@@ -158,6 +159,20 @@ def _read_csv(path: Path, lines: list[str]) -> Disks:
     if header is None:
         raise InvalidFile(f"{path}: no header line naming the columns x, y, r")
     return _finish(path, cols, **box)
+
+
+def _header_hint(line: str, header: list[str], missing: list[str]) -> str:
+    """What is most likely wrong with a CSV header that lacks `missing`: whitespace instead of
+    commas, names in another case, or a radius column named otherwise."""
+    if len(header) == 1 and len(line.split()) > 1:
+        return ": fields are separated by commas, this line by spaces or tabs"
+    lower = {h.lower(): h for h in header}
+    if all(c in lower for c in missing):
+        return (": names are case-sensitive, got " + ", ".join(repr(lower[c]) for c in missing))
+    if "r" in missing and ("radius" in lower or "diameter" in lower):
+        return (": name the radius column r" if "radius" in lower else
+                ": give the radius as a column r (half the diameter)")
+    return ""
 
 
 def _box_comment(path: Path, k: int, text: str) -> dict:
@@ -183,6 +198,9 @@ def _read_npz(path: Path) -> Disks:
                               "y, r [, m, I])")
         arrays = {c: np.asarray(data[c]) for c in REQUIRED + OPTIONAL if c in files}
         walls = {k: float(data[k]) for k in ("left", "right") if k in files}
+    if arrays["x"].ndim != 1:  # e.g. centres as one (N, 2) array: "like x" would not help
+        raise InvalidFile(f"{path}: array 'x' must be 1-D, one abscissa per disk (the "
+                          f"ordinates in array 'y'), got shape {arrays['x'].shape}")
     p = arrays["x"].size
     cols = {}
     for c, a in arrays.items():
@@ -213,8 +231,11 @@ def _read_lammps(path: Path, lines: list[str]) -> Disks:
             else "diameter"}
     missing = [v for v in need.values() if v not in names]
     if missing:
+        other = [n for n in ("xs", "ys", "xu", "yu", "xsu", "ysu") if n in names]
+        hint = (f": this dump has {', '.join(other)}; write the coordinates x y (e.g. "
+                "`dump 1 all custom N file id x y z radius`)" if other else "")
         raise InvalidFile(f"{path} line {start + 1}: the ATOMS columns must include x, y and "
-                          f"radius or diameter (missing {', '.join(missing)})")
+                          f"radius or diameter (missing {', '.join(missing)}){hint}")
     if "mass" in names:
         need["m"] = "mass"
     cols = {c: [] for c in need}

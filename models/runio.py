@@ -70,6 +70,9 @@ def load_run(path: str | os.PathLike) -> Run:
     """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
     data_path, _ = run_paths(path)
     if Path(path).is_file() and not data_path.exists():  # e.g. a text file, not PATH.npz
+        npz = Path(path).with_suffix(".npz")
+        if Path(path).suffix == ".json" and npz.is_file():  # the run's metadata, beside it
+            raise InvalidFile(f"{path} is the metadata of a run: give its data file, {npz}")
         raise InvalidFile(f"{path}: not a run file (a run is the .npz written by "
                           "`rigidlcp simulate`)")
     try:

@@ -103,7 +103,7 @@ def format_ensemble(ens: Ensemble) -> str:
     """The ensemble as a table and its spread (what `rigidlcp compare-integrators --ensemble`
     prints)."""
     sysm, lat = ens.system, ens.system.lattice
-    lines = [f"{lat.name} {lat.lx}x{lat.ly}, mu_pp {sysm.mu_pp:g}, mu_plane {sysm.mu_plane:g}, "
+    lines = [f"{lat.title()}, mu_pp {sysm.mu_pp:g}, mu_plane {sysm.mu_plane:g}, "
              f"mu_wall {sysm.mu_wall:g}, gamma {sysm.gamma:g}, V0 {sysm.V0:g}, seed {ens.seed}: "
              "one start, every selection rule",
              f"{'rule':<16} {'integrator':<20} {'status':<11} {'t_end':>8} {'mu_g':>11} "

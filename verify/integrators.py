@@ -238,11 +238,12 @@ def format_comparison(cmp: Comparison) -> str:
     """The comparison as a text table (what `rigidlcp compare-integrators` prints)."""
     ed, sysm = cmp.event_run, cmp.system
     lat = sysm.lattice
-    head = (f"{lat.name} {lat.lx}x{lat.ly}, mu_pp {sysm.mu_pp:g}, mu_plane {sysm.mu_plane:g}, "
+    head = (f"{lat.title()}, mu_pp {sysm.mu_pp:g}, mu_plane {sysm.mu_plane:g}, "
             f"mu_wall {sysm.mu_wall:g}, gamma {sysm.gamma:g}, V0 {sysm.V0:g}, seed {cmp.seed}")
     lines = [head,
              f"event-driven: {ed.status} at t = {ed.last.t:.6g} after {ed.n_events} events; "
-             f"mu_g = {ed.last.mu_g:.6f}; first-row modes {cmp.modes}",
+             f"mu_g = {ed.last.mu_g:.6f}" + (f"; first-row modes {cmp.modes}" if cmp.modes
+                                               else ""),
              f"time-stepping (Moreau-Jean); omega compared at T = {cmp.T:.6g}",
              f"{'h':>9} {'status':>8} {'t_end':>9} {'mu_g':>10} {'modes':>12} "
              f"{'|dmu_g|':>9} {'max|dalpha|':>11} {'dstates':>7} {'|domega(T)|':>11} "

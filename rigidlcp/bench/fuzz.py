@@ -35,7 +35,7 @@ import numpy as np
 
 from rigidlcp import lcp
 from rigidlcp.lcp.batch import COMPILED_BATCH
-from rigidlcp.lcp.errors import InvalidInput, OutputExists, RigidLCPError
+from rigidlcp.lcp.errors import InvalidInput, InvalidProblem, OutputExists, RigidLCPError
 
 from .fuzz_cases import CLASSES, Case, make_case
 from .fuzz_judge import (  # noqa: F401 (judge_residual, lp_feasible: public here too)
@@ -179,7 +179,12 @@ def run_from_args(args: argparse.Namespace) -> int:
         raise OutputExists(f"--out {args.out} exists; give a new folder")
     methods = tuple(m for m in args.methods.split(",") if m) if args.methods else None
     for m in methods or ():
-        lcp.get_method(m)  # an unknown name raises InvalidProblem
+        try:
+            lcp.get_method(m)  # an unknown name raises InvalidProblem
+        except InvalidProblem as exc:  # the command line cannot import a user's method
+            raise InvalidProblem(f"{exc} (a method of your own: register it in your script "
+                                 "and call rigidlcp.bench.fuzz.run_fuzz(count, seed, out, "
+                                 "methods=(...)), docs/fuzz.md)") from None
     t0 = time.perf_counter()
     if args.files:
         missing = [f for f in args.files if not Path(f).is_file()]

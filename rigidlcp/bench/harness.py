@@ -197,7 +197,9 @@ def check_methods(methods: Iterable[str], siconos: SiconosRunner | None) -> None
         if m not in known and m not in SICONOS_METHODS and m not in PEERS:
             every = sorted(known) + list(SICONOS_METHODS) + list(PEERS)
             raise ValueError(f"unknown method {m!r}{lcp.registry.did_you_mean(m, every)}; "
-                             f"available: {', '.join(every)}")
+                             f"available: {', '.join(every)} (a method of your own: register "
+                             "it in a script that calls run_bench, docs/bench.md 'A test "
+                             "double')")
         if m in SICONOS_METHODS and (siconos is None or not siconos.available):
             raise ValueError(f"{m} needs Siconos: "
                              f"{siconos.reason if siconos else 'no Siconos runner given'}")

@@ -347,8 +347,10 @@ def get_set(spec: str, *, seed: int = 0, cache_dir: str | os.PathLike | None = N
     path = Path(spec)
     if path.is_dir():
         return load_folder(path)
+    where = "" if path.is_absolute() else (
+        f" (a relative folder is read from the current folder, {Path.cwd()})")
     raise ValueError(f"unknown problem set {spec!r}: not a name ({', '.join(SETS)}) nor a "
-                     "directory")
+                     f"directory{where}")
 
 
 @dataclass(frozen=True)

@@ -217,11 +217,19 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
     from rigidlcp.bench.harness import append_csv, run_bench, write_csv
     from rigidlcp.bench.problem_sets import SETS, Unreadable
     from rigidlcp.bench.report_md import write_report
+    from rigidlcp.lcp.errors import OutputExists
     from rigidlcp.lcp.io.files import output_dir
 
     out = Path(args.out)
     created = not out.exists()
-    output_dir(out, force=args.force or args.resume)  # new or empty, unless --force/--resume
+    try:
+        output_dir(out, force=args.force or args.resume)  # new or empty, unless --force/--resume
+    except OutputExists:
+        if not (out / "results.csv").is_file():
+            raise
+        raise OutputExists(f"{out} holds an earlier bench run (results.csv): --resume "
+                           "finishes it, --force writes into it (files of the same name are "
+                           "overwritten)") from None
     csv_path = out / "results.csv"
     try:
         if not args.resume and csv_path.exists():
@@ -250,9 +258,13 @@ def _run(args, sets, set_info, specs_by_name, methods, siconos, notes, done, pee
             sets, methods, time_limit=args.time_limit, tol=args.tol,
             isolate=not args.no_isolation, siconos=siconos, progress=progress,
             batch=not args.no_batch, skip=skip, warmups=warmups)
-    except BaseException:
+    except BaseException as exc:
         if created and out.is_dir() and not any(out.iterdir()):
             out.rmdir()  # a refused or interrupted run leaves nothing behind
+        if isinstance(exc, KeyboardInterrupt) and csv_path.is_file():
+            print(f"\nrigidlcp bench: interrupted; the finished solves are in {csv_path}: "
+                  "rerun the same command with --resume to finish the run", file=sys.stderr)
+            return 130
         raise
     command = (f"rigidlcp bench {' '.join(shlex.quote(a) for a in sys.argv[2:])}"
                if sys.argv[1:2] == ["bench"] else "rigidlcp bench (called from Python)")

@@ -14,6 +14,7 @@ import numpy as np
 
 
 def register(sub) -> None:
+    from rigidlcp.cli.packing_options import add_packing_options
     from rigidlcp.models.system import DEFAULT_MU
 
     p = sub.add_parser(
@@ -34,12 +35,7 @@ def register(sub) -> None:
     for name in ("mu_pp", "mu_plane", "mu_wall"):
         p.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
                        help=f"friction coefficient (default {DEFAULT_MU[name]})")
-    p.add_argument("--left", default=None, help="left wall abscissa, or 'none' (default: the "
-                   "file's '# box:', else the tight box)")
-    p.add_argument("--right", default=None, help="right wall abscissa, or 'none'")
-    p.add_argument("--gap-tol", type=float, default=None,
-                   help="relative gap tolerance of contact detection (default 1e-9, at most 0.05: "
-                   "overlaps up to G x the smaller radius are contacts)")
+    add_packing_options(p, with_packing=False)
     p.add_argument("--no-ranges", action="store_true",
                    help="existence and dimension only (no range LPs)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
@@ -61,36 +57,17 @@ def register(sub) -> None:
     p.set_defaults(func=cmd_forceset)
 
 
-def _wall(text: str | None):
-    if text is None or text == "none":
-        return text
-    try:
-        return float(text)
-    except ValueError:
-        raise ValueError(f"a wall must be a number or 'none', got {text!r}") from None
-
-
 def cmd_forceset(args: argparse.Namespace) -> int:
-
+    from rigidlcp.cli.packing_options import read_packing_args, wall
     from rigidlcp.lcp.io.files import output_dir
-    from rigidlcp.models.packing import GAP_TOL, MAX_GAP_TOL, Overlap
-    from rigidlcp.models.packing_io import read_disks, read_packing
+    from rigidlcp.models.packing_io import read_disks
     from rigidlcp.models.system import System
 
     if args.jobs < 1:  # the options first: a bad one is named before the file is read
         raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
-    gap_tol = GAP_TOL if args.gap_tol is None else args.gap_tol
-    left, right = _wall(args.left), _wall(args.right)
+    left, right = wall(args.left), wall(args.right)
     disks = read_disks(args.file)
-    try:
-        lat = read_packing(args.file, left=left, right=right, gap_tol=gap_tol)
-    except Overlap as exc:  # a hand-written file rounds its centres: say what accepts it
-        s = min(disks.r[exc.i], disks.r[exc.j]) if exc.j >= 0 else disks.r[exc.i]
-        hint = (f"--gap-tol G accepts overlaps up to G x radius (G <= {MAX_GAP_TOL:g})"
-                if exc.overlap <= MAX_GAP_TOL * s else
-                f"{exc.overlap / s:.3g} of the radius: the disks interpenetrate, beyond what "
-                f"any --gap-tol accepts (at most {MAX_GAP_TOL:g}): not rigid disks in contact")
-        raise Overlap(f"{exc}; {hint}", exc.i, exc.j, exc.overlap) from None
+    lat = read_packing_args(args.file, args)
     system = System(lat, mu_pp=args.mu_pp, mu_plane=args.mu_plane, mu_wall=args.mu_wall)
     if args.samples < 0:
         raise ValueError(f"--samples must be >= 0, got {args.samples}")
@@ -123,8 +100,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
 
             bars.append(new_bar(total=total, desc="force ranges", unit="LP"))
         bars[0].total = total
-        bars[0].n = done
-        bars[0].refresh()
+        bars[0].update(done - bars[0].n)  # drawn at most every mininterval, not per LP
 
     fs = analyse(system, ranges=not args.no_ranges, progress=progress if show else None,
                  jobs=args.jobs)
@@ -157,7 +133,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
     print(_box_line(lat, disks, left, right))
     if fs.exists is None:
         print(f"existence undecided: {fs.undecided}")
-        return 0
+        return _written(out, fs, args)
     if not fs.exists:
         print("no equilibrium: Farkas certificate checked " + (
             "in exact rational arithmetic" if fs.exact else
@@ -168,7 +144,7 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
             print(f"it moves only disks {shown}{more} (the others held fixed)")
         elif fs.moving is not None:
             print(f"it moves every disk ({lat.p})")
-        return 0
+        return _written(out, fs, args)
     print(f"equilibrium exists (checked: balance residual {fs.residuals[0]:.2e}, laws "
           f"{fs.residuals[1]:.2e}); dimension of the admissible set: {fs.dimension}"
           + (" (unique forces)" if fs.dimension == 0 else ""))
@@ -187,6 +163,22 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         print(f"{e['samples']} uniform samples ({e['sampler']}), each checked: largest "
               f"residuals {e['residuals'][0]:.2e} (balance), {e['residuals'][1]:.2e} (laws); "
               f"force fluctuation {e['fluctuation']:.4g} <R>; samples.npz, pf.png")
+    return _written(out, fs, args)
+
+
+def _written(out, fs, args) -> int:
+    """Say what --out holds (the text output only: --json prints one object), and why
+    forceset.png is missing when it is: there is no equilibrium to draw, or no ranges."""
+    if out is not None:
+        names = ["forceset.json"]
+        if fs.exists and not args.no_ranges:
+            names.append("forceset.png")
+        if fs.exists and args.samples:
+            names += ["samples.npz", "pf.png"]
+        why = ("" if len(names) > 1 else " (no forceset.png: no equilibrium to draw)"
+               if fs.exists is False else " (no forceset.png: existence undecided)"
+               if fs.exists is None else " (no forceset.png: --no-ranges)")
+        print(f"written: {', '.join(str(out / n) for n in names)}{why}")
     return 0
 
 

@@ -5,7 +5,8 @@ its heavy imports inside the commands, so that `rigidlcp --help` stays fast. An 
 purpose by the toolkit (`rigidlcp.lcp.errors.RigidLCPError`), a bad value, a file that is
 missing, exists already or cannot be written, or an allocation that fails (MemoryError, past
 the commands' up-front memory estimates), is printed as one line naming the problem, with exit
-status 2: never a traceback.
+status 2: never a traceback. Ctrl-C (KeyboardInterrupt) is one line too, with exit status 130
+(128 + SIGINT, as a shell reports it); a command with resumable output says how to resume.
 """
 
 from __future__ import annotations
@@ -94,6 +95,9 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # `rigidlcp ... | head`: the reader left; say nothing more
         _silence_stdout()
         return 0
+    except KeyboardInterrupt:  # Ctrl-C: the user knows why; one line, not a traceback
+        print(f"\nrigidlcp {args.command}: interrupted", file=sys.stderr)
+        return 130
     except (RigidLCPError, ValueError, OSError) as exc:
         print(f"rigidlcp {args.command}: error: {_one_line(exc)}", file=sys.stderr)
         return 2

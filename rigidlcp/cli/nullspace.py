@@ -48,6 +48,9 @@ def add_nullspace(sub) -> None:
     p.add_argument("--packing", metavar="FILE", default=None,
                    help="disks from a packing file (.csv/.npz/LAMMPS dump) or a saved run "
                    "(RUN.npz) instead of --lattice/--lx/--ly (docs/packings.md)")
+    from rigidlcp.cli.packing_options import add_packing_options
+
+    add_packing_options(p)  # --left, --right, --gap-tol: read as `rigidlcp forceset` reads
     p.add_argument("--states", default="tangential", metavar="normal|tangential|FILE",
                    help="the paper's states of Eq. (3.3) or (3.4) (default tangential), or a "
                    "JSON file of per-contact states (docs/verification.md)")
@@ -69,6 +72,7 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     import numpy as np
 
     from rigidlcp import models
+    from rigidlcp.cli.packing_options import refuse_without_packing
     from rigidlcp.cli.simulate import DENSE_ONLY, refuse_array_options, refuse_too_large_for_dense
     from rigidlcp.models.engine.simulate import check_dense_memory
     from rigidlcp.verify.nullspace.contact import (
@@ -78,9 +82,10 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
         rotation_loops,
     )
 
+    refuse_without_packing(args)
     if args.packing:
         refuse_array_options(args, ("rect", 4, 3))  # nullspace's own defaults
-        lattice = packing_lattice(args.packing)
+        lattice = packing_lattice(args.packing, args)
         check_dense_memory(lattice.c, f"the dense contact matrix of {args.packing} "
                            f"({lattice.c} contacts)", instead=DENSE_ONLY)
     else:
@@ -133,28 +138,24 @@ def cmd_nullspace(args: argparse.Namespace) -> int:
     return 0
 
 
-def packing_lattice(path: str):
-    """The geometry of a packing file, or of the system of a run saved by `rigidlcp simulate
-    --out` (RUN.npz with its RUN.json: an array or a packing)."""
-    from pathlib import Path
+def packing_lattice(path: str, args: argparse.Namespace | None = None):
+    """The geometry of a packing file (read with the --left, --right, --gap-tol of args), or
+    of the system of a run saved by `rigidlcp simulate --out` (RUN.npz with its RUN.json: an
+    array or a packing)."""
+    from rigidlcp.cli.packing_options import read_packing_args
 
-    from rigidlcp.models.packing_io import read_packing
-
-    if Path(path).suffix.lower() == ".npz" and Path(path).with_suffix(".json").is_file():
-        from rigidlcp.models.runio import load_run
-
-        return load_run(path).system.lattice
-    return read_packing(path)
+    return read_packing_args(path, args or argparse.Namespace(), runs=True)
 
 
 def _print_null_space(ns, states: str, loops) -> None:
+    from rigidlcp.cli.packing_options import walls_text
     from rigidlcp.cli.simulate import title
 
     sysm = ns.system
     lat = sysm.lattice
     n_t = int(ns.normal.sum())
     n_ns = int((ns.tangential == 0).sum())
-    print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+    print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts{walls_text(lat)}; mu_pp = "
           f"{sysm.mu_pp}, mu_plane = {sysm.mu_plane}, mu_wall = {sysm.mu_wall}")
     print(f"states: {states} ({n_t} T, {lat.c - n_t} NT; {n_ns} NS, {lat.c - n_ns} sliding or "
           "frictionless)")

@@ -34,6 +34,8 @@ def register(sub) -> None:
                    help="also the case split on the disks' cap states (verify.ranges."
                    "disk_split), S seconds per end left open: a better proved bound")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar on stderr (one step per end's search)")
     p.set_defaults(func=cmd_ranges)
 
 
@@ -55,12 +57,26 @@ def cmd_ranges(args: argparse.Namespace) -> int:
                            "a steady state: `rigidlcp ranges` needs a run that reached one "
                            "(rerun `rigidlcp simulate` with a larger --t-max or --max-events)")
     _warn_long(run.system, args)
+    bars: list = []
+
+    def progress(done: int, total: int, name: str) -> None:
+        if not bars:
+            from rigidlcp.models.progress import new_bar
+
+            bars.append(new_bar(total=total, desc="range ends", unit="end"))
+        bars[0].set_postfix_str(name, refresh=False)
+        bars[0].update(done - bars[0].n)
+
     try:
         result = steady_ranges(run, which=args.observables, time_limit=args.time_limit,
-                               box=args.box, split=True if args.deep is None else args.deep)
+                               box=args.box, split=True if args.deep is None else args.deep,
+                               progress=None if args.no_progress else progress)
     except NoVelocityBound as exc:
         raise NoVelocityBound(f"{args.run}: the ranges over all valid steady states do not "
                               f"handle this system ({exc})") from None
+    finally:
+        for bar in bars:
+            bar.close()
     if args.json:
         print(json.dumps(result.to_dict()))
     else:
@@ -74,7 +90,8 @@ LONG_RUN_S = 60.0
 
 def _warn_long(system, args: argparse.Namespace) -> None:
     """Say on stderr, before the work, how long the MILPs may take: one per end of every
-    observable, each up to --time-limit, with no progress bar (a 10 x 4 run: about 14 min)."""
+    observable, each up to --time-limit (a 10 x 4 run: about 14 min); a bar then counts the
+    ends."""
     import sys
 
     n = 1 + (system.p if args.observables in ("alpha", "all") else 0) \

@@ -41,15 +41,23 @@ def add_system_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--packing", metavar="FILE", default=None,
                    help="disks from a packing file (.csv/.npz/LAMMPS dump, docs/packings.md) "
                    "instead of --lattice/--lx/--ly")
+    from rigidlcp.cli.packing_options import add_packing_options
+
+    add_packing_options(g)  # --left, --right, --gap-tol: read as `rigidlcp forceset` reads
 
 
 def system_from_args(args, array_defaults: tuple | None = None):
     """The System of the options; with --packing, refused when --lattice/--lx/--ly differ from
     the command's own `array_defaults` (default ARRAY_DEFAULTS, simulate's 10 x 4 rect)."""
+    from rigidlcp.cli.packing_options import refuse_without_packing
     from rigidlcp.models.system import make_system
 
+    refuse_without_packing(args)
     if getattr(args, "packing", None):  # a packing file: its own radii, masses and inertias
         refuse_array_options(args, array_defaults or ARRAY_DEFAULTS)
+        if args.inertia is not None:  # the library's refusal speaks Python (inertia=None)
+            raise ValueError("--inertia: the packing gives every disk's moment of inertia "
+                             "(its file's column I, else m r^2 / 2): leave --inertia out")
         from rigidlcp.models.system import System
 
         return System(packing_of(args), mu_pp=args.mu_pp, mu_plane=args.mu_plane,
@@ -75,9 +83,9 @@ def packing_of(args):
     """The lattice of --packing FILE, read once (kept on args for system_from_args)."""
     lat = getattr(args, "_packing_lattice", None)
     if lat is None:
-        from rigidlcp.models.packing_io import read_packing
+        from rigidlcp.cli.packing_options import read_packing_args
 
-        lat = args._packing_lattice = read_packing(args.packing)
+        lat = args._packing_lattice = read_packing_args(args.packing, args, runs=True)
     return lat
 
 
@@ -90,9 +98,11 @@ def refuse_too_large_for_dense(args, what: str, instead: str | None = None) -> N
     from rigidlcp.models.lattice import MAX_DISKS
 
     if getattr(args, "packing", None):  # its disks count, not the array options' defaults
+        from rigidlcp.cli.packing_options import is_run
         from rigidlcp.models.packing_io import read_disks
 
-        p = len(read_disks(args.packing).r)  # cheap first: c >= p before contacts are found
+        # cheap first: c >= p before contacts are found (a run's geometry is read whole)
+        p = packing_of(args).p if is_run(args.packing) else len(read_disks(args.packing).r)
         check_dense_memory(p, f"{what} of a packing of {p} disks (at least {p} contacts)",
                            instead=instead or SPARSE_INSTEAD)
         lat = packing_of(args)  # then its own contacts
@@ -234,8 +244,10 @@ def cmd_simulate(args) -> int:
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
+        from rigidlcp.cli.packing_options import walls_text
+
         lat = system.lattice
-        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts; mu_pp = "
+        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts{walls_text(lat)}; mu_pp = "
               f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
               f"gamma = {system.gamma} g, V0 = {system.V0}")
         rows = [("status", run.status), ("message", run.message)]

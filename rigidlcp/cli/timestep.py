@@ -83,6 +83,13 @@ def cmd_timestep(args) -> int:
     if args.json:
         print(json.dumps(summary, indent=2, default=float))
     else:
+        from .packing_options import walls_text
+        from .simulate import title
+
+        lat = system.lattice  # what was run, as simulate's first line says it
+        print(f"{title(lat)}: {lat.p} disks, {lat.c} contacts{walls_text(lat)}; mu_pp = "
+              f"{system.mu_pp}, mu_plane = {system.mu_plane}, mu_wall = {system.mu_wall}, "
+              f"gamma = {system.gamma} g, V0 = {system.V0}")
         width = max(len(k) for k in summary)
         for k, v in summary.items():
             if isinstance(v, float):

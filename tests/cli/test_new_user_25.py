@@ -102,7 +102,8 @@ def test_a_packing_run_is_not_titled_as_an_array(tmp_path, capsys):
     assert main(["simulate", "--packing", str(f), "--out", str(tmp_path / "run.npz"),
                  "--no-progress"]) == 0
     first = capsys.readouterr().out.splitlines()[0]
-    assert first.startswith("packing: 3 disks, 7 contacts; mu_pp = 0.1")
+    assert first.startswith("packing: 3 disks, 7 contacts; left wall x = 0, right wall x = 4; "
+                            "mu_pp = 0.1")  # the walls: session 28
 
 
 @pytest.mark.parametrize("command", ["solve", "certify"])

@@ -147,6 +147,12 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
 
     if not isinstance(run, Run):
         run = load_run(run)
+    if run.method.startswith("moreau-jean"):  # its records are steps: not event solutions
+        raise InvalidInput(f"a time-stepping run ({run.method}): its records are steps, "
+                           "whose impulses are not solutions of an event problem; "
+                           "certify-run certifies the events of `rigidlcp simulate` (`rigidlcp "
+                           "compare-integrators` checks a time-stepper's state in the event "
+                           "laws)")
     options = {"time_limit": float(time_limit), "tries": int(tries), "ranges": bool(ranges)}
     todo_all = list(range(run.n_events)) if events is None else sorted(set(int(k) for k in
                                                                          events))

@@ -184,7 +184,9 @@ def certify_stages(
     base = check(lcp, z, None, tol=tol, lcp_form=lcp)  # verify.certify's acceptance test
     out = StagedCertificate(base.accepted, base.scaled_residual, lcp.n,
                             {k: Verdict(k) for k in obs})
-    if not base.accepted:
+    if not base.accepted:  # every question, the contact states' too, without a verdict
+        if observables is None:
+            out.verdicts.setdefault("states", Verdict("states"))
         for v in out.verdicts.values():
             v.stage, v.reason = "residual", f"not a solution at tol {tol:g}: no verdict"
         out.seconds = time.perf_counter() - t0

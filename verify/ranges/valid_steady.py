@@ -12,6 +12,7 @@ program). The MILP's own point is never the witness.
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -148,8 +149,8 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
-                  V_mode: str | None = None, kinematics: str = "auto", split: bool | float = True
-                  ) -> SteadyRanges:
+                  V_mode: str | None = None, kinematics: str = "auto", split: bool | float = True,
+                  progress: Callable[[int, int, str], None] | None = None) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
@@ -159,7 +160,8 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     the MILP; witnesses move at (alpha, gamma) t, t = 1 or the run's V / gamma), "lazy"
     (velocities checked on each optimum, verify.ranges.milp) or "big-M" (in the MILP).
     split: an end left at the time limit gets a proved bound by verify.ranges.cap_split where
-    it applies (a number s: also disk_split's, s seconds per end). Raises NotSteady (none
+    it applies (a number s: also disk_split's, s seconds per end). progress(done, total,
+    name): called after each end's search (total: 2 per observable). Raises NotSteady (none
     valid, run not steady)."""
     t0 = time.perf_counter()
     system, last = _run_system(target)
@@ -192,9 +194,13 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
         model.add_seed(start[4])
     for s_seed in seed_states(form):
         model.add_seed(s_seed)
-    for name, L in obs.items():
+    for k, (name, L) in enumerate(obs.items()):
         lo = _end(form, model, L, +1, time_limit)
+        if progress is not None:
+            progress(2 * k + 1, 2 * len(obs), name)
         hi = _end(form, model, L, -1, time_limit)
+        if progress is not None:
+            progress(2 * k + 2, 2 * len(obs), name)
         scope = "all valid steady states" if form.proved_for(L) else unproved
         ranges[name] = Range(name, lo, hi, scope)
     # The ends left at their time limit, again against the states met since (a later end's
