@@ -204,6 +204,55 @@ def test_the_c_verdict_is_the_pythons(seed):
 
 
 @compiled
+def test_the_c_solution_fills_every_slot_or_sets_the_fields_by_name():
+    """solve_lcp writes the Solution's 14 slots directly (their offsets read from the class's
+    member descriptors by solve_setup); given a class whose fields are not plain slots (here a
+    dataclass with a __dict__), it sets them by name instead. Both objects equal the general
+    path's answer field for field."""
+    import dataclasses
+
+    from rigidlcp.lcp.problems.solution import Solution
+
+    rng = np.random.default_rng(5)
+    A = rng.standard_normal((7, 7))
+    P = lcp.LCP(A @ A.T + 0.1 * np.eye(7), rng.standard_normal(7))
+    assert not hasattr(Solution(np.zeros(1), np.zeros(1), "failed", "x"), "__dict__")
+    args = (P.M, P.q, fast_lemke.DEFAULT_TOL, 1700, kernel.sums_verified_upto())
+    slotted = fast_lemke._solve_lcp(*args)
+    assert type(slotted) is Solution
+
+    @dataclasses.dataclass
+    class Plain:  # the same fields, in a __dict__
+        z: object
+        w: object
+        status: object
+        method: object
+        iterations: object
+        residual: object
+        eq_residual: object
+        scaled_residual: object
+        basis: object
+        u: object
+        message: object
+        info: object
+        backward_error: object
+        forward_error: object
+
+    try:
+        kernel._lemke_c.solve_setup(np.dot, np.empty, np.intp, object.__new__, Plain,
+                                    fast_lemke._Q_NONNEGATIVE, residual.TOL, fast_lemke.FERR_TOL)
+        by_name = fast_lemke._solve_lcp(*args)
+    finally:
+        fast_lemke._setup()
+    assert type(by_name) is Plain and list(vars(by_name)) == [
+        f.name for f in dataclasses.fields(Solution)]
+    one = assert_same_answer(P)
+    for f in dataclasses.fields(Solution):
+        assert same(getattr(slotted, f.name), getattr(one, f.name)), f.name
+        assert same(getattr(by_name, f.name), getattr(one, f.name)), f.name
+
+
+@compiled
 @pytest.mark.parametrize("mscale, qscale", [(1.0, 1.0), (1e300, 1e-300), (1e-300, 1e300),
                                             (1e-200, 1e-150), (1e250, 1e100), (1e-310, 1.0),
                                             (1.0, 0.0)])
