@@ -14,7 +14,9 @@
  *     (code, pivots, nbasis, acode, berr, ferr, refined, raw, scaled, z, w, basis): the
  *     numbers of `solve_fast` and its arrays (basis of length nbasis) for the Python to
  *     finish (not solved, not assessed here, not measured here, or not accepted).
- * The includer includes _lemke_py.h, _lemke_problem.h and _lemke_measure.h first. */
+ * M z is numpy's own cblas_dgemv called directly when lcp/_lemke_kernel.py found and checked it
+ * (_blas.h), else numpy.dot called from here. The includer includes _lemke_py.h, _blas.h,
+ * _lemke_problem.h and _lemke_measure.h first. */
 #ifndef RIGIDLCP_LEMKE_SOLUTION_H
 #define RIGIDLCP_LEMKE_SOLUTION_H
 
@@ -180,14 +182,20 @@ static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t 
     double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
     idx nb = 0;
     int code, acode = 1;
+    int direct = blas_ok(n), measured = 0;
     Py_BEGIN_ALLOW_THREADS
     code = solve_and_accept(n, M, q, tol, max_iter, zd, b, &pivots, &nb, &acode, res);
+    if (code == 0 && acode == 0 && direct) { /* numpy's own gemv (_blas.h), then the measure */
+        blas_mz(n, M, zd, wd);
+        measured = 1;
+        if (n <= upto && measure_one(n, M, q, zd, wd, got) < 0) got[0] = got[1] = NAN;
+    }
     Py_END_ALLOW_THREADS
     if (code < 0) {
         PyErr_NoMemory();
         goto done;
     }
-    if (code == 0 && acode == 0) {
+    if (code == 0 && acode == 0 && !measured) {
         PyObject *call[3] = {args[0], z, w};
         PyObject *out = PyObject_Vectorcall(s_dot, call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;

@@ -83,6 +83,7 @@ def _setup(tol: float = TOL, ferr_tol: float = FERR_TOL) -> None:
 
 if _solve_lcp is not None:
     _setup()
+    _kernel.numpy_gemv()  # M z by numpy's own cblas_dgemv from C, when found and checked
 
 
 def solve_lemke(problem) -> Solution | None:
