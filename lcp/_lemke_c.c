@@ -27,6 +27,7 @@
  *   acceptance/_accuracy_core.h  the acceptance steps of assess_lcp (shared with _accuracy_c.c)
  *   _lemke_run.h      the Lemke state and the pivoting run on one dictionary (+ AVX2 update)
  *   _lemke_py.h       the buffer checks and the entry points run, setup, check, plain
+ *   _blas.h           numpy's cblas_dgemv, called directly for M z (gemv_setup, gemv)
  *   _lemke_problem.h  one whole problem without the GIL: equilibration (_balanced.h), the
  *                     scaled dictionary (+ AVX2 pass over M), solve_problem, the work array,
  *                     the acceptance of the answer
@@ -46,6 +47,7 @@ typedef Py_ssize_t idx;
 #include "acceptance/_accuracy_core.h" /* assess_one: the acceptance of solve_accept */
 #include "_lemke_run.h"
 #include "_lemke_py.h"
+#include "_blas.h" /* gemv_setup, gemv: numpy's own cblas_dgemv for M z */
 #include "_lemke_problem.h"
 #include "_lemke_measure.h"
 #include "_lemke_solution.h" /* solve_setup, solve_lcp: solve_fast and its Solution */
@@ -303,15 +305,21 @@ static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t
     double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
     idx nb = 0;
     int code, acode = 1;
+    int direct = blas_ok(n), measured = 0;
     Py_BEGIN_ALLOW_THREADS
     code = solve_and_accept(n, M, q, tol, max_iter, z, (int64_t *)vb.buf, &pivots, &nb, &acode,
                             res);
+    if (code == 0 && acode == 0 && direct) { /* numpy's own gemv (_blas.h), then the measure */
+        blas_mz(n, M, z, w);
+        measured = 1;
+        if (n <= upto && measure_one(n, M, q, z, w, got) < 0) got[0] = got[1] = NAN;
+    }
     Py_END_ALLOW_THREADS
     if (code < 0) {
         PyErr_NoMemory();
         goto done;
     }
-    if (code == 0 && acode == 0) {
+    if (code == 0 && acode == 0 && !measured) {
         PyObject *call[3] = {args[0], args[4], args[5]};
         PyObject *out = PyObject_Vectorcall(args[7], call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;
@@ -342,6 +350,10 @@ static PyMethodDef methods[] = {
     {"solve_lcp", (PyCFunction)(void (*)(void))py_solve_lcp, METH_FASTCALL,
      "solve_lcp(M, q, tol, max_iter, upto) -> Solution, or solve_fast's numbers and (z, w, "
      "basis): see lcp/_lemke_solution.h."},
+    {"gemv_setup", py_gemv_setup, METH_VARARGS,
+     "gemv_setup(address, ilp64): numpy's cblas_dgemv for M z (0: none; see lcp/_blas.h)."},
+    {"gemv", py_gemv, METH_VARARGS,
+     "gemv(M, z, w) -> bool: w = M z by the cblas_dgemv of gemv_setup (False: none set)."},
     {"solve_setup", py_solve_setup, METH_VARARGS,
      "solve_setup(dot, empty, intp, new, Solution, q_nonnegative, TOL, FERR_TOL): solve_lcp's "
      "Python objects."},

@@ -194,3 +194,72 @@ def solve_one(M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float, max_iter:
     if codes[0] != SOLVED:
         return None
     return Z[0], basic[0].nonzero()[0], int(pivots[0])
+
+
+#: numpy's BLAS whose cblas_dgemv `numpy_gemv` looks for: (BLAS name in numpy's build
+#: configuration, library file pattern in numpy.libs, symbol of 64-bit or 32-bit integers)
+_GEMV_LIBS = (("scipy-openblas", "libscipy_openblas*", "scipy_cblas_dgemv64_",
+               "scipy_cblas_dgemv"),)
+_GEMV_PROBE = (2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 17, 31, 32, 33, 63, 64, 65, 100,
+               127, 128, 129, 200, 301)
+_gemv_found: bool | None = None
+
+
+def _gemv_address() -> tuple[int, bool] | None:
+    """(address, 64-bit integers) of the cblas_dgemv in the BLAS library numpy loaded, or None
+    (another BLAS, numpy without a build configuration, the library not loaded)."""
+    try:
+        import ctypes  # numpy has imported it already
+
+        blas = np.__config__.CONFIG["Build Dependencies"]["blas"]
+        name, config = blas.get("name"), str(blas.get("openblas configuration", ""))
+    except Exception:  # noqa: BLE001 - numpy < 1.26 or another layout: no direct call
+        return None
+    from pathlib import Path
+
+    for lib_name, pattern, sym64, sym32 in _GEMV_LIBS:
+        if name != lib_name:
+            continue
+        ilp64 = "USE64BITINT" in config
+        for path in sorted((Path(np.__file__).parent.parent / "numpy.libs").glob(pattern)):
+            try:  # the copy numpy loaded, never a second one
+                lib = ctypes.CDLL(str(path), mode=os.RTLD_NOLOAD | ctypes.RTLD_LOCAL)
+                address = ctypes.cast(getattr(lib, sym64 if ilp64 else sym32),
+                                      ctypes.c_void_p).value
+            except (OSError, AttributeError):
+                continue
+            if address:
+                return address, ilp64
+    return None
+
+
+def numpy_gemv() -> bool:
+    """Does the C fast path take M z by numpy's own cblas_dgemv (lcp/_blas.h)? Found once: the
+    function numpy's dot calls for a C-contiguous float64 matrix times a vector, in the BLAS
+    library numpy loaded, then checked against np.dot on matrices of the sizes _GEMV_PROBE
+    (entries over 120 binary orders of magnitude, varied mantissas and signs: any other order
+    of summation or fused multiply-add shows; then within 4 orders, where every term counts),
+    bit for bit; any difference and it is not used
+    (M z then comes from np.dot, called from C)."""
+    global _gemv_found
+    if _gemv_found is None:
+        _gemv_found = False
+        found = _gemv_address() if COMPILED else None
+        if COMPILED:
+            _lemke_c.gemv_setup(*(found or (0, False)))
+        if found is not None:
+            ok = True
+            for n in _GEMV_PROBE:
+                k = np.arange(n * (n + 1)).reshape(n + 1, n)
+                for e in (k * 7919 % 241 - 120, k * 7 % 9 - 4):  # wide, then close scales
+                    P = np.exp2(e.astype(float)) * (1.0 + (k * 31 % 17) / 17.0)
+                    P[:, 1::3] *= -1.0
+                    M, z, w = P[:n], P[n], np.empty(n)
+                    ok = ok and bool(_lemke_c.gemv(M, z, w)) and (
+                        w.tobytes() == np.dot(M, z).tobytes())
+                if not ok:
+                    break
+            if not ok:
+                _lemke_c.gemv_setup(0, False)
+            _gemv_found = ok
+    return _gemv_found

@@ -24,6 +24,7 @@ typedef struct {
 typedef struct {
     int64_t *slot;
     size_t cap, count;
+    int heap; /* slot malloc'd (freed when the set grows or ends), else the caller's */
 } HashSet;
 
 static uint64_t splitmix64(uint64_t *x)
@@ -34,11 +35,13 @@ static uint64_t splitmix64(uint64_t *x)
     return z ^ (z >> 31);
 }
 
-static int hs_init(HashSet *h, size_t cap)
+/* buf: cap entries of the caller's (NULL: malloc'd here) */
+static int hs_init(HashSet *h, size_t cap, int64_t *buf)
 {
     h->cap = cap;
     h->count = 0;
-    h->slot = (int64_t *)malloc(cap * sizeof(int64_t));
+    h->heap = buf == NULL;
+    h->slot = buf ? buf : (int64_t *)malloc(cap * sizeof(int64_t));
     if (!h->slot) return -1;
     memset(h->slot, 0xFF, cap * sizeof(int64_t)); /* -1: empty (keys are >= 0) */
     return 0;
@@ -49,10 +52,10 @@ static int hs_add(HashSet *h, int64_t key)
 {
     if (2 * (h->count + 1) > h->cap) {
         HashSet g;
-        if (hs_init(&g, 2 * h->cap) < 0) return -1;
+        if (hs_init(&g, 2 * h->cap, NULL) < 0) return -1;
         for (size_t i = 0; i < h->cap; i++)
             if (h->slot[i] >= 0) hs_add(&g, h->slot[i]);
-        free(h->slot);
+        if (h->heap) free(h->slot);
         *h = g;
     }
     size_t mask = h->cap - 1, i = (size_t)((uint64_t)key * 0x9E3779B97F4A7C15ULL >> 7) & mask;
@@ -281,7 +284,53 @@ static double column_min(const double *a, idx n)
     return amin;
 }
 
+/* ------------------------------------------------------------------ the ratios */
+/* alpha_t = -a_i and theta_t = max(beta_i, 0) / alpha_t for the blocking rows i = rows[t]
+ * (b > 0 ? b : 0: a NaN or -0 gives 0). Four at a time where the CPU has AVX2: the divisions
+ * were the ratio test's bottleneck, and a division, a negation (the sign bit flipped) and
+ * vmaxpd(b, 0) (b when b > 0, else 0, NaN included) give each lane the scalar loop's number. */
+static void ratios_plain(const double *a, const double *beta, const idx *rows, idx m,
+                         double *alpha, double *theta)
+{
+    for (idx t = 0; t < m; t++) {
+        double al = -a[rows[t]], b = beta[rows[t]];
+        alpha[t] = al;
+        theta[t] = (b > 0.0 ? b : 0.0) / al;
+    }
+}
+
+#if HAVE_AVX2_CLONE
+__attribute__((target("avx2"))) static void ratios_avx2(const double *a, const double *beta,
+                                                       const idx *rows, idx m, double *alpha,
+                                                       double *theta)
+{
+    const __m256d sign = _mm256_set1_pd(-0.0), zero = _mm256_setzero_pd();
+    idx t = 0;
+    for (; t + 4 <= m; t += 4) {
+        const idx i0 = rows[t], i1 = rows[t + 1], i2 = rows[t + 2], i3 = rows[t + 3];
+        __m256d al = _mm256_xor_pd(_mm256_set_pd(a[i3], a[i2], a[i1], a[i0]), sign);
+        __m256d b = _mm256_max_pd(_mm256_set_pd(beta[i3], beta[i2], beta[i1], beta[i0]), zero);
+        _mm256_storeu_pd(alpha + t, al);
+        _mm256_storeu_pd(theta + t, _mm256_div_pd(b, al));
+    }
+    ratios_plain(a, beta, rows + t, m - t, alpha + t, theta + t);
+}
+#endif
+
+static void ratios(const double *a, const double *beta, const idx *rows, idx m, double *alpha,
+                   double *theta)
+{
+#if HAVE_AVX2_CLONE
+    if (m >= 8 && cpu_avx2()) {
+        ratios_avx2(a, beta, rows, m, alpha, theta);
+        return;
+    }
+#endif
+    ratios_plain(a, beta, rows, m, alpha, theta);
+}
+
 /* ------------------------------------------------------------------ the run */
+#define RUN_STACK_N 256 /* run's keys on the stack up to this n */
 static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
                long long *out_pivots, idx *out_s, int64_t *out_entering)
 {
@@ -289,13 +338,18 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
     const idx ld = L->ld;
     double *T = L->T, *beta = T + ld * (n + 1);
     const int64_t z0 = 2 * n;
-    uint64_t seed = 0x5EEDULL, *keys = (uint64_t *)malloc((2 * n + 1) * sizeof(uint64_t));
+    /* the keys and the first hash table on the stack up to n = RUN_STACK_N (no allocation
+     * for small problems; the table moves to the heap when it grows) */
+    uint64_t kbuf[2 * RUN_STACK_N + 1];
+    int64_t hbuf[1024];
+    uint64_t seed = 0x5EEDULL,
+             *keys = n <= RUN_STACK_N ? kbuf : (uint64_t *)malloc((2 * n + 1) * sizeof(uint64_t));
     HashSet seen;
     if (!keys) return -1;
     size_t cap = 64; /* grows as needed: start small, a small problem takes few pivots */
     while (cap < 1024 && cap < (size_t)(8 * n)) cap *= 2;
-    if (hs_init(&seen, cap) < 0) {
-        free(keys);
+    if (hs_init(&seen, cap, hbuf) < 0) {
+        if (keys != kbuf) free(keys);
         return -1;
     }
     for (idx i = 0; i < 2 * n + 1; i++) keys[i] = splitmix64(&seed) >> 1; /* >= 0 as int64 */
@@ -356,15 +410,11 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
             r = L->rows[0];
             continue;
         }
-        for (idx t = 0; t < m; t++) {
-            double al = -a[L->rows[t]], b = beta[L->rows[t]];
-            L->alpha[t] = al;
-            L->theta[t] = (b > 0.0 ? b : 0.0) / al;
-        }
+        ratios(a, beta, L->rows, m, L->alpha, L->theta);
         r = choose(L, L->rows, L->alpha, L->theta, m, amax);
     }
-    free(keys);
-    free(seen.slot);
+    if (keys != kbuf) free(keys);
+    if (seen.heap) free(seen.slot);
     *out_pivots = pivots;
     *out_s = s;
     *out_entering = entering;

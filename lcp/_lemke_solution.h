@@ -2,7 +2,7 @@
  * `solve_fast`'s work -- the solve, the acceptance of lcp/acceptance/accuracy.py's
  * `assess_lcp`, numpy's M z and lcp.residual's measure -- then the verdict `solve_lemke`
  * gives (scaled <= TOL, berr <= TOL, ferr <= FERR_TOL) and the Solution object
- * lcp.problems.solution.solved_lcp builds (the same fields, the same dict, in the same order),
+ * lcp.problems.solution.solved_lcp builds (the same fields in the same slots),
  * with no Python between. What the Python did around `solve_fast` (three np.empty, the basis
  * slice, the tuple, the tests, the info dict, solved_lcp's call) was a third of the call at
  * n = 10; the numbers are the same (the same C steps in the same order).
@@ -14,7 +14,9 @@
  *     (code, pivots, nbasis, acode, berr, ferr, refined, raw, scaled, z, w, basis): the
  *     numbers of `solve_fast` and its arrays (basis of length nbasis) for the Python to
  *     finish (not solved, not assessed here, not measured here, or not accepted).
- * The includer includes _lemke_py.h, _lemke_problem.h and _lemke_measure.h first. */
+ * M z is numpy's own cblas_dgemv called directly when lcp/_lemke_kernel.py found and checked it
+ * (_blas.h), else numpy.dot called from here. The includer includes _lemke_py.h, _blas.h,
+ * _lemke_problem.h and _lemke_measure.h first. */
 #ifndef RIGIDLCP_LEMKE_SOLUTION_H
 #define RIGIDLCP_LEMKE_SOLUTION_H
 
@@ -25,6 +27,16 @@ static const char *const s_names[14] = {
     "z", "w", "status", "method", "iterations", "residual", "eq_residual", "scaled_residual",
     "basis", "u", "message", "info", "backward_error", "forward_error"};
 static PyObject *s_keys[14], *s_solved, *s_lemke, *s_zero, *s_equilibrated, *s_polished;
+/* the byte offsets of the Solution's 14 slots (s_off[0] = -1: not known, set by name) */
+static Py_ssize_t s_off[14] = {-1};
+#ifndef Py_T_OBJECT_EX /* Python < 3.12: structmember.h's names */
+#include <structmember.h>
+#define SLOT_OBJECT_EX T_OBJECT_EX
+#define SLOT_READONLY READONLY
+#else
+#define SLOT_OBJECT_EX Py_T_OBJECT_EX
+#define SLOT_READONLY Py_READONLY
+#endif
 
 static PyObject *py_solve_setup(PyObject *self, PyObject *args)
 {
@@ -52,6 +64,27 @@ static PyObject *py_solve_setup(PyObject *self, PyObject *args)
     }
     s_tol = tol;
     s_ferr_tol = ferr_tol;
+    /* where each field's slot is in a Solution (its member descriptors): the object is then
+     * filled by 14 stores; -1 (the fields set by name instead) when a field is not a plain
+     * object slot of the class given */
+    s_off[0] = -1;
+    if (PyType_Check(cls)) {
+        Py_ssize_t off[14];
+        int ok = 1;
+        for (int k = 0; ok && k < 14; k++) {
+            PyObject *dsc = PyDict_GetItemWithError(((PyTypeObject *)cls)->tp_dict, s_keys[k]);
+            if (!dsc && PyErr_Occurred()) return NULL;
+            ok = dsc && Py_IS_TYPE(dsc, &PyMemberDescr_Type);
+            if (ok) {
+                PyMemberDef *md = ((PyMemberDescrObject *)dsc)->d_member;
+                ok = md->type == SLOT_OBJECT_EX && !(md->flags & SLOT_READONLY) &&
+                     md->offset > 0;
+                off[k] = md->offset;
+            }
+        }
+        if (ok && ((PyTypeObject *)cls)->tp_dictoffset == 0)
+            memcpy(s_off, off, sizeof off);
+    }
     Py_RETURN_NONE;
 }
 
@@ -66,13 +99,15 @@ static PyObject *new_array(idx n, int integer)
     return out;
 }
 
-/* solved_lcp(z, w, "lemke", pivots, raw, scaled, basis, message, info, berr, ferr) */
+/* solved_lcp(z, w, "lemke", pivots, raw, scaled, basis, message, info, berr, ferr): a new
+ * Solution (object.__new__, i.e. the type's tp_alloc) whose slots receive the 14 fields, in
+ * the dataclass's order; by name (setattr) when the slots are not known. */
 static PyObject *solution(PyObject *z, PyObject *w, long long pivots, double raw, double scaled,
                           PyObject *basis, int refined, double berr, double ferr)
 {
-    PyObject *info = PyDict_New(), *d = PyDict_New(), *sol = NULL;
+    PyObject *info = PyDict_New(), *sol = NULL;
     PyObject *v[14] = {NULL};
-    if (!info || !d) goto fail;
+    if (!info) return NULL;
     if (PyDict_SetItem(info, s_equilibrated, Py_True) < 0 ||
         (refined && PyDict_SetItem(info, s_polished, Py_True) < 0))
         goto fail;
@@ -84,23 +119,28 @@ static PyObject *solution(PyObject *z, PyObject *w, long long pivots, double raw
     v[8] = basis, v[9] = Py_None, v[10] = pivots ? s_empty_str : s_msg, v[11] = info;
     v[12] = PyFloat_FromDouble(berr);
     v[13] = PyFloat_FromDouble(ferr);
-    int ok = v[4] && v[5] && v[7] && v[12] && v[13];
-    for (int k = 0; ok && k < 14; k++) ok = PyDict_SetItem(d, s_keys[k], v[k]) == 0;
-    if (ok) sol = PyObject_CallOneArg(s_new, s_cls); /* object.__new__(Solution) */
-    if (sol) { /* its fields into its own __dict__: replacing the dict (GenericSetDict) is not
-                  seen by Python 3.13's inline attribute values */
-        PyObject *own = PyObject_GenericGetDict(sol, NULL);
-        if (!own || PyDict_Update(own, d) < 0) Py_CLEAR(sol);
-        Py_XDECREF(own);
+    if (!(v[4] && v[5] && v[7] && v[12] && v[13])) goto fail;
+    if (s_off[0] > 0) {
+        PyTypeObject *cls = (PyTypeObject *)s_cls;
+        if (!(sol = cls->tp_alloc(cls, 0))) goto fail;
+        for (int k = 0; k < 14; k++) {
+            Py_INCREF(v[k]);
+            *(PyObject **)((char *)sol + s_off[k]) = v[k]; /* the slot is NULL: new object */
+        }
+    } else if ((sol = PyObject_CallOneArg(s_new, s_cls))) { /* object.__new__(Solution) */
+        for (int k = 0; k < 14; k++)
+            if (PyObject_SetAttr(sol, s_keys[k], v[k]) < 0) {
+                Py_CLEAR(sol);
+                break;
+            }
     }
+fail:
     Py_XDECREF(v[4]);
     Py_XDECREF(v[5]);
     Py_XDECREF(v[7]);
     Py_XDECREF(v[12]);
     Py_XDECREF(v[13]);
-fail:
     Py_XDECREF(info);
-    Py_XDECREF(d);
     return sol;
 }
 
@@ -142,14 +182,20 @@ static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t 
     double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
     idx nb = 0;
     int code, acode = 1;
+    int direct = blas_ok(n), measured = 0;
     Py_BEGIN_ALLOW_THREADS
     code = solve_and_accept(n, M, q, tol, max_iter, zd, b, &pivots, &nb, &acode, res);
+    if (code == 0 && acode == 0 && direct) { /* numpy's own gemv (_blas.h), then the measure */
+        blas_mz(n, M, zd, wd);
+        measured = 1;
+        if (n <= upto && measure_one(n, M, q, zd, wd, got) < 0) got[0] = got[1] = NAN;
+    }
     Py_END_ALLOW_THREADS
     if (code < 0) {
         PyErr_NoMemory();
         goto done;
     }
-    if (code == 0 && acode == 0) {
+    if (code == 0 && acode == 0 && !measured) {
         PyObject *call[3] = {args[0], z, w};
         PyObject *out = PyObject_Vectorcall(s_dot, call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;

@@ -13,8 +13,8 @@ static inline double dmax(double a, double b) { return a > b ? a : b; }
 static inline double dmin(double a, double b) { return a < b ? a : b; }
 #define MAX_M 400
 #define STEPS 5
-/* assess_one's work block on the stack up to this many doubles (16 kB: m up to about 25) */
-#define ASSESS_STACK 2048
+/* assess_one's work block on the stack up to this many doubles (32 kB: m up to about 36) */
+#define ASSESS_STACK 4096
 
 /* Are all n entries of a finite? Then *mx = max |a_i| (from the value on entry). Four lanes
  * wide where the CPU has AVX2 (the maximum of finite numbers does not depend on the order). */
@@ -123,6 +123,7 @@ static double backward_error(idx n, const double *M, const double *q, const doub
 }
 
 #include "_lu_core.h" /* lu, lu_solve: the LU of the pattern's system */
+#include "_inverse_core.h" /* inverse_columns: K^-1, FB_COLS columns at a time */
 
 /* out_i = init_i + sum_j |K_ij| x_j (x NULL: + |K_ij|; init NULL: from 0), each row summed
  * for j = 0, 1, ..., m - 1 in this order, four rows at once (independent chains: the same
@@ -194,7 +195,8 @@ static void residual_ld(idx m, const double *K, const double *k, const double *y
  * (xGERFS's) is a lower bound of it and came out 20 % below on solved problems (issue 23).
  * Skeel's condition || |K^-1| |K| 1 || comes from the same columns: beyond 1 / (m eps) the
  * system is singular to working precision and 1 is returned (the numpy code's SVD path
- * decides), else 0 with *ferr set. r, g: scratch of m doubles, col of 5 m, acc of 2 m. */
+ * decides), else 0 with *ferr set. r, g: scratch of m doubles, col of (FB_COLS + 2) m, acc
+ * of 2 m. */
 static int forward_bound(idx m, const double *K, const double *A, const idx *perm,
                          const double *kp, const double *y, const double *rows, double *r,
                          double *g, double *col, double *acc, double *ferr)
@@ -212,55 +214,24 @@ static int forward_bound(idx m, const double *K, const double *A, const idx *per
     double *sk = acc + m;
     memset(acc, 0, 2 * (size_t)m * sizeof(double));
     /* acc += |K^-1 e_j| g_j, sk += |K^-1 e_j| rows_j for j = 0, 1, ..., m - 1 in this order;
-     * the columns four at a time (c4[4 i + b] = column j0 + b: independent chains), each by
-     * lu_solve's substitutions (the same numbers; the L one begun at the first nonzero of
-     * P e_j, the entries above it staying 0 as they would there) */
-    double *c4 = col + m;
-    for (idx j0 = 0; j0 < m; j0 += 4) {
-        idx nb = m - j0 < 4 ? m - j0 : 4, p = m;
-        memset(c4, 0, 4 * (size_t)m * sizeof(double));
-        for (idx b = 0; b < nb; b++) {
-            memset(col, 0, (size_t)m * sizeof(double));
-            col[j0 + b] = 1.0;
-            permute(m, perm, col);
-            idx pb = 0;
-            while (col[pb] == 0.0) pb++;
-            c4[4 * pb + b] = 1.0;
-            p = pb < p ? pb : p;
-        }
-        for (idx i = p + 1; i < m; i++) {
-            const double *Ai = A + i * m;
-            double x0 = c4[4 * i], x1 = c4[4 * i + 1], x2 = c4[4 * i + 2], x3 = c4[4 * i + 3];
-            for (idx l = p; l < i; l++) {
-                const double al = Ai[l], *cl = c4 + 4 * l;
-                x0 -= al * cl[0];
-                x1 -= al * cl[1];
-                x2 -= al * cl[2];
-                x3 -= al * cl[3];
+     * the columns FB_COLS at a time (_inverse_core.h: X[FB_COLS i + b] = column j0 + b, by
+     * lu_solve's substitutions: the same numbers however grouped) */
+    idx *lab = (idx *)col, *at = lab + m;  /* idx and double: both 8 bytes */
+    double *X = col + 2 * m;
+    unit_rows(m, perm, lab, at);
+    for (idx j0 = 0; j0 < m; j0 += FB_COLS) {
+        idx nb = m - j0 < FB_COLS ? m - j0 : FB_COLS;
+        inverse_columns(m, A, at, j0, nb, X);
+        const double *gj = g + j0, *rj = rows + j0;
+        for (idx i = 0; i < m; i++) {
+            const double *Xi = X + FB_COLS * i;
+            double a = acc[i], s = sk[i];
+            for (idx b = 0; b < nb; b++) {
+                double c = fabs(Xi[b]);
+                a += c * gj[b];
+                s += c * rj[b];
             }
-            c4[4 * i] = x0, c4[4 * i + 1] = x1, c4[4 * i + 2] = x2, c4[4 * i + 3] = x3;
-        }
-        for (idx i = m - 1; i >= 0; i--) {
-            const double *Ai = A + i * m;
-            double x0 = c4[4 * i], x1 = c4[4 * i + 1], x2 = c4[4 * i + 2], x3 = c4[4 * i + 3];
-            for (idx l = i + 1; l < m; l++) {
-                const double al = Ai[l], *cl = c4 + 4 * l;
-                x0 -= al * cl[0];
-                x1 -= al * cl[1];
-                x2 -= al * cl[2];
-                x3 -= al * cl[3];
-            }
-            const double d = Ai[i];
-            c4[4 * i] = x0 / d, c4[4 * i + 1] = x1 / d, c4[4 * i + 2] = x2 / d,
-            c4[4 * i + 3] = x3 / d;
-        }
-        for (idx b = 0; b < nb; b++) {
-            const double gj = g[j0 + b], rj = rows[j0 + b];
-            for (idx i = 0; i < m; i++) {
-                double c = fabs(c4[4 * i + b]);
-                acc[i] += c * gj;
-                sk[i] += c * rj;
-            }
+            acc[i] = a, sk[i] = s;
         }
     }
     double top = 0.0, skeel = 0.0;
@@ -320,11 +291,12 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     }
     if (!isfinite(norm)) return 1;
     double floor = mmax > 0 ? qmax + norm * (qmax / mmax) : qmax;
-    /* one block for the work below: 2 m^2 + 13 m + 1 doubles (K, its LU, the vectors, the
-     * bound's scratch), perm and the sorted pattern (m + 1 entries of 8 bytes each) and the marks (n
-     * bytes); on the stack when it fits (no allocation for small problems) */
-    size_t nd = (size_t)2 * m * m + 13 * (size_t)m + 1, words = nd + 2 * ((size_t)m + 1) +
-                                                            ((size_t)n + 7) / 8;
+    /* one block for the work below: 2 m^2 + (FB_COLS + 10) m + 1 doubles (K, its LU, the
+     * vectors, the bound's scratch), perm and the sorted pattern (m + 1 entries of 8 bytes
+     * each) and the marks (n bytes); on the stack when it fits (no allocation for small
+     * problems) */
+    size_t nd = (size_t)2 * m * m + (FB_COLS + 10) * (size_t)m + 1,
+           words = nd + 2 * ((size_t)m + 1) + ((size_t)n + 7) / 8;
     double stackbuf[ASSESS_STACK];
     double *buf = words <= ASSESS_STACK ? stackbuf : (double *)malloc(words * sizeof(double));
     if (!buf) return 1;
@@ -346,7 +318,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     double ferr = 0.0;
     int refined = 0;
     double *K = buf, *A = K + m * m, *kp = A + m * m, *y = kp + m, *r = y + m, *d = r + m,
-           *g = d + m, *rows = g + m, *col = rows + m, *acc = col + 5 * m;
+           *g = d + m, *rows = g + m, *col = rows + m, *acc = col + (FB_COLS + 2) * m;
     for (idx i = 0; i < m; i++) {
         kp[i] = q[a[i]];
         y[i] = z[a[i]];
@@ -439,11 +411,11 @@ static int bound_one(idx m, const double *K, const double *kp, const double *y, 
         *ferr = 0.0;
         return 0;
     }
-    size_t nd = (size_t)m * m + 10 * (size_t)m;
+    size_t nd = (size_t)m * m + (FB_COLS + 7) * (size_t)m;
     double *buf = (double *)malloc((nd + (size_t)m + 1) * sizeof(double));
     if (!buf) return 1;
     double *A = buf, *rows = A + m * m, *r = rows + m, *g = r + m, *col = g + m,
-           *acc = col + 5 * m;
+           *acc = col + (FB_COLS + 2) * m;
     idx *perm = (idx *)(buf + nd);
     memcpy(A, K, (size_t)m * m * sizeof(double));
     abs_row_sums_by4(m, K, NULL, NULL, rows);

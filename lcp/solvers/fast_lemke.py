@@ -66,7 +66,9 @@ _measure = _kernel._lemke_c.lcp_measure if _kernel.COMPILED else None
 #: steps in one call (lcp/_lemke_c.c: solve_fast)
 _solve_fast = _kernel._lemke_c.solve_fast if _solve_accept is not None else None
 _empty, _intp, _dot = np.empty, np.intp, np.dot
-_upto = _kernel.sums_verified_upto
+#: the longest row whose |M| sum C rounds as numpy (`sums_verified_upto`: probed once, read
+#: here once, not at every call)
+_UPTO = _kernel.sums_verified_upto() if _kernel.COMPILED else 0
 #: `_solve_fast`, the verdict below and `solved_lcp`'s Solution in one call (lcp/_lemke_c.c:
 #: solve_lcp, lcp/_lemke_solution.h): the Solution when accepted, else the numbers of
 #: `_solve_fast` and its arrays for the steps below
@@ -83,6 +85,7 @@ def _setup(tol: float = TOL, ferr_tol: float = FERR_TOL) -> None:
 
 if _solve_lcp is not None:
     _setup()
+    _kernel.numpy_gemv()  # M z by numpy's own cblas_dgemv from C, when found and checked
 
 
 def solve_lemke(problem) -> Solution | None:
@@ -103,7 +106,7 @@ def solve_lemke(problem) -> Solution | None:
     try:  # C-contiguous native float64 M (n x n) and q (n), finite (else ValueError or
         # BufferError): the solve, `assess_lcp`'s C steps, M z, the measure and, when the
         # verdict below is "accepted", the Solution, in one call (lcp/_lemke_solution.h)
-        out = _solve_lcp(M, q, DEFAULT_TOL, max_iter, _upto())
+        out = _solve_lcp(M, q, DEFAULT_TOL, max_iter, _UPTO)
         if type(out) is not tuple:
             return out
         code, pivots, m, acode, berr, ferr, refined, raw, scaled, z, w, basis = out

@@ -8,6 +8,8 @@ that fails any part of the acceptance (the general path then answers), in the Py
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -17,7 +19,7 @@ from rigidlcp.lcp import _lemke_kernel as kernel
 from rigidlcp.lcp.acceptance import residual
 from rigidlcp.lcp.solvers import fast_lemke
 
-from .test_fast_lemke import assert_same_answer, random_lcps, same
+from .test_fast_lemke import assert_same_answer, outcome, random_lcps, same
 from .test_lemke import degenerate_integer_lcps
 
 compiled = pytest.mark.skipif(fast_lemke._solve_fast is None,
@@ -204,6 +206,53 @@ def test_the_c_verdict_is_the_pythons(seed):
 
 
 @compiled
+def test_the_c_solution_fills_every_slot_or_sets_the_fields_by_name():
+    """solve_lcp writes the Solution's 14 slots directly (their offsets read from the class's
+    member descriptors by solve_setup); given a class whose fields are not plain slots (here a
+    dataclass with a __dict__), it sets them by name instead. Both objects equal the general
+    path's answer field for field."""
+    from rigidlcp.lcp.problems.solution import Solution
+
+    rng = np.random.default_rng(5)
+    A = rng.standard_normal((7, 7))
+    P = lcp.LCP(A @ A.T + 0.1 * np.eye(7), rng.standard_normal(7))
+    assert not hasattr(Solution(np.zeros(1), np.zeros(1), "failed", "x"), "__dict__")
+    args = (P.M, P.q, fast_lemke.DEFAULT_TOL, 1700, kernel.sums_verified_upto())
+    slotted = fast_lemke._solve_lcp(*args)
+    assert type(slotted) is Solution
+
+    @dataclasses.dataclass
+    class Plain:  # the same fields, in a __dict__
+        z: object
+        w: object
+        status: object
+        method: object
+        iterations: object
+        residual: object
+        eq_residual: object
+        scaled_residual: object
+        basis: object
+        u: object
+        message: object
+        info: object
+        backward_error: object
+        forward_error: object
+
+    try:
+        kernel._lemke_c.solve_setup(np.dot, np.empty, np.intp, object.__new__, Plain,
+                                    fast_lemke._Q_NONNEGATIVE, residual.TOL, fast_lemke.FERR_TOL)
+        by_name = fast_lemke._solve_lcp(*args)
+    finally:
+        fast_lemke._setup()
+    assert type(by_name) is Plain and list(vars(by_name)) == [
+        f.name for f in dataclasses.fields(Solution)]
+    one = assert_same_answer(P)
+    for f in dataclasses.fields(Solution):
+        assert same(getattr(slotted, f.name), getattr(one, f.name)), f.name
+        assert same(getattr(by_name, f.name), getattr(one, f.name)), f.name
+
+
+@compiled
 @pytest.mark.parametrize("mscale, qscale", [(1.0, 1.0), (1e300, 1e-300), (1e-300, 1e300),
                                             (1e-200, 1e-150), (1e250, 1e100), (1e-310, 1.0),
                                             (1.0, 0.0)])
@@ -229,3 +278,53 @@ def test_dictionary_of_a_balanced_m_is_filled_as_with_explicit_factors(n, mscale
         if outs[0][0] == kernel.NEEDS_RUIZ:  # s not decided in C (near a midpoint)
             continue
         assert all(same(np.asarray(x), np.asarray(y)) for x, y in zip(*outs)), outs
+
+
+@compiled
+@settings(max_examples=40, deadline=None)
+@given(random_lcps(max_n=40))
+def test_m_z_by_numpys_own_gemv_is_numpys_dot(problem):
+    """M z by the cblas_dgemv numpy's dot calls, found in numpy's BLAS library and called from
+    C (lcp/_blas.h; lcp/_lemke_kernel.py: numpy_gemv), is np.dot's M z bit for bit; and the
+    fast path's Solution is the same with and without it (np.dot called from C instead)."""
+    if not kernel.numpy_gemv():
+        pytest.skip("numpy's BLAS is not one numpy_gemv recognizes: np.dot is called from C")
+    M, q = problem
+    n = q.size
+    for z in (q, np.abs(q) * 1e150, q * 1e-170):
+        w = np.empty(n)
+        if n >= 2:
+            assert kernel._lemke_c.gemv(M, z, w)
+            with np.errstate(all="ignore"):  # extreme data overflow: compared all the same
+                assert same(w, np.dot(M, z)) and same(w, M.dot(z))
+        else:  # numpy multiplies a 1 x 1 by a scalar product: not taken by gemv
+            assert not kernel._lemke_c.gemv(M, z, w)
+    P = lcp.LCP(M, q)
+    with_gemv = outcome(fast_lemke.solve_lemke, P)
+    kernel._lemke_c.gemv_setup(0, False)
+    try:
+        without = outcome(fast_lemke.solve_lemke, P)
+    finally:
+        kernel._lemke_c.gemv_setup(*kernel._gemv_address())
+    assert type(with_gemv) is type(without)
+    if isinstance(without, lcp.Solution):
+        for f in dataclasses.fields(without):
+            assert same(getattr(with_gemv, f.name), getattr(without, f.name)), f.name
+
+
+@compiled
+def test_no_gemv_is_used_when_numpys_blas_is_not_recognized(monkeypatch):
+    """numpy_gemv sets no function when it finds none (another BLAS): gemv then declines and
+    the fast path calls np.dot from C, with the general path's answer."""
+    monkeypatch.setattr(kernel, "_gemv_found", None)
+    monkeypatch.setattr(kernel, "_gemv_address", lambda: None)
+    try:
+        assert kernel.numpy_gemv() is False
+        assert not kernel._lemke_c.gemv(np.eye(3), np.ones(3), np.empty(3))
+        rng = np.random.default_rng(3)
+        A = rng.standard_normal((9, 9))
+        assert_same_answer(lcp.LCP(A @ A.T + np.eye(9), rng.standard_normal(9)))
+    finally:
+        monkeypatch.undo()
+        kernel._gemv_found = None
+        assert kernel.numpy_gemv() == (kernel._gemv_address() is not None)
