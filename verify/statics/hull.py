@@ -161,9 +161,10 @@ def locally_dependent(B: sp.spmatrix, p: int) -> np.ndarray:
     nonzero rows touch fewer columns than their number (e.g. a disk left with one contact
     once the implicit equalities R = 0 are substituted: 2 columns, 3 rows), the disk's rows
     are 0 outside those columns, so a row that is a combination of the disk's other rows on
-    them is one in B, and rank B is unchanged without it. The disk's rows are kept in order while they
-    raise the exact rank (python-flint, on the stored doubles) of the kept ones. Dropping them
-    lets the sparse full-row-rank test settle the rank above the dense SVD's limit."""
+    them is one in B, and rank B is unchanged without it. The disk's rows are kept in order
+    while they raise the exact rank (python-flint, on the stored doubles) of the kept ones.
+    Dropping them lets the sparse full-row-rank test settle the rank above the dense SVD's
+    limit."""
     from flint import fmpq_mat
 
     from .farkas import rational
