@@ -54,6 +54,9 @@ STALL = 24
 #: Coordinates below this (in weights) where the iteration stops are suspected of being
 #: implicit equalities: certificates are sought around them (never taken on suspicion).
 SUSPECT = 0.1
+#: Most contacts around which certificates are sought for the face (each a few small LPs; a
+#: P without points, whose iteration diverges everywhere, would otherwise cost thousands).
+SUSPECTS = 300
 #: Faces tried after the first run (each with the coordinates found 0 so far fixed at 0).
 FACE_TRIES = 3
 #: A centred point: every w_j z_j within this factor of tau.
@@ -84,7 +87,8 @@ def analytic_centre(prob: StaticProblem) -> np.ndarray | None:
         # some the iteration had not yet driven below SMALL: the centre of the face where
         # they are all 0
         small = zero | (last < SMALL)
-        small |= _proved(prob, zero | (last < SUSPECT))
+        suspects = zero | (last < SUSPECT)
+        small |= _proved(prob, suspects if suspects.sum() <= 2 * SUSPECTS else small)
         if small.sum() == zero.sum() or small.all():
             break
         zero = small
@@ -112,7 +116,7 @@ def _proved(prob: StaticProblem, zero: np.ndarray) -> np.ndarray:
     cone_row = np.r_[prob.fric, c + np.arange(k), plain]  # of each coordinate
     target = np.zeros(c + k, dtype=bool)
     target[cone_row[zero]] = True
-    return proved_cone(prob, target)[cone_row]
+    return proved_cone(prob, target, SUSPECTS)[cone_row]
 
 
 def _newton(K: sp.csr_matrix, b: np.ndarray, reg: float = 0.0, stall: int | None = None,

@@ -78,14 +78,16 @@ def proved_rows(prob: StaticProblem, undecided: np.ndarray) -> np.ndarray:
     return out
 
 
-def proved_cone(prob: StaticProblem, target: np.ndarray) -> np.ndarray:
+def proved_cone(prob: StaticProblem, target: np.ndarray, limit: int = MAX_CONTACTS
+                ) -> np.ndarray:
     """The cone rows (farkas.cone_rows's numbering) proved to vanish on all of P by checked
     certificates (module docstring) sought around the contacts of the `target` rows: all of
-    the target rows when it works, and any other row the certificates prove."""
+    the target rows when it works, and any other row the certificates prove; none sought
+    when the targets span more than `limit` contacts."""
     cone = Cone(prob)
     proved = np.zeros(cone.C.shape[0], dtype=bool)
     contacts = np.unique(cone.contact[target])
-    if contacts.size == 0 or contacts.size > MAX_CONTACTS:
+    if contacts.size == 0 or contacts.size > limit:
         return proved
     lat = prob.system.lattice
     disk = lat.j >= 0
