@@ -64,3 +64,26 @@ def test_exact_lp_on_the_corner_disk(mu_wall):
             got = exact_lp.solve(prob, e)
             assert got is not None and got.status == "optimal"
             assert float(got.value) == s * want
+
+
+def test_exact_optima_agree_with_linprog_on_a_pile_of_20():
+    """On a generic 20-disk pile (60 balance rows, the largest solved exactly), where linprog
+    finds optima far inside its tolerances, the exact optima are linprog's to 1e-9, and each
+    exact point (rounded once per entry) lies in P."""
+    from scipy.optimize import linprog
+
+    lat = deposit(20, seed=5, radii=(0.8, 1.2))
+    prob = StaticProblem(models.System(lat, mu_pp=0.5, mu_plane=0.5, mu_wall=0.5))
+    assert prob.A.shape[0] <= exact_lp.MAX_ROWS
+    bounds = [(None if not np.isfinite(lo) else lo, None if not np.isfinite(hi) else hi)
+              for lo, hi in zip(prob.lb, prob.ub)]
+    for k in (0, prob.c + 3):
+        e = np.zeros(prob.n)
+        e[k] = -1.0
+        got = exact_lp.solve(prob, e)
+        ref = linprog(e, A_ub=prob.G, b_ub=np.zeros(prob.G.shape[0]), A_eq=prob.A,
+                      b_eq=prob.b, bounds=bounds, method="highs")
+        assert ref.status == 0 and got is not None and got.status == "optimal"
+        assert abs(float(got.value) - ref.fun) <= 1e-9 * max(1.0, abs(ref.fun))
+        assert prob.admissible(got.lam) and abs(got.lam[k] + float(got.value)) <= 1e-12 * abs(
+            float(got.value))
