@@ -3,14 +3,18 @@ test; it prints a markdown table).
 
     python benchmarks/packings.py [--deposit 1000,10000] [--statics 100,1000] [--ranges 100]
                                   [--arrays 100] [--mu 0.5] [--seed 1] [--radii 0.8:1.2]
-                                  [--jobs 1] [--sample 1000:64[:8]]
+                                  [--jobs 1] [--sample 1000:64[:8]] [--holes 3]
 
 deposit N: `models.deposition.deposit` of N disks (radii uniform in --radii, default width).
 statics N: existence and dimension (`verify.statics.forceset.analyse(ranges=False)`).
 ranges N: the whole analysis: also the range of every R and S and the sliding contacts, the
 range LPs in --jobs worker processes (verify.statics.contact_ranges).
 arrays L: existence and dimension of the L x L rectangular and triangular arrays written as
-packings (`models.make_packing`: packings that stand, where deposited piles at scale fall).
+packings (`models.make_packing`: packings that stand, where deposited piles at scale fall);
+with --holes K, every K-th disk of their top row removed (from the left; a disk of the rect
+array's top row then beside one neighbour only can roll away from it on the disk below: with
+mu < 1 that contact, and a top disk's right wall, carry R = 0 on all of P: implicit
+equalities, a few per row, proved by verify.statics.implicit).
 sample N:K[:B]: the ranges of K contacts of an N-disk pile (one warm DualForceLP as in
 `analyse`, in this process, the LPs ordered and kept bases tried as in
 verify.statics.range_ends), and the whole pile's range LPs extrapolated from them (c / K times
@@ -50,6 +54,16 @@ def _timed(fn):
     t, c = time.perf_counter(), _cpu()
     out = fn()
     return out, time.perf_counter() - t, _cpu() - c
+
+
+def _without_holes(x: np.ndarray, every: int) -> np.ndarray:
+    """The indices of the disks kept when every `every`-th disk of the top row (highest
+    centres, from the left) is removed (every 0: all)."""
+    if every <= 0:
+        return np.arange(len(x))
+    top = np.flatnonzero(x[:, 1] == x[:, 1].max())
+    top = top[np.argsort(x[top, 0])]
+    return np.setdiff1d(np.arange(len(x)), top[::every])
 
 
 def _picks(prob: StaticProblem, k: int, blocks: int) -> np.ndarray:
@@ -99,6 +113,8 @@ def main() -> int:
     ap.add_argument("--radii", default="0.8:1.2")
     ap.add_argument("--jobs", type=int, default=1, help="worker processes of the range LPs")
     ap.add_argument("--sample", default="", help="N:K[:B] (see above)")
+    ap.add_argument("--holes", type=int, default=0,
+                    help="remove every K-th disk of the arrays' top row (0: none)")
     args = ap.parse_args()
     radii = tuple(float(v) for v in args.radii.split(":"))
     print(f"radii {radii[0]}:{radii[1]}, seed {args.seed}, mu = {args.mu} on every contact, "
@@ -133,14 +149,18 @@ def main() -> int:
     for L in args.arrays:
         for kind in ("rect", "tri"):
             lat = models.make_lattice(kind, L, L)
-            pk = models.make_packing(lat.x, lat.radii, left=lat.left, right=lat.right)
+            keep = _without_holes(lat.x, args.holes)
+            pk = models.make_packing(lat.x[keep], lat.radii[keep], left=lat.left,
+                                     right=lat.right)
             system = models.System(pk, mu_pp=args.mu, mu_plane=args.mu, mu_wall=args.mu)
             fs, wall, cpu = _timed(lambda s=system: analyse(s, ranges=False))
             result = (f"exists, dim {fs.dimension}" if fs.exists else
                       f"undecided ({fs.undecided})" if fs.exists is None else
                       "no equilibrium")
-            print(f"| existence + dimension, {kind} {L}x{L} array | {pk.p} | {pk.c} | {result} "
-                  f"| {wall:.2f} | {cpu:.2f} |", flush=True)
+            result += f", {sum(bool(s) for s in fs.implicit)} implicit" if fs.exists else ""
+            holes = f", top row holes every {args.holes}" if args.holes else ""
+            print(f"| existence + dimension, {kind} {L}x{L} array{holes} | {pk.p} | {pk.c} "
+                  f"| {result} | {wall:.2f} | {cpu:.2f} |", flush=True)
     if sample:
         n, k, blocks = sample
         pile = piles[n]

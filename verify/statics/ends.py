@@ -21,7 +21,13 @@ the check fails it tries, in order:
 4. for a range LP, a cold dual simplex (DualForceLP): warm and cold, the primal simplex
    answered "unbounded" for max R of contact 2 (n 9, seed 342, mu 0.99999, the primal's
    chunk) with rays whose descent, 9e-12 and 4e-11 of their size, fails its check; the cold
-   dual finds the end 835822.16, certified exactly (linprog: 835822.16).
+   dual finds the end 835822.16, certified exactly (linprog: 835822.16);
+5. on P of at most exact_lp.MAX_ROWS balance rows, the LP solved in rational arithmetic
+   (verify.statics.exact_lp: an optimum with its dual certificate, a ray, or a Farkas
+   certificate of an empty face, each checked exactly): on the symmetric degenerate optima of
+   equal disks between walls the float certificates cannot be made exact (n 3, seed 1,
+   mu 1.001953125: max S of contact 3 is +inf by an exact ray where the float LP stopped at
+   0.50098; n 2, seed 1, mu 0.99999: the face S = mu R of contact 0 is empty).
 
 An optimum's dual certificate must also hold beyond the simplex's tolerance (`_dual_exact`:
 exactly on small piles, else to rounding), and a sliding LP's "infeasible" needs a checked
@@ -39,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from . import exact
+from . import exact, exact_lp
 from .model import (
     BALANCE_TOL,
     DUAL_TOL,
@@ -84,9 +90,10 @@ class Evidence:
 class Settled:
     """An end: status "optimal" (lam: a checked optimum), "unbounded" (a checked ray) or
     "unknown" (evidence: the last try's failed check); lps: LPs solved; how: the try that
-    settled it ("warm", "basis", "ray LP", "cold", "cold basis", "cold dual"; "" when
-    unknown; "vertex": a kept basis, `at_basis`; "kept start": the LP again from a kept basis,
-    verify.statics.range_ends); first: the warm answer's evidence when a retry was needed."""
+    settled it ("warm", "basis", "ray LP", "cold", "cold basis", "cold dual", "exact LP"; ""
+    when unknown; "vertex": a kept basis, `at_basis`; "kept start": the LP again from a kept
+    basis, verify.statics.range_ends); first: the warm answer's evidence when a retry was
+    needed."""
 
     status: str
     lam: np.ndarray | None
@@ -160,6 +167,11 @@ def settle(prob: StaticProblem, lp: DualForceLP | ForceLP, cost: np.ndarray,
         if ev3 is None:
             return Settled(status, lam, lps, how="cold dual", first=ev)
         ev2 = ev3
+    # 5. on small piles, the LP solved exactly (verify.statics.exact_lp), its answer with
+    # its certificate checked in rationals
+    got = exact_lp.solve(prob, cost, fixed)
+    if got is not None and (got.status != "infeasible" or "infeasible" in as_is):
+        return Settled(got.status, got.lam, lps + 1, how="exact LP", first=ev)
     return Settled("unknown", None, lps, evidence=ev2, how="", first=ev)
 
 

@@ -227,7 +227,7 @@ def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e
 def first_exact(rows: list[list], bq: list, J: np.ndarray, start: list
                 ) -> tuple[list, object] | None:
     """The first of two rational candidates, the y with the cone rows J exactly active and
-    its free unknowns at `start` (`_solve_homogeneous`), then `start` itself, that is a
+    its free unknowns at `start` (`solve_homogeneous`), then `start` itself, that is a
     Farkas certificate exactly: b . y < 0 and row . y <= 0 for every row (C y <= 0). (y, b . y)
     as python-flint fmpq's, or None when neither passes."""
     from flint import fmpq, fmpq_mat
@@ -235,7 +235,7 @@ def first_exact(rows: list[list], bq: list, J: np.ndarray, start: list
     cands = [start]
     if J.size:
         A = fmpq_mat(len(J), len(start), [v for j in J for v in rows[int(j)]])
-        cands.insert(0, _solve_homogeneous(A, start))
+        cands.insert(0, solve_homogeneous(A, start))
     for cand in cands:
         if cand is None:
             continue
@@ -247,7 +247,7 @@ def first_exact(rows: list[list], bq: list, J: np.ndarray, start: list
     return None
 
 
-def _solve_homogeneous(A, start: list) -> list | None:
+def solve_homogeneous(A, start: list) -> list | None:
     """The rational y with A y = 0, free unknowns (non-pivots of A's reduced row echelon
     form) at `start`; None if that makes y = 0."""
     from flint import fmpq

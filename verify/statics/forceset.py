@@ -15,9 +15,12 @@
   slack can be made positive is not implicit; when no undecided row can, all are: at most one
   LP per row, a few in practice). An interior point of P (the analytic centre of P or of a
   face, verify.statics.centre, or failing those HiGHS's IPM without crossover; checked to lie
-  in P) decides most rows first: a clearly positive slack there is a witness.
+  in P) decides most rows first: a clearly positive slack there is a witness; the rows left
+  are proved implicit by local virtual motions checked in exact arithmetic
+  (verify.statics.implicit) before any slack LP runs.
   Then dim P = (number of unknowns left once the implicit equalities are substituted) - rank
-  of the balance equations on them: full row rank is settled by the extreme eigenvalues of
+  of the balance equations on them (rows dependent within one disk's rows dropped first,
+  exactly: hull.locally_dependent): full row rank is settled by the extreme eigenvalues of
   B B^T (sparse, any size) when sigma_min > 1e-6 sigma_max, else by a dense SVD with the
   standard tolerance max(shape) eps sigma_max (the singular values at the cut are reported).
 * ranges: [min, max] of every R and S over P (two LPs each, warm-started; +-inf unbounded),

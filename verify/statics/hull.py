@@ -12,6 +12,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
+from .implicit import proved_rows
 from .model import LP_TOL, StaticProblem, interior_point
 
 #: A slack or a force below this times the largest disk weight is zero.
@@ -33,11 +34,18 @@ def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> lis
     # point of P is not an implicit equality; the slack LPs then decide only the rest.
     if x is None:
         x = interior_point(prob, 1e3 * float(np.sum(prob.system.masses)) * prob.system.g)[1]
+    witness = None
     if x is not None:
         weight = float(np.sum(prob.system.masses)) * prob.system.g
         eq, viol = prob.residuals(x)
         if eq <= 1e-9 * weight and viol <= 1e-9 * weight:
             undecided &= ~(-(Gi @ x) > 1e-6 * T)
+            witness = x if prob.admissible(x) else None
+    # the rows left, when few: exactly checked local certificates that they vanish on all of
+    # P (verify.statics.implicit: a few small LPs each, where the slack LP below solves P
+    # whole); the rows none proves go to the slack LPs
+    proved = proved_rows(prob, undecided) if witness is not None else np.zeros(m, dtype=bool)
+    undecided &= ~proved
     while undecided.any():
         cost = np.r_[np.zeros(prob.n), -undecided.astype(float)]
         A_ub = sp.hstack([Gi, sp.eye(m)], format="csr")
@@ -55,13 +63,16 @@ def implicit_equalities(prob: StaticProblem, x: np.ndarray | None = None) -> lis
         if not new.any():
             break
         undecided &= ~new
-    return labels(prob, undecided)
+    return labels(prob, undecided | proved, witness)
 
 
-def labels(prob: StaticProblem, undecided: np.ndarray) -> list[str]:
+def labels(prob: StaticProblem, undecided: np.ndarray,
+           witness: np.ndarray | None = None) -> list[str]:
     """Per contact, the strongest implicit equality among the rows left `undecided` (no slack
     found: -R <= 0 for the c contacts, then S - mu R <= 0 and -S - mu R <= 0 for the k
-    frictional ones): "R=0" (implies S = +-mu R = 0), "S=+muR", "S=-muR" or ""."""
+    frictional ones): "R=0" (implies S = +-mu R = 0), "S=+muR", "S=-muR" or "". witness: a
+    point of P (checked by the caller, `StaticProblem.admissible`) whose R > ZERO x scale
+    there stands for `_positive_R`'s LP."""
     c, k = prob.c, prob.fric.size
     out = [""] * c
     for a in range(c):
@@ -72,9 +83,13 @@ def labels(prob: StaticProblem, undecided: np.ndarray) -> list[str]:
             continue
         plus, minus = undecided[c + n], undecided[c + k + n]
         # S = mu R and S = -mu R both on all of P give 2 mu R = 0: R = 0 (which implies both)
-        if (plus and minus) or ((plus or minus) and not _positive_R(prob, a)):
+        if not (plus or minus):
+            continue
+        positive = (witness is not None and witness[a] > ZERO * prob.scale) or (
+            _positive_R(prob, a))
+        if (plus and minus) or not positive:
             out[a] = "R=0"
-        elif plus or minus:
+        else:
             out[a] = "S=+muR" if plus else "S=-muR"
     return out
 
@@ -122,7 +137,9 @@ def dimension(prob: StaticProblem, implicit: list[str]
     """(dim P, (smallest singular value kept, largest dropped)); None when the rank is not
     settled (rank deficient above the dense limit)."""
     B = reduced_balance(prob, implicit)
-    B = B[np.flatnonzero(np.diff(B.tocsr().indptr))]  # rows that are exactly zero: rank 0
+    keep = np.diff(B.tocsr().indptr) > 0  # rows that are exactly zero: rank 0
+    keep &= ~locally_dependent(B, prob.p)
+    B = B[np.flatnonzero(keep)]
     if B.shape[1] == 0 or B.shape[0] == 0:
         return B.shape[1], (None, None)
     full = _full_row_rank(B)
@@ -136,6 +153,43 @@ def dimension(prob: StaticProblem, implicit: list[str]
     kept = float(w[rank - 1]) if rank else None
     dropped = float(w[rank]) if rank < w.size else None
     return B.shape[1] - rank, (kept, dropped)
+
+
+def locally_dependent(B: sp.spmatrix, p: int) -> np.ndarray:
+    """Rows of B (3p: the u, v, w balance rows of the p disks) that are exact linear
+    combinations of other rows of the same disk, one mask entry per row: at a disk whose
+    nonzero rows touch fewer columns than their number (e.g. a disk left with one contact
+    once the implicit equalities R = 0 are substituted: 2 columns, 3 rows), the disk's rows
+    are 0 outside those columns, so a row that is a combination of the disk's other rows on
+    them is one in B, and rank B is unchanged without it. The disk's rows are kept in order
+    while they raise the exact rank (python-flint, on the stored doubles) of the kept ones.
+    Dropping them lets the sparse full-row-rank test settle the rank above the dense SVD's
+    limit."""
+    from flint import fmpq_mat
+
+    from .farkas import rational
+
+    B = sp.csr_matrix(B)
+    out = np.zeros(B.shape[0], dtype=bool)
+    nz = (abs(B) > 0).astype(float)
+    disk_of = np.tile(np.arange(p), 3)
+    M = sp.csr_matrix((np.ones(3 * p), (disk_of, np.arange(3 * p))), shape=(p, 3 * p))
+    ncols = np.diff((M @ nz).tocsr().indptr)  # distinct columns touching each disk's rows
+    nrows = np.asarray(M @ (np.diff(B.indptr) > 0).astype(float)).ravel()
+    for d in np.flatnonzero(ncols < nrows):
+        rows = [r for r in (d, p + d, 2 * p + d) if B.indptr[r + 1] > B.indptr[r]]
+        block = B[rows]
+        cols = np.unique(block.indices)
+        dense = block[:, cols].toarray()
+        kept: list[int] = []
+        for n, r in enumerate(rows):
+            trial = kept + [n]
+            A = fmpq_mat(len(trial), cols.size, [rational(v) for i in trial for v in dense[i]])
+            if A.rank() == len(trial):
+                kept = trial
+            else:
+                out[r] = True
+    return out
 
 
 def _full_row_rank(B: sp.csr_matrix) -> float | None:

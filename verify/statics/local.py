@@ -65,7 +65,7 @@ class LocalCertificate:
     exact: dict
 
 
-class _Cone:
+class Cone:
     """C (cone rows, verify.statics.farkas.cone_rows) with, per row, its contact."""
 
     def __init__(self, prob: StaticProblem):
@@ -87,19 +87,31 @@ class _Cone:
         return np.r_[D, p + D, 2 * p + D]
 
 
-def window_lp(cone: _Cone, D: np.ndarray) -> tuple[float, np.ndarray | None]:
+def window_lp(cone: Cone, D: np.ndarray, target: np.ndarray | None = None
+              ) -> tuple[float, np.ndarray | None]:
     """(min b_D . y_D, its y_D) over C_D y_D <= 0, |y_D|_inf <= 1 by HiGHS's simplex;
-    (0, None) when HiGHS reports no optimum."""
+    (0, None) when HiGHS reports no optimum. With `target` (cone rows of contacts touching D):
+    min sum_target (C y)_r subject also to b_D . y_D = 0 (verify.statics.implicit)."""
     import highspy
 
     rows, cols = cone.rows_of(D), cone.cols_of(D)
     Cd = sp.csc_matrix(cone.C[rows][:, cols])
+    cost = np.asarray(cone.prob.b[cols], dtype=float)
+    bounds = np.zeros(rows.size)
+    if target is not None:
+        cost = np.asarray(cone.C[target][:, cols].sum(axis=0), dtype=float).ravel()
+        Cd = sp.vstack([Cd, sp.csr_matrix(np.asarray(cone.prob.b[cols], dtype=float)[None, :])],
+                       format="csc")
+        bounds = np.r_[bounds, 0.0]
     m, n = Cd.shape
     lp = highspy.HighsLp()
     lp.num_col_, lp.num_row_ = n, m
-    lp.col_cost_ = np.asarray(cone.prob.b[cols], dtype=float)
+    lp.col_cost_ = cost
     lp.col_lower_, lp.col_upper_ = -np.ones(n), np.ones(n)
-    lp.row_lower_, lp.row_upper_ = np.full(m, -highspy.kHighsInf), np.zeros(m)
+    lp.row_lower_ = np.full(m, -highspy.kHighsInf)
+    if target is not None:
+        lp.row_lower_[-1] = 0.0
+    lp.row_upper_ = bounds
     lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
         Cd.indptr, Cd.indices, Cd.data)
@@ -119,27 +131,9 @@ def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
     nearly active made exactly active, checked exactly: C_D y <= 0 and b_D . y < 0 for the
     stored H, b, mu (module docstring). {column of the full y: Fraction} on D's columns, or
     None when the check fails."""
-    from flint import fmpq
-
-    cone = _Cone(prob)
+    cone = Cone(prob)
     rows, cols = cone.rows_of(D), cone.cols_of(D)
-    n = cols.size
-    where = {int(k): s for s, k in enumerate(cols)}
-    H = sp.csr_matrix(prob.A.T)
-    c, mu = prob.c, prob.mu
-    exact_rows = []  # C_D exactly: -H_n + mu H_t (row < c) or -H_n - mu H_t, on D's columns
-    for r in rows:
-        a = int(cone.contact[r])
-        sign = 1 if r < c else -1
-        mq = rational(mu[a]) * sign
-        row = [fmpq(0)] * n
-        for k, coef in ((a, fmpq(-1)), (c + a, mq)):
-            lo, hi = H.indptr[k], H.indptr[k + 1]
-            for col, val in zip(H.indices[lo:hi], H.data[lo:hi]):
-                s = where.get(int(col))
-                if s is not None:
-                    row[s] += coef * rational(val)
-        exact_rows.append(row)
+    exact_rows = window_rows(cone, rows, cols)
     bq = [rational(v) for v in prob.b[cols]]
     scale = float(np.max(np.abs(yD), initial=0.0))
     if scale == 0:
@@ -151,6 +145,30 @@ def exact_local(prob: StaticProblem, D: np.ndarray, yD: np.ndarray,
     if found is None:
         return None
     return {int(k): Fraction(int(v.p), int(v.q)) for k, v in zip(cols, found[0])}
+
+
+def window_rows(cone: Cone, rows: np.ndarray, cols: np.ndarray) -> list[list]:
+    """The cone rows `rows` of C on the columns `cols` in rationals (one list of fmpq per row):
+    -H_n + mu H_t (row < c) or -H_n - mu H_t, from the stored H and mu."""
+    from flint import fmpq
+
+    prob = cone.prob
+    where = {int(k): s for s, k in enumerate(cols)}
+    H = sp.csr_matrix(prob.A.T)
+    c, mu = prob.c, prob.mu
+    out = []
+    for r in rows:
+        a = int(cone.contact[r])
+        mq = rational(mu[a]) * (1 if r < c else -1)
+        row = [fmpq(0)] * cols.size
+        for k, coef in ((a, fmpq(-1)), (c + a, mq)):
+            lo, hi = H.indptr[k], H.indptr[k + 1]
+            for col, val in zip(H.indices[lo:hi], H.data[lo:hi]):
+                s = where.get(int(col))
+                if s is not None:
+                    row[s] += coef * rational(val)
+        out.append(row)
+    return out
 
 
 def windows(prob: StaticProblem, side: float) -> list[np.ndarray]:
@@ -185,7 +203,7 @@ def scan(prob: StaticProblem, start: float = START_DIAMETERS,
     solved, side) after each side."""
     if prob.p == 0:
         return None
-    cone = _Cone(prob)
+    cone = Cone(prob)
     dmax = 2.0 * float(np.max(prob.system.lattice.radii))
     weight = float(np.max(prob.system.masses)) * prob.system.g
     side, solved, level = start * dmax, 0, 0
@@ -209,7 +227,7 @@ def scan(prob: StaticProblem, start: float = START_DIAMETERS,
     return None
 
 
-def _settle(prob: StaticProblem, cone: _Cone, D: np.ndarray, yD: np.ndarray,
+def _settle(prob: StaticProblem, cone: Cone, D: np.ndarray, yD: np.ndarray,
             solved: int) -> LocalCertificate | None:
     """The window's y shrunk to the disks it moves and checked exactly."""
     k = D.size

@@ -122,9 +122,9 @@ def test_no_certificate_where_an_equilibrium_exists(system):
 
 
 def _cone(prob):
-    from rigidlcp.verify.statics.local import _Cone
+    from rigidlcp.verify.statics.local import Cone
 
-    return _Cone(prob)
+    return Cone(prob)
 
 
 def test_windows_cover_every_disk_and_small_clusters():

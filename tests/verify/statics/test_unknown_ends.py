@@ -249,7 +249,8 @@ PYRAMID = "# box: left=0.0 right=4.0\nx,y,r\n1,1,1\n3,1,1\n2,2.7320508075688772,
 def test_an_end_whose_check_fails_is_unknown_in_the_json_and_the_text(tmp_path, capsys,
                                                                       monkeypatch):
     """Every check of max R at the first bounded contact refused (its evidence: a dual gap of
-    1e-3 against 1e-8): that end is "unknown" (not a number, not null) after the retries, its
+    1e-3 against 1e-8) is settled by the exact LP (the same end); that refused as well, the
+    end is "unknown" (not a number, not null) after the retries, its
     evidence in unknown_ends, counted in unchecked_optima and in the text; the other ends and
     the unbounded ones (null) as without the refusal."""
     f = tmp_path / "p.csv"
@@ -266,6 +267,14 @@ def test_an_end_whose_check_fails_is_unknown_in_the_json_and_the_text(tmp_path, 
         return real(prob, lp, cost, status, lam, fixed, y, basis)
 
     monkeypatch.setattr(ends, "judge", refuse)
+    # the last retry, the LP solved in rationals, settles it with the same end ...
+    assert main(args + ["--json"]) == 0
+    exact = json.loads(capsys.readouterr().out)
+    assert abs(exact["contacts"][a]["R"][1] - before["contacts"][a]["R"][1]) <= 1e-9 * max(
+        1.0, abs(before["contacts"][a]["R"][1]))
+    assert exact["unchecked_optima"] == 0
+    # ... and refused too, the end is unknown
+    monkeypatch.setattr(ends.exact_lp, "solve", lambda prob, cost, fixed=(): None)
     assert main(args + ["--json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert d["contacts"][a]["R"][1] == "unknown"
@@ -342,7 +351,8 @@ def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word(monkeypatch):
     from a witness within 1e-9 of its largest force (2.8e8 weights) of the bound, where
     mu R - |S| was 6% of R: the witness must now be at the bound to 1e-9 of the contact's own
     R, and both runs agree that contact 19 cannot slide. With the certificate check refused,
-    the verdict is unknown, not "cannot slide"."""
+    the exact LP (verify.statics.exact_lp) still proves it; with that refused too, the
+    verdict is unknown, not "cannot slide"."""
     system = _pile(13, 1, 0.99999)
     serial = analyse(system)
     fs = analyse(system, ranges=False)
@@ -384,6 +394,9 @@ def test_a_warm_infeasible_sliding_face_is_not_taken_on_its_word(monkeypatch):
             assert not exact.face_empty(prob, y, (a,)), a
     assert tried > 0
     monkeypatch.setattr(exact, "face_empty", lambda *a: False)
+    settled = analyse(system)  # the exact LP (the last retry) proves both faces empty
+    assert not settled.sliding_unknown[19] and not settled.sliding[19]
+    monkeypatch.setattr(ends.exact_lp, "solve", lambda prob, cost, fixed=(): None)
     doubt = analyse(system)
     assert doubt.sliding_unknown[19] and not doubt.sliding[19] and doubt.unchecked >= 1
 
