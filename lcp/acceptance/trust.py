@@ -16,14 +16,14 @@ The run (called by `lcp.api.solve` with a validated problem):
 4. "infeasible" is kept only with a checked Farkas certificate (lcp.farkas); otherwise the
    status becomes "failed" (the claim could not be proved), or a fallback's answer is returned;
 5. "ray", "max_iter" and "failed" are retried once with the other equilibration setting. Then,
-   if the LP finds a Farkas certificate, the status becomes "infeasible"
+   if the LP finds a Farkas certificate, the status becomes "infeasible" (not for a method
+   that raised: its status stays "failed", the exception in ``info["exception"]``)
    (``info["status_of_method"]`` keeps the method's own); else, with a fallback asked for and
    M copositive-plus (M + M^T PSD: solvable when feasible, Lemke's theorem), the fallbacks run.
 """
 
 from __future__ import annotations
 
-import traceback
 from collections.abc import Callable
 
 import numpy as np
@@ -48,17 +48,11 @@ def attempt(func: Callable[..., Solution], name: str, eq: Equilibration, options
             ) -> Solution:
     """Run one method on the (equilibrated) data and map its answer back to the user's units.
 
-    An exception other than bad input or a refusal is a bug of the method; it is reported as
-    status "failed" with the exception in ``info["exception"]`` instead of escaping."""
+    `func` is the method as lcp.api hands it over: an exception other than bad input, a
+    refusal or MemoryError (a bug of the method) comes back as status "failed" with the
+    exception in ``info["exception"]`` (lcp.api._returning_solutions), never escapes."""
     n = eq.q.size
-    try:
-        sol = func(eq.M, eq.q, **options)
-    except (InvalidProblem, NotApplicable):
-        raise
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        return Solution(z=np.zeros(n), w=eq.q.copy(), status="failed", method=name,
-                        message=f"the method raised {type(exc).__name__}: {exc}",
-                        info={"exception": "".join(traceback.format_exception_only(exc))})
+    sol = func(eq.M, eq.q, **options)
     sol.method = name
     z = np.asarray(sol.z, dtype=float)
     if z.shape != (n,) or not np.all(np.isfinite(z)):
@@ -222,8 +216,8 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
             if got is not None:
                 return _adopt(sol, got, f"{name} had ended with status {sol.status!r} on a "
                               "copositive-plus M with no certificate of infeasibility")
-        if cert is not None:
-            sol.info.update(cert.as_info())
+        if cert is not None and "exception" not in sol.info:  # a crash stays the method's
+            sol.info.update(cert.as_info())                   # failure (bench, fuzz)
             sol.info["status_of_method"] = sol.status
             sol.status = "infeasible"
             _note(sol, f"the LCP is infeasible: a Farkas certificate y (info['farkas']) was "
