@@ -18,8 +18,8 @@ from dataclasses import replace
 import rigidlcp.lcp.registry as registry
 
 from .acceptance.residual import TOL
-from .acceptance.trust import Run, solve_checked
-from .errors import RigidLCPError
+from .acceptance.trust import Run, call_method, solve_checked
+from .errors import NotASolution
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
 from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup, register
@@ -126,26 +126,18 @@ def _returning_solutions(info: MethodInfo) -> MethodInfo:
     """`info` whose functions (the method and its native forms) answer with an lcp.Solution.
 
     A method that raises (RuntimeError, IndexError, ...: a bug of the method) gives status
-    "failed", credited to it, with the exception's type and message in the message and in
-    ``info["exception"]`` (bench and fuzz count it as the method's failure): lcp.solve's
-    docstring promises a status, and a registered method's RuntimeError escaped as a
-    traceback (session 28). Bad input and refusals (RigidLCPError: InvalidProblem,
-    NotApplicable) and MemoryError propagate, as do KeyboardInterrupt and SystemExit (not
-    Exceptions). A method that returns anything but an lcp.Solution raises TypeError naming
-    it: one that forgot its `return` failed with "'NoneType' object has no attribute
-    'method'" deep in lcp.acceptance.trust."""
+    "failed", credited to it (lcp.acceptance.trust.call_method): lcp.solve's docstring
+    promises a status, and a registered method's RuntimeError escaped as a traceback
+    (session 28). A method that returns anything but an lcp.Solution raises NotASolution (a
+    TypeError) naming it: one that forgot its `return` failed with "'NoneType' object has no
+    attribute 'method'" deep in lcp.acceptance.trust."""
     name = info.name
 
     def guarded(func: Callable[..., Solution]) -> Callable[..., Solution]:
         def checked(*args, **kwargs) -> Solution:
-            try:
-                sol = func(*args, **kwargs)
-            except (RigidLCPError, MemoryError):
-                raise
-            except Exception as exc:  # noqa: BLE001 - a method's bug is its failure
-                return _raised(name, exc, args)
+            sol = call_method(func, name, *args, **kwargs)
             if not isinstance(sol, Solution):
-                raise TypeError(f"method {name!r} returned {type(sol).__name__}, not an "
+                raise NotASolution(f"method {name!r} returned {type(sol).__name__}, not an "
                                 "lcp.Solution (a registered method returns lcp.Solution(z=..., "
                                 "w=..., status=..., method=...))")
             return sol
@@ -154,25 +146,6 @@ def _returning_solutions(info: MethodInfo) -> MethodInfo:
 
     return replace(info, func=guarded(info.func),
                    native={kind: guarded(fn) for kind, fn in info.native.items()})
-
-
-def _raised(name: str, exc: Exception, args: tuple) -> Solution:
-    """Status "failed" for method `name` that raised `exc` when called on `args` ((M, q) or a
-    problem object): z = 0 of the problem's size, the exception named in message and info."""
-    import traceback
-
-    import numpy as np
-
-    q = args[1] if len(args) == 2 and isinstance(args[1], np.ndarray) else None
-    n = q.size if q is not None else int(getattr(args[0], "n", 0)) if args else 0
-    said = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
-    frames = traceback.extract_tb(exc.__traceback__)
-    where = f"{frames[-1].filename}:{frames[-1].lineno} in {frames[-1].name}" if frames else ""
-    return Solution(z=np.zeros(n), w=q.copy() if q is not None else np.zeros(n),
-                    status="failed", method=name,
-                    message=f"the method raised {said}" + (f" ({where})" if where else ""),
-                    info={"exception": "".join(traceback.format_exception_only(exc)),
-                          "exception_type": type(exc).__name__, "raised_at": where})
 
 
 def _fallbacks(fallback) -> tuple[str, ...]:

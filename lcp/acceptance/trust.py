@@ -24,10 +24,12 @@ The run (called by `lcp.api.solve` with a validated problem):
 
 from __future__ import annotations
 
+import traceback
 from collections.abc import Callable
 
 import numpy as np
 
+from ..errors import RigidLCPError
 from ..problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from ..problems.solution import Solution
 from .accuracy import Accuracy, assess, assess_lcp
@@ -44,15 +46,44 @@ def identity(M: np.ndarray, q: np.ndarray) -> Equilibration:
     return Equilibration(M=M, q=q, r=np.ones(n), c=np.ones(n))
 
 
+def call_method(func: Callable[..., Solution], name: str, /, *args, **options) -> Solution:
+    """func(*args, **options): the method `name` on (M, q) or on a problem object. An
+    exception it raises other than bad input or a refusal (RigidLCPError: InvalidProblem,
+    NotApplicable) or MemoryError is a bug of the method: it comes back as status "failed",
+    credited to it, the exception's type and message in the message and in
+    ``info["exception"]`` (`failed_by`), never escapes; KeyboardInterrupt and SystemExit are
+    no Exceptions and propagate."""
+    try:
+        return func(*args, **options)
+    except (RigidLCPError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - a method's bug is its failure
+        return failed_by(name, exc, args)
+
+
+def failed_by(name: str, exc: Exception, args: tuple) -> Solution:
+    """Status "failed" for method `name` that raised `exc` when called on `args` ((M, q) or a
+    problem object): z = 0 of the problem's size, the exception named in message and info."""
+    q = args[1] if len(args) == 2 and isinstance(args[1], np.ndarray) else None
+    n = q.size if q is not None else int(getattr(args[0], "n", 0)) if args else 0
+    said = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+    frames = traceback.extract_tb(exc.__traceback__)
+    where = f"{frames[-1].filename}:{frames[-1].lineno} in {frames[-1].name}" if frames else ""
+    return Solution(z=np.zeros(n), w=q.copy() if q is not None else np.zeros(n),
+                    status="failed", method=name,
+                    message=f"the method raised {said}" + (f" ({where})" if where else ""),
+                    info={"exception": "".join(traceback.format_exception_only(exc)),
+                          "exception_type": type(exc).__name__, "raised_at": where})
+
+
 def attempt(func: Callable[..., Solution], name: str, eq: Equilibration, options: dict
             ) -> Solution:
     """Run one method on the (equilibrated) data and map its answer back to the user's units.
 
-    `func` is the method as lcp.api hands it over: an exception other than bad input, a
-    refusal or MemoryError (a bug of the method) comes back as status "failed" with the
-    exception in ``info["exception"]`` (lcp.api._returning_solutions), never escapes."""
+    An exception other than bad input, a refusal or MemoryError (a bug of the method) comes
+    back as status "failed" with the exception in ``info["exception"]`` (`call_method`)."""
     n = eq.q.size
-    sol = func(eq.M, eq.q, **options)
+    sol = call_method(func, name, eq.M, eq.q, **options)
     sol.method = name
     z = np.asarray(sol.z, dtype=float)
     if z.shape != (n,) or not np.all(np.isfinite(z)):

@@ -139,3 +139,18 @@ def test_fuzz_counts_it_as_the_methods_crash(raising):
     cells = [cell for (_, m), cell in result["table"].items() if m == "test-raises-runtime"]
     assert cells and sum(cell["crash"] for cell in cells) == 6
     assert sum(cell["solved"] + cell["WRONG"] for cell in cells) == 0
+
+
+def test_callers_of_the_table_without_the_facade_get_failed_too(raising):
+    """lcp.acceptance.trust's Run is also driven with the raw table (lcp.registry.lookup: the
+    local rescue of lcp.solvers.state_pivoting, below the facade): a raising method still
+    comes back "failed" there (trust.call_method), and a method returning no Solution still
+    raises the named TypeError through the facade."""
+    from rigidlcp.lcp.acceptance.residual import TOL
+    from rigidlcp.lcp.acceptance.trust import Run, solve_checked
+
+    problem = lcp.LCP(M, Q)
+    sol = solve_checked(Run(problem, problem, registry.lookup, TOL), "test-raises-runtime",
+                        True, True, {})
+    _is_failure_of(sol, "test-raises-runtime", "RuntimeError", "boom")
+    assert issubclass(lcp.errors.NotASolution, TypeError)
