@@ -12,12 +12,14 @@ trusted): see lcp.acceptance.trust.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 
 import rigidlcp.lcp.registry as registry
 
 from .acceptance.residual import TOL
-from .acceptance.trust import Run, solve_checked
+from .acceptance.trust import Run, call_method, solve_checked
+from .errors import NotASolution
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
 from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup, register
@@ -121,20 +123,29 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
 
 
 def _returning_solutions(info: MethodInfo) -> MethodInfo:
-    """`info` whose function raises TypeError, naming the method, when it returns anything but
-    an lcp.Solution: a registered method that forgot its `return` failed with "'NoneType'
-    object has no attribute 'method'" deep in lcp.acceptance.trust."""
-    func, name = info.func, info.name
+    """`info` whose functions (the method and its native forms) answer with an lcp.Solution.
 
-    def checked(*args, **kwargs) -> Solution:
-        sol = func(*args, **kwargs)
-        if not isinstance(sol, Solution):
-            raise TypeError(f"method {name!r} returned {type(sol).__name__}, not an "
-                            "lcp.Solution (a registered method returns lcp.Solution(z=..., "
-                            "w=..., status=..., method=...))")
-        return sol
+    A method that raises (RuntimeError, IndexError, ...: a bug of the method) gives status
+    "failed", credited to it (lcp.acceptance.trust.call_method): lcp.solve's docstring
+    promises a status, and a registered method's RuntimeError escaped as a traceback
+    (session 28). A method that returns anything but an lcp.Solution raises NotASolution (a
+    TypeError) naming it: one that forgot its `return` failed with "'NoneType' object has no
+    attribute 'method'" deep in lcp.acceptance.trust."""
+    name = info.name
 
-    return replace(info, func=checked)
+    def guarded(func: Callable[..., Solution]) -> Callable[..., Solution]:
+        def checked(*args, **kwargs) -> Solution:
+            sol = call_method(func, name, *args, **kwargs)
+            if not isinstance(sol, Solution):
+                raise NotASolution(f"method {name!r} returned {type(sol).__name__}, not an "
+                                "lcp.Solution (a registered method returns lcp.Solution(z=..., "
+                                "w=..., status=..., method=...))")
+            return sol
+
+        return checked
+
+    return replace(info, func=guarded(info.func),
+                   native={kind: guarded(fn) for kind, fn in info.native.items()})
 
 
 def _fallbacks(fallback) -> tuple[str, ...]:

@@ -33,5 +33,10 @@ class NotApplicable(RigidLCPError, ValueError):
     """A method (or a reduction) refuses a well-formed problem, and says why."""
 
 
+class NotASolution(RigidLCPError, TypeError):
+    """A registered method returned something other than an lcp.Solution (e.g. a forgotten
+    `return`): an error of the method's code, named, never reported as the method's failure."""
+
+
 class OutputExists(RigidLCPError, FileExistsError):
     """An output path that already exists and would be overwritten (pass force=True / --force)."""

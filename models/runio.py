@@ -50,6 +50,7 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
         "message": run.message, "contacts": run.contacts, "method": run.method,
         "wall_time": run.wall_time, "events": run.n_events,
         "methods_per_event": [r.method for r in run.records],
+        "closed": run.closed,  # the dense backend's closed-solution search, or None
         "summary": run.summary(),
     }
     text = json.dumps(meta, indent=2, default=_json_default)
@@ -67,7 +68,8 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
 
 
 def load_run(path: str | os.PathLike) -> Run:
-    """Read a run written by `save_run` (the system is rebuilt from the metadata)."""
+    """Read a run written by `save_run` (the system is rebuilt from the metadata; run.closed,
+    the closed-solution search of a dense run, is restored, None in files older than it)."""
     data_path, _ = run_paths(path)
     if Path(path).is_file() and not data_path.exists():  # e.g. a text file, not PATH.npz
         npz = Path(path).with_suffix(".npz")
@@ -125,7 +127,18 @@ def _load_run(data_path: Path) -> Run:
         records.append(EventRecord(**{k: v for k, v in rec.items() if k in names}))
     return Run(system, records, status=meta["status"], message=meta["message"],
                contacts=list(meta.get("contacts", [])), wall_time=float(meta["wall_time"]),
-               method=meta["method"], final=final)
+               method=meta["method"], final=final, closed=_closed(meta))
+
+
+def _closed(meta: dict) -> dict | None:
+    """Run.closed as saved; a file written before it was saved keeps it only in its summary
+    ("closed_search", since the search exists), an older one not at all (None)."""
+    closed = meta.get("closed", (meta.get("summary") or {}).get("closed_search"))
+    if closed is None:
+        return None
+    if not isinstance(closed, dict):
+        raise TypeError(f"the closed-solution search's record is a {type(closed).__name__}")
+    return dict(closed)
 
 
 _GEOMETRY = ("packing_x", "packing_r", "packing_m", "packing_I")

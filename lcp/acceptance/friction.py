@@ -12,7 +12,14 @@ import numpy as np
 from ..errors import NotApplicable
 from ..problems.friction import FrictionContact2D, natural_residual
 from ..problems.solution import Solution
-from .friction_accuracy import assess_fc2d, states_of_glocker_basis
+from .friction_accuracy import (
+    OPEN,
+    SLIDE_BACKWARD,
+    SLIDE_FORWARD,
+    STICK,
+    assess_fc2d,
+    states_of_glocker_basis,
+)
 from .residual import TOL
 
 #: A friction-contact answer counts as solved at this relative natural-map residual.
@@ -30,7 +37,9 @@ def finish(problem: FrictionContact2D, sol: Solution, tol: float = FC_TOL,
     judged (lcp.acceptance.friction_accuracy); u = W r + q and the natural-map residual are
     recomputed; z = r, w = u. A "solved" that fails (backward error > lcp.residual.TOL,
     forward error bound > lcp.accuracy.FERR_TOL or natural-map residual > `tol`) becomes
-    "inaccurate", its errors in the message."""
+    "inaccurate", its errors in the message. A judged answer's contact states are counted in
+    info["contact_states"] (open / sticking / sliding), which its repr shows; sol.basis stays
+    the method's own (a Glocker LCP basis, or the states method's closed contacts)."""
     r = np.asarray(sol.z, dtype=float).reshape(-1)
     acc = None
     if r.shape != (problem.n,) or not np.all(np.isfinite(r)):
@@ -46,6 +55,12 @@ def finish(problem: FrictionContact2D, sol: Solution, tol: float = FC_TOL,
     u = problem.u(r)
     res = natural_residual(problem, r, u)
     sol.z, sol.w, sol.residual = r, u, res
+    if acc is not None:  # the judged answer's contact states (sol.basis is the method's own)
+        st = acc.states
+        sol.info["contact_states"] = {"open": int(np.sum(st == OPEN)),
+                                      "sticking": int(np.sum(st == STICK)),
+                                      "sliding": int(np.sum((st == SLIDE_FORWARD)
+                                                            | (st == SLIDE_BACKWARD)))}
     sol.scaled_residual = res
     sol.info["natural_residual"] = res
     if acc is not None and not (res <= tol and acc.accepted):

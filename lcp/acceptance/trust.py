@@ -16,7 +16,8 @@ The run (called by `lcp.api.solve` with a validated problem):
 4. "infeasible" is kept only with a checked Farkas certificate (lcp.farkas); otherwise the
    status becomes "failed" (the claim could not be proved), or a fallback's answer is returned;
 5. "ray", "max_iter" and "failed" are retried once with the other equilibration setting. Then,
-   if the LP finds a Farkas certificate, the status becomes "infeasible"
+   if the LP finds a Farkas certificate, the status becomes "infeasible" (not for a method
+   that raised: its status stays "failed", the exception in ``info["exception"]``)
    (``info["status_of_method"]`` keeps the method's own); else, with a fallback asked for and
    M copositive-plus (M + M^T PSD: solvable when feasible, Lemke's theorem), the fallbacks run.
 """
@@ -28,6 +29,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ..errors import RigidLCPError
 from ..problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from ..problems.solution import Solution
 from .accuracy import Accuracy, assess, assess_lcp
@@ -44,21 +46,44 @@ def identity(M: np.ndarray, q: np.ndarray) -> Equilibration:
     return Equilibration(M=M, q=q, r=np.ones(n), c=np.ones(n))
 
 
+def call_method(func: Callable[..., Solution], name: str, /, *args, **options) -> Solution:
+    """func(*args, **options): the method `name` on (M, q) or on a problem object. An
+    exception it raises other than bad input or a refusal (RigidLCPError: InvalidProblem,
+    NotApplicable) or MemoryError is a bug of the method: it comes back as status "failed",
+    credited to it, the exception's type and message in the message and in
+    ``info["exception"]`` (`failed_by`), never escapes; KeyboardInterrupt and SystemExit are
+    no Exceptions and propagate."""
+    try:
+        return func(*args, **options)
+    except (RigidLCPError, MemoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - a method's bug is its failure
+        return failed_by(name, exc, args)
+
+
+def failed_by(name: str, exc: Exception, args: tuple) -> Solution:
+    """Status "failed" for method `name` that raised `exc` when called on `args` ((M, q) or a
+    problem object): z = 0 of the problem's size, the exception named in message and info."""
+    q = args[1] if len(args) == 2 and isinstance(args[1], np.ndarray) else None
+    n = q.size if q is not None else int(getattr(args[0], "n", 0)) if args else 0
+    said = f"{type(exc).__name__}: {exc}" if str(exc) else type(exc).__name__
+    frames = traceback.extract_tb(exc.__traceback__)
+    where = f"{frames[-1].filename}:{frames[-1].lineno} in {frames[-1].name}" if frames else ""
+    return Solution(z=np.zeros(n), w=q.copy() if q is not None else np.zeros(n),
+                    status="failed", method=name,
+                    message=f"the method raised {said}" + (f" ({where})" if where else ""),
+                    info={"exception": "".join(traceback.format_exception_only(exc)),
+                          "exception_type": type(exc).__name__, "raised_at": where})
+
+
 def attempt(func: Callable[..., Solution], name: str, eq: Equilibration, options: dict
             ) -> Solution:
     """Run one method on the (equilibrated) data and map its answer back to the user's units.
 
-    An exception other than bad input or a refusal is a bug of the method; it is reported as
-    status "failed" with the exception in ``info["exception"]`` instead of escaping."""
+    An exception other than bad input, a refusal or MemoryError (a bug of the method) comes
+    back as status "failed" with the exception in ``info["exception"]`` (`call_method`)."""
     n = eq.q.size
-    try:
-        sol = func(eq.M, eq.q, **options)
-    except (InvalidProblem, NotApplicable):
-        raise
-    except (ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
-        return Solution(z=np.zeros(n), w=eq.q.copy(), status="failed", method=name,
-                        message=f"the method raised {type(exc).__name__}: {exc}",
-                        info={"exception": "".join(traceback.format_exception_only(exc))})
+    sol = call_method(func, name, eq.M, eq.q, **options)
     sol.method = name
     z = np.asarray(sol.z, dtype=float)
     if z.shape != (n,) or not np.all(np.isfinite(z)):
@@ -222,8 +247,8 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
             if got is not None:
                 return _adopt(sol, got, f"{name} had ended with status {sol.status!r} on a "
                               "copositive-plus M with no certificate of infeasibility")
-        if cert is not None:
-            sol.info.update(cert.as_info())
+        if cert is not None and "exception" not in sol.info:  # a crash stays the method's
+            sol.info.update(cert.as_info())                   # failure (bench, fuzz)
             sol.info["status_of_method"] = sol.status
             sol.status = "infeasible"
             _note(sol, f"the LCP is infeasible: a Farkas certificate y (info['farkas']) was "

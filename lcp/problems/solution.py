@@ -75,18 +75,25 @@ class Solution:
 
     def __repr__(self) -> str:
         n = self.z.size
+        fc = self.info.get("contact_states") if isinstance(self.info, dict) else None
+        measure = ("relative natural-map residual" if isinstance(self.info, dict)
+                   and "natural_residual" in self.info else
+                   f"max|min(z, w)|; scaled {self.scaled_residual:.3e}")
         lines = [
             f"Solution(method={self.method!r}, status={self.status!r}, n={n})",
             f"  iterations : {self.iterations}",
-            f"  residual   : {self.residual:.3e}  (max|min(z, w)|; scaled "
-            f"{self.scaled_residual:.3e})",
+            f"  residual   : {self.residual:.3e}  ({measure})",
         ]
         if np.isfinite(self.backward_error) or np.isfinite(self.forward_error):
             lines.append(f"  errors     : backward {self.backward_error:.3e}, forward bound "
                          f"{self.forward_error:.3e}")
         if self.u is not None:
             lines.append(f"  eq_residual: {self.eq_residual:.3e}  (max|A u + C v + a|)")
-        if self.basis is not None:
+        if fc is not None:  # a friction answer: z is r, its basis is not over z
+            closed = fc["sticking"] + fc["sliding"]
+            lines.append(f"  contacts   : {closed} of {closed + fc['open']} closed "
+                         f"({fc['sticking']} sticking, {fc['sliding']} sliding)")
+        elif self.basis is not None and self.info.get("natural_residual") is None:
             lines.append(f"  active set : {int(np.size(self.basis))} of {n} z basic")
         if self.message:
             lines.append(f"  message    : {self.message}")

@@ -95,3 +95,18 @@ def test_a_run_not_steady_is_told_what_to_rerun(runs, capsys):
     err = capsys.readouterr().err.strip()
     assert f"{short}: the run ended 'time_limit'" in err
     assert "--t-max or --max-events" in err and "pass its system" not in err
+
+
+def test_table_prints_no_rounding_noise(runs, capsys):
+    """Session 7's closing note: ends that are 0 printed as -4.4e-16, a point range's width as
+    3.469e-18 (this 3 x 1 run's alpha[0]). The table prints no digit below what each end is
+    known to (verify.ranges.result.value_text); the JSON keeps full precision."""
+    import re
+
+    assert main(["ranges", str(runs[2])]) == 0
+    out = capsys.readouterr().out
+    tiny = [v for v in re.findall(r"-?\d[\d.]*e-\d+", out) if abs(float(v)) < 1e-12]
+    assert not tiny, out
+    assert main(["ranges", str(runs[2]), "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)["steady"]
+    assert st["mu_g"][0] == pytest.approx(st["witnesses"]["min"]["mu_g"], abs=1e-15)

@@ -108,3 +108,20 @@ def test_friction_methods_refuse_an_lcp_and_bad_input_is_named():
         lcp.FrictionContact2D(np.eye(2), np.zeros(2), -0.1)
     with pytest.raises(lcp.InvalidProblem, match="2c x 2c"):
         lcp.FrictionContact2D(np.eye(3), np.zeros(3), 0.1)
+
+
+def test_repr_counts_the_contact_states_not_a_glocker_basis():
+    """The repr of a friction answer said "active set : k of 2c z basic", k counting a basis of
+    the Glocker LCP (3c unknowns; the closed contacts for `states`) against r's 2c entries
+    (session 7's closing note). It now counts the answer's contact states, here the three
+    contacts of test_one_contact_solved_by_hand side by side (W = I): stick, slide, open."""
+    p = lcp.FrictionContact2D(np.eye(6), np.array([-1.0, 0.2, -1.0, 2.0, 0.5, -3.0]), 0.5)
+    for name in FC_METHODS:
+        sol = lcp.solve(p, name)
+        assert sol.status == "solved", (name, sol)
+        assert sol.info["contact_states"] == {"open": 1, "sticking": 1, "sliding": 1}
+        text = repr(sol)
+        assert "contacts   : 2 of 3 closed (1 sticking, 1 sliding)" in text, text
+        assert "z basic" not in text and "relative natural-map residual" in text
+    plain = repr(lcp.solve(lcp.LCP(np.eye(2), -np.ones(2)), "lemke"))
+    assert "active set : 2 of 2 z basic" in plain and "contacts" not in plain

@@ -164,3 +164,39 @@ def test_closed_solutions_satisfy_the_event_laws(n, seed, mu, spins):
 @pytest.mark.parametrize("n,seed,mu,spins", [(6, 3, 0.5, False), (8, 7, 0.3, True)])
 def test_closed_solutions_examples(n, seed, mu, spins):
     test_closed_solutions_satisfy_the_event_laws.hypothesis.inner_test(n, seed, mu, spins)
+
+
+def test_a_reloaded_run_keeps_its_closed_search(tmp_path):
+    """models.load_run gave run.closed = None even when the run had searched (session 7's
+    closing note): it is saved and reloaded; a file written before keeps it in its summary
+    only, an older one not at all, and both still load."""
+    import json
+
+    from rigidlcp.models.runio import load_run, run_paths, save_run
+
+    system = models.System(models.rectangular(3, 1), mu_pp=0.05, mu_plane=0.1, mu_wall=0.0,
+                           gamma=0.01)
+    off = models.simulate(system, seed=1, closed_search=False)
+    assert off.closed == {"search": False, "searched": 0, "followed": []}
+    assert load_run(save_run(off, tmp_path / "off")).closed == off.closed
+    run = models.simulate(system, seed=1)
+    assert run.closed == {"search": True, "searched": 0, "followed": []}
+    run.closed["followed"] = [3, 7]  # as a run that followed closed solutions records them
+    back = load_run(save_run(run, tmp_path / "run"))
+    assert back.closed == run.closed and back.message == run.message
+
+    def rewrite(drop_summary: bool) -> dict | None:
+        path, _ = run_paths(tmp_path / "run")
+        with np.load(path) as data:
+            arrays = {k: data[k] for k in data.files}
+        meta = json.loads(str(arrays["__meta__"]))
+        del meta["closed"]
+        if drop_summary:
+            del meta["summary"]["closed_search"]
+        arrays["__meta__"] = np.array(json.dumps(meta))
+        old = tmp_path / ("oldest.npz" if drop_summary else "old.npz")
+        np.savez_compressed(old, **arrays)
+        return load_run(old).closed
+
+    assert rewrite(False) == run.closed
+    assert rewrite(True) is None

@@ -83,3 +83,25 @@ def state_lps():
 def q_pattern_lp():
     """pattern_lp, for the tests."""
     return pattern_lp
+
+
+def best_over(L: np.ndarray, sense: int, lps) -> tuple[str, float]:
+    """("optimal", value) / ("unbounded", inf) of min (sense +1) or max (sense -1) of L x over
+    the union of the polyhedra of `lps` (linprog's arguments, e.g. of `pattern_lp` or
+    `state_set_lps`): the best of their LPs; an unbounded one makes the union unbounded."""
+    best = None
+    for lp in lps:
+        r = linprog(sense * L, **lp, method="highs",
+                    options={"primal_feasibility_tolerance": 1e-10})
+        if r.status == 3:
+            return "unbounded", np.inf
+        if r.status == 0 and (best is None or r.fun < best):
+            best = r.fun
+    assert best is not None, "every LP empty: no point to take the best of"
+    return "optimal", sense * best
+
+
+@pytest.fixture(scope="session")
+def lp_union_best():
+    """best_over, for the tests."""
+    return best_over

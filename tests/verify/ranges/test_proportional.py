@@ -39,19 +39,12 @@ def _q_parts(system: models.System):
     return acc, a_rel, a0, np.flatnonzero(system.mu > 0)
 
 
-def _brute(system: models.System, L: np.ndarray, sense: int, pattern_lp) -> tuple[str, float]:
-    """("optimal", value) / ("unbounded", inf) of L x over Q: every a_t sign pattern's LP
-    (conftest's pattern_lp)."""
-    best = None
-    for sig in itertools.product((1, -1, 0), repeat=_q_parts(system)[3].size):
-        r = linprog(sense * L, **pattern_lp(system, np.array(sig)), method="highs",
-                    options={"primal_feasibility_tolerance": 1e-10})
-        if r.status == 3:
-            return "unbounded", np.inf
-        if r.status == 0 and (best is None or r.fun < best):
-            best = r.fun
-    assert best is not None
-    return "optimal", sense * best
+def _brute(system: models.System, L: np.ndarray, sense: int, pattern_lp, best_over
+           ) -> tuple[str, float]:
+    """("optimal", value) / ("unbounded", inf) of L x over Q: the best of every a_t sign
+    pattern's LP (conftest's pattern_lp and best_over)."""
+    signs = itertools.product((1, -1, 0), repeat=_q_parts(system)[3].size)
+    return best_over(L, sense, (pattern_lp(system, np.array(sig)) for sig in signs))
 
 
 def _alpha_rows(system: models.System) -> np.ndarray:
@@ -80,7 +73,8 @@ def _check_witness(system: models.System, w, V_ref: float | None = None) -> None
     (models.rectangular(2, 1), (0.3, 0.1, 0.0), -0.15),
     (models.rectangular(3, 1), (0.05, 0.1, 0.0), 0.02),
 ])
-def test_ranges_equal_brute_force_over_a_t_patterns(q_pattern_lp, lattice, mu, gamma):
+def test_ranges_equal_brute_force_over_a_t_patterns(q_pattern_lp, lp_union_best, lattice, mu,
+                                                     gamma):
     """mu_g and every alpha over all valid steady states (default kinematics: proportional)
     equal the extremes over every a_t sign pattern's LP, written here without velocities."""
     s = models.System(lattice, mu_pp=mu[0], mu_plane=mu[1], mu_wall=mu[2], gamma=gamma)
@@ -91,7 +85,7 @@ def test_ranges_equal_brute_force_over_a_t_patterns(q_pattern_lp, lattice, mu, g
     obs = {"mu_g": g} | {f"alpha[{i}]": row for i, row in enumerate(_alpha_rows(s))}
     for name, L in obs.items():
         for end, sense in ((res.ranges[name].lo, 1), (res.ranges[name].hi, -1)):
-            status, value = _brute(s, L, sense, q_pattern_lp)
+            status, value = _brute(s, L, sense, q_pattern_lp, lp_union_best)
             assert end.status == status, (name, end)
             if status == "optimal":
                 assert end.value == pytest.approx(value, abs=1e-9), name
