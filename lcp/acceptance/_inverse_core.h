@@ -68,45 +68,38 @@ static void inverse_columns_plain(idx m, const double *A, const idx *at, idx j0,
 
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #define INV_HAVE_AVX2 1
+/* Row i of the group, Xi, minus sum_{l = from}^{to - 1} Ai[l] X row l, in that order: the
+ * subtractions of both substitutions (one chain per column, four registers of four). */
+__attribute__((target("avx2"))) static inline void sub_rows_avx2(double *Xi, const double *Ai,
+                                                                const double *X, idx from,
+                                                                idx to)
+{
+    __m256d x0 = _mm256_loadu_pd(Xi), x1 = _mm256_loadu_pd(Xi + 4),
+            x2 = _mm256_loadu_pd(Xi + 8), x3 = _mm256_loadu_pd(Xi + 12);
+    for (idx l = from; l < to; l++) {
+        const __m256d al = _mm256_set1_pd(Ai[l]);
+        const double *Xl = X + FB_COLS * l;
+        x0 = _mm256_sub_pd(x0, _mm256_mul_pd(al, _mm256_loadu_pd(Xl)));
+        x1 = _mm256_sub_pd(x1, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 4)));
+        x2 = _mm256_sub_pd(x2, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 8)));
+        x3 = _mm256_sub_pd(x3, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 12)));
+    }
+    _mm256_storeu_pd(Xi, x0), _mm256_storeu_pd(Xi + 4, x1);
+    _mm256_storeu_pd(Xi + 8, x2), _mm256_storeu_pd(Xi + 12, x3);
+}
+
 __attribute__((target("avx2"))) static void inverse_columns_avx2(idx m, const double *A,
                                                                 const idx *at, idx j0, idx nb,
                                                                 double *X)
 {
     idx p = inverse_start(m, at, j0, nb, X);
-    for (idx i = p + 1; i < m; i++) {
-        const double *Ai = A + i * m;
-        double *Xi = X + FB_COLS * i;
-        __m256d x0 = _mm256_loadu_pd(Xi), x1 = _mm256_loadu_pd(Xi + 4),
-                x2 = _mm256_loadu_pd(Xi + 8), x3 = _mm256_loadu_pd(Xi + 12);
-        for (idx l = p; l < i; l++) {
-            const __m256d al = _mm256_set1_pd(Ai[l]);
-            const double *Xl = X + FB_COLS * l;
-            x0 = _mm256_sub_pd(x0, _mm256_mul_pd(al, _mm256_loadu_pd(Xl)));
-            x1 = _mm256_sub_pd(x1, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 4)));
-            x2 = _mm256_sub_pd(x2, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 8)));
-            x3 = _mm256_sub_pd(x3, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 12)));
-        }
-        _mm256_storeu_pd(Xi, x0), _mm256_storeu_pd(Xi + 4, x1);
-        _mm256_storeu_pd(Xi + 8, x2), _mm256_storeu_pd(Xi + 12, x3);
-    }
+    for (idx i = p + 1; i < m; i++) sub_rows_avx2(X + FB_COLS * i, A + i * m, X, p, i);
     for (idx i = m - 1; i >= 0; i--) {
-        const double *Ai = A + i * m;
         double *Xi = X + FB_COLS * i;
-        __m256d x0 = _mm256_loadu_pd(Xi), x1 = _mm256_loadu_pd(Xi + 4),
-                x2 = _mm256_loadu_pd(Xi + 8), x3 = _mm256_loadu_pd(Xi + 12);
-        for (idx l = i + 1; l < m; l++) {
-            const __m256d al = _mm256_set1_pd(Ai[l]);
-            const double *Xl = X + FB_COLS * l;
-            x0 = _mm256_sub_pd(x0, _mm256_mul_pd(al, _mm256_loadu_pd(Xl)));
-            x1 = _mm256_sub_pd(x1, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 4)));
-            x2 = _mm256_sub_pd(x2, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 8)));
-            x3 = _mm256_sub_pd(x3, _mm256_mul_pd(al, _mm256_loadu_pd(Xl + 12)));
-        }
-        const __m256d d = _mm256_set1_pd(Ai[i]);
-        _mm256_storeu_pd(Xi, _mm256_div_pd(x0, d));
-        _mm256_storeu_pd(Xi + 4, _mm256_div_pd(x1, d));
-        _mm256_storeu_pd(Xi + 8, _mm256_div_pd(x2, d));
-        _mm256_storeu_pd(Xi + 12, _mm256_div_pd(x3, d));
+        sub_rows_avx2(Xi, A + i * m, X, i + 1, m);
+        const __m256d d = _mm256_set1_pd(A[i * m + i]);
+        for (int k = 0; k < FB_COLS; k += 4)
+            _mm256_storeu_pd(Xi + k, _mm256_div_pd(_mm256_loadu_pd(Xi + k), d));
     }
 }
 static int inv_avx2 = -1; /* -1: not decided yet */
