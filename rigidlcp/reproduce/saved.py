@@ -141,9 +141,9 @@ class Cells:
 def open_out(out: str | os.PathLike, options: dict, plan: dict, code: str, *, force: bool,
              resume: bool) -> Cells:
     """Check OUT and return its `Cells`. Without `resume`, OUT must be new or empty (else
-    `OutputExists`, unless `force`, which also drops an earlier run's cells); with it, OUT must
-    be a reproduce folder whose record has the same options and plan (else a ValueError naming
-    the option), and its cells are read (`Cells.load`)."""
+    `OutputExists`, unless `force`, which also drops an earlier reproduce run's cells); with it,
+    OUT must be a reproduce folder whose record has the same options and plan (else a
+    ValueError naming the option), and its cells are read (`Cells.load`)."""
     out = Path(out)
     path = out / MARKER
     record = record_of(options, plan, code)
@@ -159,7 +159,8 @@ def open_out(out: str | os.PathLike, options: dict, plan: dict, code: str, *, fo
                                "the same name are overwritten), or --resume to finish an "
                                "interrupted rigidlcp reproduce run there") from None
         cells = Cells(out)
-        cells.clear()
+        if path.is_file():  # --force over an earlier reproduce run: none of its jobs kept
+            cells.clear()  # (in any other folder, OUT/cells/*.pkl would be the user's files)
         atomic_write_text(path, json.dumps(record, indent=1) + "\n")
         return cells
     if out.exists() and not out.is_dir():

@@ -16,7 +16,15 @@ from hypothesis import strategies as st
 from rigidlcp.cli.main import main
 from rigidlcp.lcp.errors import InvalidFile
 from rigidlcp.reproduce import experiments, report
-from rigidlcp.reproduce.saved import CELLS, MARKER, Cells, cell_name, job_key, read_cell
+from rigidlcp.reproduce.saved import (
+    CELLS,
+    MARKER,
+    Cells,
+    cell_name,
+    job_key,
+    open_out,
+    read_cell,
+)
 
 #: A computing time in report.md / claims.json ("0.1 s", "[0.04 s]"): the one thing that
 #: differs between two uninterrupted runs.
@@ -169,6 +177,15 @@ def test_a_folder_that_is_not_a_reproduce_folder_is_refused(tmp_path, capsys):
     assert str(mine / MARKER) in one_line_error(capsys)
     assert (mine / "notes.txt").read_text() == "a file of the user's\n"
     assert not (tmp_path / "new").exists()
+    # --force writes into it, and drops saved jobs only where a reproduce run left them
+    (mine / MARKER).unlink()
+    (mine / CELLS).mkdir()
+    (mine / CELLS / "data.pkl").write_bytes(b"the user's")
+    p = experiments.plan(quick=True)
+    open_out(mine, {"--quick": True}, p, "abc", force=True, resume=False)
+    assert (mine / CELLS / "data.pkl").read_bytes() == b"the user's"
+    open_out(mine, {"--quick": True}, p, "abc", force=True, resume=False)  # now it is one
+    assert not (mine / CELLS / "data.pkl").exists()
 
 
 def test_a_damaged_saved_job_is_refused_naming_the_file(tmp_path, monkeypatch, capsys,
