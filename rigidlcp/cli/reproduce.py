@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
+from pathlib import Path
 
 
 def register(sub) -> None:
@@ -25,28 +26,44 @@ def register(sub) -> None:
     p.add_argument("--dask", default=None, metavar="tcp://HOST:PORT|local",
                    help="run the jobs on a dask.distributed scheduler or a LocalCluster")
     p.add_argument("--force", action="store_true",
-                   help="write into an --out directory that is not empty")
+                   help="write into an --out directory that is not empty (an earlier run's "
+                   "saved jobs there are dropped)")
+    p.add_argument("--resume", action="store_true",
+                   help="finish an interrupted run in --out: each job is saved in OUT/cells "
+                   "as it finishes, and the saved ones are not run again (same --quick only)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=cmd_reproduce)
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from rigidlcp.lcp.io.files import output_dir
     from rigidlcp.reproduce.claims import evaluate
-    from rigidlcp.reproduce.experiments import SELECT, plan, run_all
+    from rigidlcp.reproduce.experiments import SELECT, plan, provenance, run_all
     from rigidlcp.reproduce.report import figures, write_report
+    from rigidlcp.reproduce.saved import open_out
 
     if args.jobs is not None and args.jobs < 1:
         raise ValueError(f"--jobs must be >= 1, got {args.jobs}")
-    out = output_dir(args.out, force=args.force)  # new or empty, unless --force
+    if args.resume and args.force:
+        raise ValueError("--resume and --force exclude each other")
+    p = plan(quick=args.quick)
+    # new or empty unless --force; with --resume, a reproduce folder of the same options
+    cells = open_out(args.out, {"--quick": bool(args.quick)}, p, provenance(),
+                     force=args.force, resume=args.resume)
+    out = Path(args.out)
     command = "rigidlcp reproduce " + " ".join(
         shlex.quote(a) for a in (sys.argv[2:] if sys.argv[1:2] == ["reproduce"] else
                                  ["--out", str(out)] + (["--quick"] if args.quick else [])))
-    p = plan(quick=args.quick)
-    res = run_all(p, jobs=args.jobs, dask=args.dask, progress=not args.no_progress)
-    claims = evaluate(res)
-    files = figures(res, out)
-    path = write_report(res, claims, out, files, command)
+    try:
+        res = run_all(p, jobs=args.jobs, dask=args.dask, progress=not args.no_progress,
+                      cells=cells)
+        claims = evaluate(res)
+        files = figures(res, out)
+        path = write_report(res, claims, out, files, command)
+    except KeyboardInterrupt:
+        print(f"\nrigidlcp reproduce: interrupted; the {cells.count()} finished jobs are saved "
+              f"in {cells.dir}: rerun the same command with --resume to finish the run",
+              file=sys.stderr)
+        return 130
     print_claims(claims, f"{path} ({res.wall_time:.0f} s on {res.executor})", SELECT)
     errors = [c for c in claims if c.error]
     for c in errors:

@@ -28,7 +28,7 @@ import numpy as np
 
 from rigidlcp import models
 from rigidlcp.models.effective import Effective, legendre
-from rigidlcp.models.executors import default_jobs, iter_map
+from rigidlcp.models.executors import default_jobs
 from rigidlcp.models.sweep import Sweep, parse_grid, run_point
 
 BASE = dict(mu_pp=0.1, mu_plane=0.2, mu_wall=0.0)  # Figs. 7, 9, 10 (and 13, see plan)
@@ -207,53 +207,42 @@ class Results:
 
 
 def run_all(p: dict, jobs: int | None = None, dask: str | None = None,
-            progress: bool = True) -> Results:
-    """Run every job of plan `p` on the executor and collect the results."""
+            progress: bool = True, cells=None) -> Results:
+    """Run every job of plan `p` on the executor and collect the results, in job order.
+    cells (saved.Cells): the jobs saved there (an interrupted run) are not run again, and
+    every job run is saved there as it finishes (`rigidlcp reproduce --resume`)."""
+    from .saved import run_jobs
 
     todo = jobs_of(p)
     where = f"dask {dask}" if dask else f"{jobs or default_jobs()} local process(es)"
     res = Results(p, executor=where)
-    bar = None
-    if progress:
-        from rigidlcp.models.progress import new_bar  # erased at the end: no stale bar
-
-        bar = new_bar(total=len(todo), unit="job", desc="reproduce")
     start = time.perf_counter()
-    try:
-        for k, out in iter_map(Job(p), todo, jobs=jobs, dask=dask):
-            job = todo[k]
-            if job[0] == "sim":
-                res.runs.setdefault(job[1], {})[job[2:]] = out
-            elif job[0] == "point":
-                res.sweeps.setdefault(job[1], []).append(out)
-            elif job[0] == "band":
-                res.bands.setdefault(job[1], []).append(out)
-            else:
-                res.formulas += out
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    outs = run_jobs(Job(p), todo, jobs=jobs, dask=dask, cells=cells,
+                    desc="reproduce" if progress else None)
+    for job, out in zip(todo, outs):
+        if job[0] == "sim":
+            res.runs.setdefault(job[1], {})[job[2:]] = out
+        elif job[0] == "point":
+            res.sweeps.setdefault(job[1], []).append(out)
+        elif job[0] == "band":
+            res.bands.setdefault(job[1], []).append(out)
+        else:
+            res.formulas += out
     for rows in res.sweeps.values():
         rows.sort(key=lambda r: r["gamma"])
     for pts in res.bands.values():
         pts.sort(key=lambda pt: pt.gamma)
     checks = check_jobs(p, res)
-    if bar is not None:
-        bar = new_bar(total=len(checks), unit="job", desc="cross-checks")
-    try:
-        for k, out in iter_map(Job(p), checks, jobs=jobs, dask=dask):
-            kind, label = checks[k][:2]
-            {"cert": res.certificates, "steady-set": res.steady_sets,
-             "patterns": res.patterns}.get(
-                kind, res.ts_checks)[label] = out
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
+    outs = run_jobs(Job(p), checks, jobs=jobs, dask=dask, cells=cells,
+                    desc="cross-checks" if progress else None)
+    for (kind, label, *_), out in zip(checks, outs):
+        {"cert": res.certificates, "steady-set": res.steady_sets,
+         "patterns": res.patterns}.get(kind, res.ts_checks)[label] = out
     res.wall_time = time.perf_counter() - start
+    if cells is not None and cells.kept:
+        code = f", computed by the code at git {cells.other_code}" if cells.other_code else ""
+        res.executor += (f" (resumed: {cells.kept} of {len(todo) + len(checks)} jobs taken from "
+                         f"the earlier run's {cells.dir}{code}; their time is not counted)")
     return res
 
 
