@@ -4,7 +4,8 @@
  * lcp/acceptance/_accuracy_c.c (the binding `assess`) and by lcp/_lemke_c.c (`solve_accept`:
  * the solve and its acceptance in one call), so that both run the same code. The includer
  * defines `idx` (Py_ssize_t) and includes <float.h>, <math.h>, <stdint.h>, <stdlib.h> and
- * <string.h>. assess_one returns 0 (done) or 1 (not handled here: the numpy code decides). */
+ * <string.h>. assess_one returns 0 (done) or 1 (not handled here: the numpy code decides).
+ * The forward bound and the long double residual are _bound_core.h's (included below). */
 #ifndef RIGIDLCP_ACCURACY_CORE_H
 #define RIGIDLCP_ACCURACY_CORE_H
 
@@ -122,130 +123,7 @@ static double backward_error(idx n, const double *M, const double *q, const doub
     return out;
 }
 
-#include "_lu_core.h" /* lu, lu_solve: the LU of the pattern's system */
-#include "_inverse_core.h" /* inverse_columns: K^-1, FB_COLS columns at a time */
-
-/* out_i = init_i + sum_j |K_ij| x_j (x NULL: + |K_ij|; init NULL: from 0), each row summed
- * for j = 0, 1, ..., m - 1 in this order, four rows at once (independent chains: the same
- * numbers as row by row, sooner). out may be init. */
-static void abs_row_sums_by4(idx m, const double *K, const double *x, const double *init,
-                             double *out)
-{
-    idx i = 0;
-    for (; i + 4 <= m; i += 4) {
-        const double *K0 = K + i * m, *K1 = K0 + m, *K2 = K1 + m, *K3 = K2 + m;
-        double s0 = init ? init[i] : 0.0, s1 = init ? init[i + 1] : 0.0,
-               s2 = init ? init[i + 2] : 0.0, s3 = init ? init[i + 3] : 0.0;
-        if (x)
-            for (idx j = 0; j < m; j++) {
-                double xj = x[j];
-                s0 += fabs(K0[j]) * xj;
-                s1 += fabs(K1[j]) * xj;
-                s2 += fabs(K2[j]) * xj;
-                s3 += fabs(K3[j]) * xj;
-            }
-        else
-            for (idx j = 0; j < m; j++) {
-                s0 += fabs(K0[j]);
-                s1 += fabs(K1[j]);
-                s2 += fabs(K2[j]);
-                s3 += fabs(K3[j]);
-            }
-        out[i] = s0, out[i + 1] = s1, out[i + 2] = s2, out[i + 3] = s3;
-    }
-    for (; i < m; i++) {
-        double s = init ? init[i] : 0.0;
-        for (idx j = 0; j < m; j++) s += x ? fabs(K[i * m + j]) * x[j] : fabs(K[i * m + j]);
-        out[i] = s;
-    }
-}
-
-/* r = K y + k, accumulated in long double, rounded to double. */
-static void residual_ld(idx m, const double *K, const double *k, const double *y, double *r)
-{
-    idx i0 = 0;
-    for (; i0 + 4 <= m; i0 += 4) {  /* four rows at once, each summed in its own order */
-        const double *K0 = K + i0 * m, *K1 = K0 + m, *K2 = K1 + m, *K3 = K2 + m;
-        long double s0 = (long double)k[i0], s1 = (long double)k[i0 + 1],
-                    s2 = (long double)k[i0 + 2], s3 = (long double)k[i0 + 3];
-        for (idx j = 0; j < m; j++) {
-            long double yj = (long double)y[j];
-            s0 += (long double)K0[j] * yj;
-            s1 += (long double)K1[j] * yj;
-            s2 += (long double)K2[j] * yj;
-            s3 += (long double)K3[j] * yj;
-        }
-        r[i0] = (double)s0, r[i0 + 1] = (double)s1, r[i0 + 2] = (double)s2,
-        r[i0 + 3] = (double)s3;
-    }
-    for (idx i = i0; i < m; i++) {
-        long double s = (long double)k[i];
-        for (idx j = 0; j < m; j++) s += (long double)K[i * m + j] * (long double)y[j];
-        r[i] = (double)s;
-    }
-}
-
-/* LAPACK's forward error bound at y of the pattern's system K y + k = 0 (A, perm: K's LU;
- * rows_i = sum_j |K_ij|), lcp/acceptance/accuracy.py's `forward_bound`:
- *
- *     ferr = || |K^-1| (|r| + (m + 1) eps_ld (|K| |y| + |k|)) ||_inf / ||y||_inf + eps,
- *
- * r = K y + k in long double. |K^-1| is formed column by column from the LU (column j =
- * K^-1 e_j; m solves, O(m^3)), so the norm is computed, not estimated: Hager's estimator
- * (xGERFS's) is a lower bound of it and came out 20 % below on solved problems (issue 23).
- * Skeel's condition || |K^-1| |K| 1 || comes from the same columns: beyond 1 / (m eps) the
- * system is singular to working precision and 1 is returned (the numpy code's SVD path
- * decides), else 0 with *ferr set. r, g: scratch of m doubles, col of (FB_COLS + 2) m, acc
- * of 2 m. */
-static int forward_bound(idx m, const double *K, const double *A, const idx *perm,
-                         const double *kp, const double *y, const double *rows, double *r,
-                         double *g, double *col, double *acc, double *ferr)
-{
-    const double eps = DBL_EPSILON, eps_ld = LDBL_EPSILON;
-    residual_ld(m, K, kp, y, r);
-    double ymax = 0.0;
-    for (idx i = 0; i < m; i++) {
-        col[i] = fabs(y[i]);
-        ymax = dmax(ymax, col[i]);
-    }
-    for (idx i = 0; i < m; i++) g[i] = fabs(kp[i]);
-    abs_row_sums_by4(m, K, col, g, g);  /* g_i = |k_i| + sum_j |K_ij| |y_j| */
-    for (idx i = 0; i < m; i++) g[i] = fabs(r[i]) + (double)(m + 1) * eps_ld * g[i];
-    double *sk = acc + m;
-    memset(acc, 0, 2 * (size_t)m * sizeof(double));
-    /* acc += |K^-1 e_j| g_j, sk += |K^-1 e_j| rows_j for j = 0, 1, ..., m - 1 in this order;
-     * the columns FB_COLS at a time (_inverse_core.h: X[FB_COLS i + b] = column j0 + b, by
-     * lu_solve's substitutions: the same numbers however grouped) */
-    idx *lab = (idx *)col, *at = lab + m;  /* idx and double: both 8 bytes */
-    double *X = col + 2 * m;
-    unit_rows(m, perm, lab, at);
-    for (idx j0 = 0; j0 < m; j0 += FB_COLS) {
-        idx nb = m - j0 < FB_COLS ? m - j0 : FB_COLS;
-        inverse_columns(m, A, at, j0, nb, X);
-        const double *gj = g + j0, *rj = rows + j0;
-        for (idx i = 0; i < m; i++) {
-            const double *Xi = X + FB_COLS * i;
-            double a = acc[i], s = sk[i];
-            for (idx b = 0; b < nb; b++) {
-                double c = fabs(Xi[b]);
-                a += c * gj[b];
-                s += c * rj[b];
-            }
-            acc[i] = a, sk[i] = s;
-        }
-    }
-    double top = 0.0, skeel = 0.0;
-    int finite = 1;
-    for (idx i = 0; i < m; i++) {
-        finite &= isfinite(acc[i]) && isfinite(sk[i]);
-        top = dmax(top, acc[i]);
-        skeel = dmax(skeel, sk[i]);
-    }
-    if (!finite || skeel * (double)m * eps > 1.0) return 1;
-    *ferr = top / dmax(ymax, 1e-300) + eps;
-    if (!isfinite(*ferr)) *ferr = INFINITY;
-    return 0;
-}
+#include "_bound_core.h" /* forward_bound, residual_ld, abs_row_sums_by4; lu, lu_solve */
 
 static int assess_one(idx n, const double *M, const double *q, const double *z,
                       const int64_t *a, idx m, double *out, double *res)
@@ -399,29 +277,6 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
     res[0] = berr;
     res[1] = ferr;
     res[2] = refined;
-    return code;
-}
-
-/* forward_bound of K y + k = 0 at y, K m x m row-major: the LU here (the same `lu` as
- * assess_one's, so the same number for the same K and y). Returns 0 (*ferr set) or 1
- * (singular to working precision, a zero pivot, or no memory: the numpy code decides). */
-static int bound_one(idx m, const double *K, const double *kp, const double *y, double *ferr)
-{
-    if (m == 0) {
-        *ferr = 0.0;
-        return 0;
-    }
-    size_t nd = (size_t)m * m + (FB_COLS + 7) * (size_t)m;
-    double *buf = (double *)malloc((nd + (size_t)m + 1) * sizeof(double));
-    if (!buf) return 1;
-    double *A = buf, *rows = A + m * m, *r = rows + m, *g = r + m, *col = g + m,
-           *acc = col + (FB_COLS + 2) * m;
-    idx *perm = (idx *)(buf + nd);
-    memcpy(A, K, (size_t)m * m * sizeof(double));
-    abs_row_sums_by4(m, K, NULL, NULL, rows);
-    int code = lu(m, A, perm) < 0 ? 1 : forward_bound(m, K, A, perm, kp, y, rows, r, g, col,
-                                                      acc, ferr);
-    free(buf);
     return code;
 }
 

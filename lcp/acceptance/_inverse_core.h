@@ -1,5 +1,5 @@
 /* Columns of K^-1 from K's LU (lcp/acceptance/_lu_core.h), FB_COLS at a time, for the forward
- * bound of _accuracy_core.h (|K^-1| formed, not estimated). Each column is lu_solve's
+ * bound of _bound_core.h (|K^-1| formed, not estimated). Each column is lu_solve's
  * substitutions on P e_j -- the L one begun at the first nonzero of P e_j (the entries above it
  * stay +0, as they would there), then U's from the last row up, each row's subtractions in the
  * order j = i + 1, ..., m - 1 and the division last -- so every entry is the same number

@@ -65,7 +65,7 @@ _EPS_LD = float(np.finfo(np.longdouble).eps)
 FERR_TOL = 1e-6
 #: Refinement steps at most (each one LU solve with an extended-precision residual).
 STEPS = 5
-#: Up to this size the bound runs in C (lcp/acceptance/_accuracy_core.h: forward_bound).
+#: Up to this size the bound runs in C (lcp/acceptance/_bound_core.h: forward_bound).
 _EXPLICIT = 400
 
 

@@ -1,4 +1,4 @@
-"""The C forward bound (lcp/acceptance/_accuracy_core.h: forward_bound, through
+"""The C forward bound (lcp/acceptance/_bound_core.h: forward_bound, through
 `_accuracy_c.bound`) against a transcription of its definition in plain Python floats, bit for
 bit: the LU with partial pivoting, the long-double residual, g, and |K^-1| formed column by
 column by the substitutions -- each column on its own, its L solve begun at its own unit entry.

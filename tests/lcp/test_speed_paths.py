@@ -212,7 +212,7 @@ def test_c_assess_agrees_with_the_numpy_assess(n):
 def test_c_assess_singularity_test_across_conditioning(k):
     """The C `assess` declines (code 1: the numpy code's SVD path decides) a pattern system
     singular to working precision -- Skeel's condition || |K^-1| |K| 1 || beyond 1 / (m eps) --
-    and handles a well-conditioned one (lcp/acceptance/_accuracy_core.h: forward_bound, from
+    and handles a well-conditioned one (lcp/acceptance/_bound_core.h: forward_bound, from
     |K^-1|'s columns). Conditions 1 .. 1e18, away from the threshold by a factor 100 either way
     (near it the computed condition, rounded, may
     fall on either side)."""

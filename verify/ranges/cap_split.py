@@ -43,7 +43,7 @@ from .bounds import rotation_cap
 from .disk_split import _load, disk_split_bound, witness_of
 from .milp import certified_result
 from .observables import alpha_rows
-from .result import OPTIMAL, TIME_LIMIT
+from .result import OPTIMAL, TIME_LIMIT, value_text, witness_tolerance
 from .steady import Formulation, _equalities, velocity_box
 
 #: At most this many cap contacts (2^n linear programs).
@@ -195,8 +195,10 @@ def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],
                 wit = None if dres.candidate is None else witness_of(form, dres.candidate)
                 if wit is not None and sense * float(L @ np.r_[wit.R, wit.S]) < (
                         np.inf if end.best is None else sense * end.best):
-                    end.best, end.witness = float(L @ np.r_[wit.R, wit.S]), wit
+                    x = np.r_[wit.R, wit.S]
+                    end.best, end.witness = float(L @ x), wit
                     end.residual = wit.residual
+                    end.tol = witness_tolerance(form.system, L, x, wit.residual)
                 if dres.bound > bound:
                     how, bound = (f"the case split on the disks' cap states ({dres.cases} "
                                   f"certified LPs, {dres.empty} empty, {dres.open} left)"), \
@@ -210,5 +212,6 @@ def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],
                 end.status, end.value = OPTIMAL, end.best
                 end.note = f"{how}; attained by the witness"
             else:
-                met = "" if end.best is None else f"; best met {end.best:.10g}"
+                # as the ranges table prints it: no digit below what it is known to
+                met = "" if end.best is None else f"; best met {value_text(end.best, end.tol)}"
                 end.note = f"{'min' if sense > 0 else 'max'} not decided: {how}{met}"

@@ -11,8 +11,12 @@ solution of the event", "... with R <= U" when a force bound is not proved).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from rigidlcp.models.system import System
 
 OPTIMAL, UNBOUNDED, TIME_LIMIT, INFEASIBLE = "optimal", "unbounded", "time limit", "infeasible"
 
@@ -113,6 +117,14 @@ def end_tolerance(L: np.ndarray, x: np.ndarray, residual: float = 0.0,
                 if k else 0.0)
     law = residual * f_scale * float(np.abs(L).sum()) if residual > 0 else 0.0
     return rounding + law
+
+
+def witness_tolerance(system: System, L: np.ndarray, x: np.ndarray, residual: float) -> float:
+    """end_tolerance of a witness x = [R; S] with its steady_check residual, at the force
+    scale of verify.steadiness.from_velocities."""
+    f_scale = max(float(np.max(np.abs(x), initial=0.0)),
+                  float(system.mass) * max(system.g, abs(system.gamma), 1e-12))
+    return end_tolerance(L, x, residual, f_scale)
 
 
 def value_text(x: float, tol: float = float("nan"), digits: int = 10) -> str:

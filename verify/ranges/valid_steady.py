@@ -35,8 +35,8 @@ from .result import (
     End,
     Range,
     end_cell,
-    end_tolerance,
     width_text,
+    witness_tolerance,
 )
 from .seeds import seed_starts, seed_states
 from .steady import (
@@ -237,14 +237,6 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                         time.perf_counter() - t0, run_values, own)
 
 
-def _tolerance(system: System, L: np.ndarray, x: np.ndarray, residual: float) -> float:
-    """result.end_tolerance of a witness x = [R; S] with its steady_check residual, at the
-    force scale of verify.steadiness.from_velocities."""
-    f_scale = max(float(np.max(np.abs(x), initial=0.0)),
-                  float(system.mass) * max(system.g, abs(system.gamma), 1e-12))
-    return end_tolerance(L, x, residual, f_scale)
-
-
 def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     """An end over the valid steady states with the run's contact states (its velocities)."""
     R, S, omega, V, s = start
@@ -255,7 +247,7 @@ def _own_end(form: Formulation, start: tuple, L: np.ndarray, sense: int) -> End:
     v_scale = max(float(np.sqrt(system.g * system.lattice.radius)), abs(V))
     wit = make_witness(system, omega, V, x[:system.c], x[system.c:], form.dyn, v_scale)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
-              tol=_tolerance(system, L, x, wit.residual))
+              tol=witness_tolerance(system, L, x, wit.residual))
     if wit.residual > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"
@@ -318,7 +310,7 @@ def _end(form: Formulation, model: MilpModel, L: np.ndarray, sense: int, time_li
     wit = make_witness(form.system, vel[0], vel[1], x[:c], x[c:], form.dyn, v_scale)
     end = End(OPTIMAL, float(L @ x), wit, residual=wit.residual,
               seconds=time.perf_counter() - t0, note=how,
-              tol=_tolerance(form.system, L, x, wit.residual))
+              tol=witness_tolerance(form.system, L, x, wit.residual))
     if wit.residual > WITNESS_TOL:
         end.status, end.value = "failed", None
         end.note = f"witness rejected by the independent check (residual {wit.residual:.1e})"

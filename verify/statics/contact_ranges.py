@@ -36,7 +36,7 @@ from .hull import ZERO
 from .model import DualForceLP, ForceLP, StaticProblem
 from .range_ends import Vertices, Witnesses, at_bound, ranges_of, spatial_order
 
-__all__ = ["Ranges", "Vertices", "Witnesses", "at_bound", "contact_ranges", "lp_count",
+__all__ = ["Ranges", "Vertices", "Witnesses", "at_bound", "contact_ranges", "end_count",
            "ranges_of", "sliding_of"]
 
 
@@ -58,8 +58,11 @@ class Ranges:
     retried: int = 0
 
 
-def lp_count(prob: StaticProblem, implicit: list[str]) -> int:
-    """The most range LPs `contact_ranges` may need (the progress total)."""
+def end_count(prob: StaticProblem, implicit: list[str]) -> int:
+    """The range ends `contact_ranges` settles, the progress total: each end counted once
+    whether an LP, a kept basis or a bound attained at a checked point settled it
+    (verify.statics.range_ends), so the count reaches it exactly; the LPs run are fewer
+    (Ranges.lps, which also counts the sliding LPs)."""
     todo = [a for a in range(prob.c) if implicit[a] != "R=0"]
     return 2 * len(todo) + 2 * sum(1 for a in todo if prob.mu[a] > 0 and not implicit[a])
 
@@ -125,10 +128,10 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
                    jobs: int = 1) -> Ranges:
     """The ranges of every R and S and the sliding contacts (module docstring). witness: a
     checked point of P; lp: a ForceLP of P (built here if None; unused when jobs > 1);
-    progress(done, total, "ranges") as the ends are settled."""
+    progress(done, total, "ranges") as the ends are settled (by any means: `end_count`)."""
     check_jobs(jobs)
     c = prob.c
-    total, done = lp_count(prob, implicit), 0
+    total, done = end_count(prob, implicit), 0
 
     def step(ends: int) -> None:
         nonlocal done

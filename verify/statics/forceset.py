@@ -162,7 +162,8 @@ def analyse(system: models.System, ranges: bool = True,
             progress: Callable[[int, int, str], None] | None = None,
             jobs: int = 1) -> ForceSet:
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
-    progress(done, total, stage): called as the LPs of the ranges are solved; jobs: worker
+    progress(done, total, stage): called as the range ends are settled (by an LP, a kept basis
+    or a bound: verify.statics.contact_ranges.end_count, the total); jobs: worker
     processes for the range LPs (verify.statics.contact_ranges; 1: in this process)."""
     check_jobs(jobs)  # before any LP
     prob = StaticProblem(system)

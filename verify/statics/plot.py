@@ -38,8 +38,8 @@ def plot_forceset(fs: ForceSet, out: str | Path, max_width: float = 5.0) -> Path
     colour = np.where(np.isinf(spread), top, spread)  # NaN (an unknown end): grey
     widths = max_width * R / max(float(R.max(initial=0.0)), 1e-300)
     segs = LineCollection(np.stack([a, b], axis=1), linewidths=np.maximum(widths, 0.2),
-                          cmap="viridis", linestyles=[":" if not f else "-" for f in finite])
-    segs.cmap.set_bad("0.6")
+                          cmap=matplotlib.colormaps["viridis"].with_extremes(bad="0.6"),
+                          linestyles=[":" if not f else "-" for f in finite])
     segs.set_array(np.ma.masked_invalid(colour))
     segs.set_clim(0.0, top)
     ax.add_collection(segs)
