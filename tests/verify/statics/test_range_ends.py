@@ -8,13 +8,13 @@ with its cone rows, no warm start, no filter, no kept basis).
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog
 
 from rigidlcp import models
 from rigidlcp.models.deposition import deposit
-from rigidlcp.verify.statics import ends, range_ends
+from rigidlcp.verify.statics import ends, exact_lp, range_ends
 from rigidlcp.verify.statics.forceset import analyse
 from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 from rigidlcp.verify.statics.range_ends import Vertices, Witnesses, ranges_of
@@ -48,8 +48,34 @@ def _close(got: float, want: float, scale: float) -> bool:
     return abs(got - want) <= 1e-7 * max(scale, abs(want))
 
 
+def _agrees(prob: StaticProblem, k: int, sgn: float, got: float, scale: float) -> bool:
+    """got is end (k, sgn)'s value: linprog's answer, and where linprog disagrees or fails,
+    the LP solved exactly in rationals (exact_lp, its size limit lifted: the piles here are
+    small), whose optimum is checked by its own certificate. linprog at its default
+    tolerances can stop short: on n 21, seed 0, mu 1.0625 it gave 0.8755362781 for a max
+    whose exact value is 0.8760671508556245 (= the end reported)."""
+    want = _own_lp(prob, k, sgn)
+    if want is not None and _close(got, want, scale):
+        return True
+    limit = exact_lp.MAX_ROWS
+    exact_lp.MAX_ROWS = 10**6
+    try:
+        cost = np.zeros(prob.n)
+        cost[k] = sgn
+        ex = exact_lp.solve(prob, cost)
+    finally:
+        exact_lp.MAX_ROWS = limit
+    if ex is None:
+        return want is None
+    if ex.status == "unbounded":
+        return got == -sgn * np.inf
+    return ex.status == "optimal" and abs(got - float(ex.lam[k])) <= 1e-9 * max(scale, abs(got))
+
+
 @settings(max_examples=10)
 @given(n=st.integers(3, 24), seed=st.integers(0, 10**4), mu=st.floats(0.05, 1.2))
+@example(n=21, seed=0, mu=1.0625)  # linprog stops short of two maxima (_agrees)
+@example(n=18, seed=0, mu=1.0625)  # linprog 1.8e-7 short of a maximum
 def test_ends_settled_without_their_lp_are_their_lps_answers(n, seed, mu):
     """Over seeded piles: every end settled at a kept basis (`at_basis`) is a point of P
     (balance backward error and laws <= 1e-8) whose value is that end's own LP answer; every
@@ -82,14 +108,12 @@ def test_ends_settled_without_their_lp_are_their_lps_answers(n, seed, mu):
                                          initial=0.0)))
     for k, sgn, lam in kept:
         assert prob.admissible(lam)
-        want = _own_lp(prob, k, sgn)
         got = (lo if sgn > 0 else hi)[k]
         assert got == lam[k]
-        assert want is None or _close(got, want, scale), (k, sgn, got, want)
+        assert _agrees(prob, k, sgn, float(got), scale), (k, sgn, got)
     for k in range(prob.n):
         for sgn, ends_ in ((1.0, lo), (-1.0, hi)):
-            want = _own_lp(prob, k, sgn)
-            assert want is None or _close(float(ends_[k]), want, scale), (k, sgn, ends_[k], want)
+            assert _agrees(prob, k, sgn, float(ends_[k]), scale), (k, sgn, ends_[k])
 
 
 def test_a_kept_basis_settles_only_the_ends_it_is_optimal_for():
