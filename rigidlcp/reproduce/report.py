@@ -142,8 +142,11 @@ def band_figures(res: Results, name: str, out: Path, cite: bool) -> tuple[Path, 
     sel = f"this toolkit's selection ({SELECT})"
     fig, ax = plt.subplots(figsize=(6.0, 4.0))
     g = np.array([pt.gamma for pt in ok])
+    # `where` given: matplotlib 3.6.0 (our lowest) with newer numpy fails without it
+    # (IndexError in cbook.contiguous_regions on a 0-d mask)
     ax.fill_between(g, [pt.every.lo.value for pt in ok], [pt.every.hi.value for pt in ok],
-                    color="C0", alpha=0.25, lw=0, label="all valid steady states (band)")
+                    where=np.ones(len(g), dtype=bool), color="C0", alpha=0.25, lw=0,
+                    label="all valid steady states (band)")
     ax.plot(eff.gamma, eff.mu_g, "o-", ms=3, color="C1", label=sel)
     for x in bad:
         ax.axvline(x, color="red", lw=0.6, ls=":")
@@ -164,7 +167,8 @@ def band_figures(res: Results, name: str, out: Path, cite: bool) -> tuple[Path, 
         if curves:
             stack = np.vstack(curves + [getattr(eff, q)])
             ax.fill_between(eff.gamma, stack.min(axis=0), stack.max(axis=0), color="C0",
-                            alpha=0.2, lw=0, label="between the band's end curves")
+                            where=np.ones(stack.shape[1], dtype=bool), alpha=0.2, lw=0,
+                            label="between the band's end curves")
         for (key, e), style in zip(fam.items(), ("--", ":")):
             if e is not None:
                 ax.plot(e.gamma, getattr(e, q), style, color="C0", lw=1.2,
