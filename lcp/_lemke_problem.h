@@ -196,7 +196,7 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
 
 /* Scratch of one problem of size n: T, the int64 bookkeeping and the Lemke buffers, in one
  * block: `stack` (of STACK_WORDS 8-byte words, 64-byte aligned) when it is large enough, else
- * malloc'd and aligned here. From n = 16 on, T's columns are padded to a multiple of 4
+ * malloc'd and aligned here. From n = 8 on, T's columns are padded to a multiple of 4
  * doubles (ld) and start 32-byte aligned, as do the pivot column `col` and V: the vectorized update then never
  * splits a load across cache lines, and its speed no longer depends on where malloc put the
  * block (a 25-40 % difference between processes at n >= 100 before). The numbers are the
@@ -224,7 +224,7 @@ static size_t round_up(size_t words) { return (words + ALIGN_WORDS - 1) / ALIGN_
 static int work_init(Work *w, idx n, double tol, uint64_t *stack)
 {
     Lemke *L = &w->L;
-    const idx ld = n < 16 ? n : (n + 3) / 4 * 4; /* short columns: no padding (no gain) */
+    const idx ld = n < 8 ? n : (n + 3) / 4 * 4; /* below 8: no padding (no gain) */
     /* T ld(n + 2), V n n, alpha/theta/col ld each and row n + 2, ints 6n + 3, rows 4n, bz n
      * bytes: all 8-byte words, each part starting on a 64-byte boundary */
     size_t nT = round_up((size_t)ld * (n + 2)), nV = round_up((size_t)n * n),

@@ -10,7 +10,7 @@
 typedef struct {
     idx n;
     idx ld; /* column stride of T: n for a dictionary from Python; in the work array of
-             * solve_eq / solve_batch n rounded up to a multiple of 4 from n = 16 on (columns
+             * solve_eq / solve_batch n rounded up to a multiple of 4 from n = 8 on (columns
              * 32-byte aligned) */
     double *T;
     int64_t *basic, *nonbasic, *row_of, *slot_of;
@@ -98,6 +98,30 @@ __attribute__((target("avx2"))) static void update_avx2(double *T, const double 
                                                        const double *row, idx n, idx ld,
                                                        idx m)
 {
+    if (ld % 4 == 0) {
+        /* columns of a multiple of 4 doubles (padded by work_init from n = 8 on): the whole
+         * column, 8 entries a step, no scalar remainder. col's padding entries are 0 (pivot
+         * copies the padded column, whose padding rows work_init zeroed), so the padding rows
+         * of T only ever get 0 * rc added: never read, they change nothing. */
+        for (idx c = 0; c < m; c++) {
+            double rc = row[c];
+            if (rc == 0.0) continue;
+            double *Tc = T + ld * c;
+            const __m256d v = _mm256_set1_pd(rc);
+            idx i = 0;
+            for (; i + 8 <= ld; i += 8) {
+                __m256d a = _mm256_loadu_pd(Tc + i), b = _mm256_loadu_pd(Tc + i + 4);
+                a = _mm256_add_pd(a, _mm256_mul_pd(_mm256_loadu_pd(col + i), v));
+                b = _mm256_add_pd(b, _mm256_mul_pd(_mm256_loadu_pd(col + i + 4), v));
+                _mm256_storeu_pd(Tc + i, a);
+                _mm256_storeu_pd(Tc + i + 4, b);
+            }
+            if (i < ld)
+                _mm256_storeu_pd(Tc + i, _mm256_add_pd(_mm256_loadu_pd(Tc + i),
+                                                       _mm256_mul_pd(_mm256_loadu_pd(col + i), v)));
+        }
+        return;
+    }
     for (idx c = 0; c < m; c++) {
         double rc = row[c];
         if (rc == 0.0) continue;
@@ -125,7 +149,7 @@ static int64_t pivot(Lemke *L, idx r, idx s)
     double *T = L->T, *row = L->row, *col = L->col;
     double *Ts = T + ld * s;
     double p = Ts[r];
-    memcpy(col, Ts, n * sizeof(double));
+    memcpy(col, Ts, ld * sizeof(double)); /* with the padding rows (0) when ld > n */
     double mult = -1.0 / p;
     for (idx c = 0; c < m; c++) row[c] = T[r + ld * c] * mult;
     row[s] = 1.0 / p;

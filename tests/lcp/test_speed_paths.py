@@ -1,7 +1,7 @@
 """The speed changes of issue 23 change no answer and no refusal.
 
 * The C kernel's work array of `solve_eq` / `solve_batch` (lcp/_lemke_c.c: T's columns padded
-  to a multiple of 4 doubles from n = 16, the block 64-byte aligned, on the stack up to n = 28
+  to a multiple of 4 doubles from n = 8, the block 64-byte aligned, on the stack up to n = 28
   and malloc'd above) gives the z, pivots, basis and status of the general path, whose
   dictionary comes from Python with no padding (`_lemke_kernel.run`), bit for bit: on sizes
   that are and are not multiples of 4, on both sides of the stack/heap boundary, on random,
@@ -28,9 +28,9 @@ from .test_fast_lemke import assert_same_answer, same
 
 compiled = pytest.mark.skipif(not kernel.enabled(), reason="the C extension is not built or is off")
 
-#: Around the padding threshold (n = 16) and the stack/heap boundary of the work block
-#: (n = 28/29), not multiples of 4, and larger.
-SIZES = (3, 13, 15, 16, 17, 23, 27, 28, 29, 31, 33, 50, 61, 64, 65)
+#: Around the padding threshold (n = 8; n = 16 before), the stack/heap boundary of the work
+#: block (n = 28/29), not multiples of 4, and larger.
+SIZES = (3, 7, 8, 9, 10, 12, 13, 15, 16, 17, 23, 27, 28, 29, 31, 33, 50, 61, 64, 65)
 
 
 def _problem(n: int, kind: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
