@@ -9,7 +9,10 @@ DIR = /tmp/main-build/lcp). Both builds solve the same problems -- random, badly
 nonsymmetric, rank-deficient, integer-degenerate, all-ties; n from 1 to 203 -- and the script
 counts the answers that differ in any bit: `solve_eq` (code, pivots, z, basis, bounds, with and
 without Ruiz factors), `solve_batch` (z, basic set, codes, pivots) and `assess` (code, berr,
-ferr, refined, the polished z) on Lemke's answers, on perturbed ones and on wrong bases. Then the
+ferr, refined, the polished z) on Lemke's answers, on perturbed ones and on wrong bases. Answers
+that differ in `assess`'s forward bound only (a build that reports the comparison-matrix bound
+where it certifies, issue 23) are counted apart: that bound must be no smaller than the other
+build's and give the same verdict at FERR_TOL and at bench's stated accuracies. Then the
 time per call of `solve_eq` and `assess` for each build on M = A A^T + 0.1 I (best of 5, runs
 interleaved).
 """
@@ -26,8 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
+from rigidlcp.bench.report import ACCURACIES
 from rigidlcp.lcp import _lemke_c
 from rigidlcp.lcp.acceptance import _accuracy_c
+from rigidlcp.lcp.acceptance.accuracy import FERR_TOL
 from rigidlcp.lcp.acceptance.scaling import ruiz
 
 
@@ -61,9 +66,12 @@ def problems(rng: np.random.Generator):
             yield n, np.ascontiguousarray(M), np.ascontiguousarray(q)
 
 
-def compare(ref_lemke, ref_acc) -> tuple[int, int]:
+def compare(ref_lemke, ref_acc) -> tuple[int, int, list[tuple[float, float]]]:
+    """(answers compared, answers differing in any bit but `assess`'s forward bound, the
+    (other, this) forward bounds of the answers that differ in that bound only)."""
     rng = np.random.default_rng(1)
     count = differ = 0
+    ferr: list[tuple[float, float]] = []
     for n, M, q in problems(rng):
         eq = ruiz(M, q)
         for r, c in ((None, None), (eq.r, eq.c)):
@@ -95,11 +103,30 @@ def compare(ref_lemke, ref_acc) -> tuple[int, int]:
                 r1 = ref_acc.assess(M, q, zz, basis, o1)
                 r2 = _accuracy_c.assess(M, q, zz, basis, o2)
                 same = (r1[0] == r2[0] and r1[3] == r2[3]
-                        and np.array(r1[1:3]).tobytes() == np.array(r2[1:3]).tobytes()
+                        and np.float64(r1[1]).tobytes() == np.float64(r2[1]).tobytes()
                         and (r1[0] != 0 or o1.tobytes() == o2.tobytes()))
                 count += 1
                 differ += not same
-    return count, differ
+                if same and np.float64(r1[2]).tobytes() != np.float64(r2[2]).tobytes():
+                    ferr.append((r1[2], r2[2]))
+    return count, differ, ferr
+
+
+def ferr_report(ferr: list[tuple[float, float]]) -> bool:
+    """Print how the forward bounds that differ differ (this build's against the other's):
+    each must be no smaller and give the same verdict at FERR_TOL and at every accuracy bench
+    states. Returns whether they all do."""
+    if not ferr:
+        return True
+    ref, new = np.array(ferr).T
+    smaller = int(np.sum(new < ref))
+    verdicts = int(sum(np.sum((ref <= a) != (new <= a)) for a in (FERR_TOL, *ACCURACIES)))
+    ratio = new / ref
+    print(f"  of which {len(ferr)} differ in the forward bound only: {smaller} smaller than the "
+          f"other build's, {verdicts} verdicts changed (at {FERR_TOL:g}, "
+          f"{', '.join(f'{a:g}' for a in ACCURACIES)}); this / other {ratio.min():.3g} to "
+          f"{ratio.max():.3g} (median {np.median(ratio):.3g}), largest bound {new.max():.3g}")
+    return smaller == 0 and verdicts == 0
 
 
 def timing(sizes, ref_lemke, ref_acc) -> None:
@@ -136,10 +163,12 @@ def main(argv: list[str] | None = None) -> int:
     ref_lemke, ref_acc = load(args.ref, "_lemke_c"), load(args.ref, "_accuracy_c")
     print(f"this build: {Path(_lemke_c.__file__).parent}; other build: {args.ref}; load "
           f"average {os.getloadavg()[0]:.2f}")
-    count, differ = compare(ref_lemke, ref_acc)
-    print(f"{count} answers compared (solve_eq, solve_batch, assess): {differ} differ in a bit")
+    count, differ, ferr = compare(ref_lemke, ref_acc)
+    print(f"{count} answers compared (solve_eq, solve_batch, assess): "
+          f"{differ + len(ferr)} differ in a bit")
+    bounds_ok = ferr_report(ferr)
     timing([int(s) for s in args.sizes.split(",")], ref_lemke, ref_acc)
-    return 1 if differ else 0
+    return 1 if differ or not bounds_ok else 0
 
 
 if __name__ == "__main__":

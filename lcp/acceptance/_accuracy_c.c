@@ -71,12 +71,14 @@ static PyObject *py_assess(PyObject *self, PyObject *args)
     return Py_BuildValue("iddi", code, res[0], res[1], (int)res[2]);
 }
 
-/* bound(K, k, y) -> (code, ferr): accuracy.py's forward_bound (K m x m, k, y m; float64,
- * C-contiguous); code 1: singular to working precision or bad buffers (numpy decides). */
+/* bound(K, k, y, exact=0) -> (code, ferr): accuracy.py's forward_bound (K m x m, k, y m;
+ * float64, C-contiguous); code 1: singular to working precision or bad buffers (numpy
+ * decides). exact = 1: |K^-1| formed whatever the comparison bound says (for tests). */
 static PyObject *py_bound(PyObject *self, PyObject *args)
 {
     PyObject *oK, *ok, *oy;
-    if (!PyArg_ParseTuple(args, "OOO", &oK, &ok, &oy)) return NULL;
+    int exact = 0;
+    if (!PyArg_ParseTuple(args, "OOO|p", &oK, &ok, &oy, &exact)) return NULL;
     Py_buffer b[3];
     PyObject *o[3] = {oK, ok, oy};
     int got = 0;
@@ -95,7 +97,7 @@ static PyObject *py_bound(PyObject *self, PyObject *args)
         }
         if (fine)
             code = bound_one(m, (const double *)b[0].buf, (const double *)b[1].buf,
-                             (const double *)b[2].buf, &ferr);
+                             (const double *)b[2].buf, exact, &ferr);
     }
     for (int i = 0; i < got; i++) PyBuffer_Release(&b[i]);
     return Py_BuildValue("id", code, ferr);
@@ -103,8 +105,9 @@ static PyObject *py_bound(PyObject *self, PyObject *args)
 
 static PyMethodDef methods[] = {
     {"bound", py_bound, METH_VARARGS,
-     "bound(K, k, y) -> (code, ferr): lcp/acceptance/accuracy.py's forward_bound at y "
-     "(code 1: singular to working precision or not handled, run the numpy code)."},
+     "bound(K, k, y, exact=False) -> (code, ferr): lcp/acceptance/accuracy.py's forward_bound "
+     "at y (code 1: singular to working precision or not handled, run the numpy code); exact: "
+     "|K^-1| formed even where the comparison-matrix bound certifies."},
     {"assess", py_assess, METH_VARARGS,
      "assess(M, q, z, basis, out) -> (code, berr, ferr, refined): lcp/accuracy.py's assess "
      "of an LCP answer on its basis (code 1: not handled, run the numpy code)."},

@@ -226,7 +226,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
                 if (size <= eps * ymax) break;
             }
             /* the bound at the refined y (exact norm of |K^-1| g; Skeel's singularity test) */
-            if (forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, &ferr)) code = 1;
+            if (forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, 0, &ferr)) code = 1;
         }
     }
     if (!code) {
@@ -251,7 +251,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
                     y[i] = 0.0;
                     clipped = 1;
                 }
-            if (clipped && forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, &ferr))
+            if (clipped && forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc, 0, &ferr))
                 ferr = INFINITY;  /* not finite (the same K passed the test above) */
         } else {
             /* z as given: the bound at z_a itself (lcp/acceptance/accuracy.py's `assess`),
@@ -262,7 +262,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             memcpy(d, y, (size_t)m * sizeof(double));  /* the refined y */
             for (idx i = 0; i < m; i++) y[i] = z[a[i]];
             if (!isfinite(ferr) || forward_bound(m, K, A, perm, kp, y, rows, r, g, col, acc,
-                                                 &at_z)) {
+                                                 0, &at_z)) {
                 at_z = ferr;  /* not finite: |z_a - y| + the bound of y, as numpy */
                 for (idx i = 0; i < m; i++) gap = dmax(gap, fabs(z[a[i]] - d[i]));
             }

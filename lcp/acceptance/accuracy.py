@@ -35,7 +35,11 @@ the pattern's system (y - y* = K_PP^-1 r exactly). |K_PP^-1| is formed column by
 LU, never estimated (Hager's estimator, which LAPACK's xGERFS uses, is a lower bound of the norm:
 0.46x, and 2e-16x on a rank-deficient pattern, on cases tests/lcp/test_forward_bound.py and
 docs/performance.md record); one C function computes it for the C acceptance and for this code,
-so lcp.solve and verify.certify report the same number for the same answer and pattern. A
+so lcp.solve and verify.certify report the same number for the same answer and pattern. That
+function first bounds |K_PP^-1| g from above in O(m^2) by the LU's comparison matrices,
+C(U)^-1 C(L)^-1 P g, and reports that larger bound instead when it is at most 1e-13
+(_bound_core.h's CHEAP_FERR; no verdict at FERR_TOL or at bench's accuracies depends on it;
+tests/lcp/test_comparison_bound.py); without the C extension |K_PP^-1| is always formed. A
 singular K_PP (a continuum of solutions) uses its pseudo-inverse at the numerical rank (y's
 distance to the refined point added), and an inconsistent one has ferr = inf.
 
@@ -142,7 +146,8 @@ def _residual_ld(Kp: np.ndarray, kp: np.ndarray, y: np.ndarray) -> np.ndarray:
 def forward_bound(Kp: np.ndarray, kp: np.ndarray, y: np.ndarray) -> float | None:
     """LAPACK's forward error bound at y of K_PP y = -k_P (module doc), with |K_PP^-1| formed
     from an LU (not estimated: Hager's estimator is a lower bound of the norm, 20 % below on
-    solved problems, issue 23). None when K_PP is singular to working precision (Skeel's
+    solved problems, issue 23), or the LU's comparison-matrix bound where that is at most 1e-13
+    (C only: module doc). None when K_PP is singular to working precision (Skeel's
     || |K^-1| |K| 1 ||_inf beyond 1 / (m eps)). In C when the extension is built (the same
     function the C acceptance calls: lcp.solve and verify.certify compute one number), else
     numpy with the same formula."""
