@@ -285,7 +285,7 @@ static int accept_one(idx n, const double *M, const double *q, const double *zs,
     res[0] = res[1] = res[2] = 0.0;
     int code = -1;
     if ((double)n * bound[0] * (bound[2] + 1.0) + bound[1] < SAFE)
-        code = m <= MAX_M ? assess_one(n, M, q, zs, basis, m, out, res) : 1;
+        code = m <= MAX_M ? assess_one(n, M, q, zs, basis, m, bound[0], out, res) : 1;
     if (code) memcpy(out, zs, (size_t)n * sizeof(double));
     return code;
 }

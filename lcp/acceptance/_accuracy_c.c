@@ -60,7 +60,7 @@ static PyObject *py_assess(PyObject *self, PyObject *args)
         }
         if (ok && n >= 1)
             code = assess_one(n, (const double *)vM.buf, (const double *)vq.buf,
-                              (const double *)vz.buf, (const int64_t *)va.buf, m,
+                              (const double *)vz.buf, (const int64_t *)va.buf, m, -1.0,
                               (double *)vo.buf, res);
     }
     if (got >= 5) PyBuffer_Release(&vo);

@@ -71,12 +71,21 @@ static int abs_max_finite(const double *a, idx n, double *mx)
     return finite;
 }
 
-/* berr of lcp/accuracy.py (nu = 0). */
+/* berr of lcp/accuracy.py (nu = 0). M finite (assess_one returns before otherwise). The row
+ * sums run over the columns j with x_j != 0 only (nz: scratch of n), in increasing j as
+ * before: a term M_ij x_j with x_j = 0 is a zero, which leaves a sum unchanged but for the sign
+ * of a zero sum, and no use of a row's sum sees that sign (|min(v, w)|, and s is a sum of
+ * nonnegative terms). An answer on a pattern of m unknowns costs O(n m), not O(n^2). */
 static double backward_error(idx n, const double *M, const double *q, const double *x,
-                             double mmax, double qmax, double floor)
+                             double mmax, double qmax, double floor, idx *nz)
 {
     double xmax = 0.0;
-    for (idx i = 0; i < n; i++) xmax = dmax(xmax, fabs(x[i]));
+    idx nnz = 0;
+    for (idx i = 0; i < n; i++) {
+        xmax = dmax(xmax, fabs(x[i]));
+        nz[nnz] = i;
+        nnz += x[i] != 0.0; /* a NaN counts: != is true */
+    }
     double vs = dmax(xmax, mmax > 0 ? qmax / mmax : 0.0);
     if (!(vs > 0)) vs = 1.0;
     double out = 0.0;
@@ -89,7 +98,8 @@ static double backward_error(idx n, const double *M, const double *q, const doub
             const double *r1 = row + n, *r2 = r1 + n, *r3 = r2 + n;
             double a0 = q[i], a1 = q[i + 1], a2 = q[i + 2], a3 = q[i + 3];
             double b0 = fabs(q[i]), b1 = fabs(q[i + 1]), b2 = fabs(q[i + 2]), b3 = fabs(q[i + 3]);
-            for (idx j = 0; j < n; j++) {
+            for (idx t = 0; t < nnz; t++) {
+                const idx j = nz[t];
                 double xj = x[j], axj = fabs(xj);
                 a0 += row[j] * xj;
                 b0 += fabs(row[j]) * axj;
@@ -109,7 +119,8 @@ static double backward_error(idx n, const double *M, const double *q, const doub
         } else {
             res = q[i];
             s = fabs(q[i]);
-            for (idx j = 0; j < n; j++) {
+            for (idx t = 0; t < nnz; t++) {
+                const idx j = nz[t];
                 res += row[j] * x[j];
                 s += fabs(row[j]) * fabs(x[j]);
             }
@@ -125,8 +136,10 @@ static double backward_error(idx n, const double *M, const double *q, const doub
 
 #include "_bound_core.h" /* forward_bound, residual_ld, abs_row_sums_by4; lu, lu_solve */
 
+/* mmax_in: max |M_ij| when the caller knows it and M is finite (solve_accept: the solve
+ * checked and measured M), else negative (measured here). */
 static int assess_one(idx n, const double *M, const double *q, const double *z,
-                      const int64_t *a, idx m, double *out, double *res)
+                      const int64_t *a, idx m, double mmax_in, double *out, double *res)
 {
     const double eps = DBL_EPSILON;
     double mmax = 0.0, qmax = 0.0, norm = 0.0;
@@ -135,7 +148,7 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
         if (!isfinite(z[i]) || !isfinite(q[i])) return 1;
     /* |M|_max and ||M||_inf, for the data's scale (lcp/accuracy.py's data_scale):
      * |q| + ||M||_inf |q| / |M|_max */
-    if (abs_max_finite(M, n * n, &mmax)) {
+    if (mmax_in >= 0 ? (mmax = mmax_in, 1) : abs_max_finite(M, n * n, &mmax)) {
         /* all finite: the maxima do not depend on the order, and each row sum is taken in its
          * own order, four rows at once (independent chains: the same numbers, sooner) */
         idx i = 0;
@@ -174,13 +187,14 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
      * each) and the marks (n bytes); on the stack when it fits (no allocation for small
      * problems) */
     size_t nd = (size_t)2 * m * m + (FB_COLS + 10) * (size_t)m + 1,
-           words = nd + 2 * ((size_t)m + 1) + ((size_t)n + 7) / 8;
+           words = nd + 2 * ((size_t)m + 1) + (size_t)n + ((size_t)n + 7) / 8;
     double stackbuf[ASSESS_STACK];
     double *buf = words <= ASSESS_STACK ? stackbuf : (double *)malloc(words * sizeof(double));
     if (!buf) return 1;
     idx *perm = (idx *)(buf + nd);  /* each in its own words (8 bytes, 8-aligned) */
     int64_t *sorted = (int64_t *)(buf + nd + m + 1);
-    char *mark = (char *)(buf + nd + 2 * (m + 1));
+    idx *nz = (idx *)(buf + nd + 2 * (m + 1));  /* backward_error's scratch */
+    char *mark = (char *)(nz + n);
     memset(mark, 0, (size_t)n);
     for (idx i = 0; i < m; i++) {
         if (a[i] < 0 || a[i] >= n || mark[a[i]]) {
@@ -236,10 +250,10 @@ static int assess_one(idx n, const double *M, const double *q, const double *z,
             if (!isfinite(y[i])) finite = 0;
             out[a[i]] = y[i] > 0.0 ? y[i] : 0.0;
         }
-        double bp = finite ? backward_error(n, M, q, out, mmax, qmax, floor) : INFINITY;
+        double bp = finite ? backward_error(n, M, q, out, mmax, qmax, floor, nz) : INFINITY;
         /* kept when its backward error is at rounding level or not larger than z's */
         if (!(finite && bp <= 8.0 * (double)n * eps))
-            berr = backward_error(n, M, q, z, mmax, qmax, floor);
+            berr = backward_error(n, M, q, z, mmax, qmax, floor, nz);
         if (finite && (bp <= 8.0 * (double)n * eps || bp <= berr)) {
             berr = bp;
             refined = 1;
