@@ -25,7 +25,8 @@
  * One job per file; this one holds the entry points of whole problems (solve_eq, solve_accept,
  * solve_batch, solve_fast) and the module table, and includes, in this order:
  *   acceptance/_accuracy_core.h  the acceptance steps of assess_lcp (shared with _accuracy_c.c)
- *   _lemke_run.h      the Lemke state and the pivoting run on one dictionary (+ AVX2 update)
+ *   _lemke_run.h      the Lemke state and the pivoting run on one dictionary (its updates,
+ *                     eager or lazy, in _lemke_update.h)
  *   _lemke_py.h       the buffer checks and the entry points run, setup, check, plain
  *   _blas.h           numpy's cblas_dgemv, called directly for M z (gemv_setup, gemv)
  *   _lemke_problem.h  one whole problem without the GIL: equilibration (_balanced.h), the

@@ -165,6 +165,8 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     bound[2] = 0.0;
     if (S.qmin >= 0) return 0; /* z = 0 solves it */
     L->T = T;
+    L->ne = 0; /* no eta kept: every column of the new dictionary is up to date */
+    for (idx c = 0; c < n + 2; c++) L->ver[c] = 0;
     for (idx i = 0; i < n; i++) {
         L->basic[i] = i;
         L->row_of[i] = i;
@@ -194,7 +196,8 @@ static int solve_problem(Lemke *L, double *T, const double *M, const double *q, 
     return 0;
 }
 
-/* Scratch of one problem of size n: T, the int64 bookkeeping and the Lemke buffers, in one
+/* Scratch of one problem of size n: T, the int64 bookkeeping, the Lemke buffers and the lazy
+ * updates' etas (lcp/_lemke_run.h: sync_column; at most ECAP kept), in one
  * block: `stack` (of STACK_WORDS 8-byte words, 64-byte aligned) when it is large enough, else
  * malloc'd and aligned here. From n = 8 on, T's columns are padded to a multiple of 4
  * doubles (ld) and start 32-byte aligned, as do the pivot column `col` and V: the vectorized update then never
@@ -209,7 +212,8 @@ typedef struct {
     void *heap;
 } Work;
 
-#define STACK_WORDS 2048 /* 16 kB: enough for n <= 28 */
+#define STACK_WORDS 4096 /* 32 kB: enough for n <= 32 */
+#define ECAP 128         /* lazy updates kept at most (then every column is brought up to date) */
 #define ALIGN_WORDS 8    /* 64 bytes */
 #if defined(__GNUC__)
 #define STACK_ALIGNED __attribute__((aligned(64))) /* of a stack block: uint64_t b[STACK_WORDS] */
@@ -225,12 +229,16 @@ static int work_init(Work *w, idx n, double tol, uint64_t *stack)
 {
     Lemke *L = &w->L;
     const idx ld = n < 8 ? n : (n + 3) / 4 * 4; /* below 8: no padding (no gain) */
-    /* T ld(n + 2), V n n, alpha/theta/col ld each and row n + 2, ints 6n + 3, rows 4n, bz n
-     * bytes: all 8-byte words, each part starting on a 64-byte boundary */
+    /* T ld(n + 2), V n n, alpha/theta/col ld each and row n + 2, ints 6n + 3, rows 4n, the
+     * lazy updates' etas ecap ld, their rows and multipliers ecap each, the versions n + 2 and
+     * sync_avx2's scratch 3 ecap,
+     * bz n bytes: all 8-byte words, each part starting on a 64-byte boundary */
+    const idx ecap = n + 2 < ECAP ? n + 2 : ECAP;
     size_t nT = round_up((size_t)ld * (n + 2)), nV = round_up((size_t)n * n),
            nA = round_up(3 * (size_t)ld + n + 2), nI = round_up(6 * (size_t)n + 3),
-           nR = round_up(4 * (size_t)n);
-    size_t words = nT + nV + nA + nI + nR + ((size_t)n + 7) / 8;
+           nR = round_up(4 * (size_t)n), nE = round_up((size_t)ecap * ld),
+           nL = round_up(5 * (size_t)ecap + n + 2);
+    size_t words = nT + nV + nA + nI + nR + nE + nL + ((size_t)n + 7) / 8;
     uint64_t *block = stack;
     w->heap = NULL;
     if (!stack || words > STACK_WORDS) {
@@ -244,11 +252,21 @@ static int work_init(Work *w, idx n, double tol, uint64_t *stack)
     L->alpha = L->V + nV;
     w->ints = (int64_t *)(L->alpha + nA);
     L->rows = (idx *)(w->ints + nI);
-    w->bz = (int8_t *)(L->rows + nR);
+    L->E = (double *)(L->rows + nR);
+    L->emult = L->E + nE;
+    L->er = (idx *)(L->emult + ecap);
+    L->ver = L->er + ecap;
+    L->cur = (double *)(L->ver + n + 2);
+    L->rcs = L->cur + ecap;
+    L->tr = (idx *)(L->rcs + ecap);
+    w->bz = (int8_t *)(L->emult + nL);
     L->n = n;
     L->ld = ld;
     L->T = w->T;
     L->tol = tol;
+    L->lazy = 1;
+    L->ne = 0;
+    L->ecap = ecap;
     L->basic = w->ints;
     L->nonbasic = w->ints + n;
     L->row_of = w->ints + 2 * n + 1;

@@ -44,6 +44,7 @@ static PyObject *py_run(PyObject *self, PyObject *args)
     L.row_of = (int64_t *)vrow.buf;
     L.slot_of = (int64_t *)vslot.buf;
     L.tol = tol;
+    L.lazy = 0; /* every column updated at every pivot: Python reads the whole dictionary */
     L.rows = (idx *)malloc(4 * n * sizeof(idx));
     L.alpha = (double *)malloc((4 * n + 2) * sizeof(double));
     L.V = (double *)malloc((size_t)n * n * sizeof(double));

@@ -1,8 +1,9 @@
 /* Lemke's pivoting run on one dictionary (included by lcp/_lemke_c.c): the Lemke state, the
- * basis hash that detects numerical cycling, the rank-one update (and its AVX2 clone), the
- * pivot, the ratio test with the lexicographic tie-break, and `run`, the loop of
- * lcp/solvers/lemke.py's `_Lemke.run` (same rules, same order of floating-point operations).
- * Also HAVE_AVX2_CLONE and cpu_avx2(), which the other parts of _lemke_c.c use. The includer
+ * basis hash that detects numerical cycling, the pivot (its updates of the dictionary, eager
+ * or lazy, in _lemke_update.h), the ratio test with the lexicographic tie-break, and `run`, the
+ * loop of lcp/solvers/lemke.py's `_Lemke.run` (same rules, same order of floating-point
+ * operations). Also HAVE_AVX2_CLONE and cpu_avx2() (_lemke_update.h), which the other parts of
+ * _lemke_c.c use. The includer
  * defines `idx` (Py_ssize_t) and includes <stdint.h>, <stdlib.h> and <string.h>. */
 #ifndef RIGIDLCP_LEMKE_RUN_H
 #define RIGIDLCP_LEMKE_RUN_H
@@ -18,6 +19,15 @@ typedef struct {
     /* scratch */
     idx *rows, *cand, *wj, *pos;
     double *alpha, *theta, *row, *col, *V;
+    /* lazy updates (solve_problem's runs; 0 in `run` from Python): each pivot's column (the
+     * eta, ld doubles, its pivot row's entry 1), row and multiplier are kept, and a column of
+     * T gets the updates it has not had only when it is read (sync_column); beta and the
+     * entering column are updated at every pivot. ne etas kept (at most ecap), ver[c] the
+     * number column c has had. */
+    int lazy;
+    idx ne, ecap;
+    double *E, *emult, *cur, *rcs; /* cur, rcs, tr: sync_avx2's scratch (ecap each) */
+    idx *er, *ver, *tr;
 } Lemke;
 
 /* ------------------------------------------------------------------ basis hash (Zobrist) */
@@ -68,84 +78,16 @@ static int hs_add(HashSet *h, int64_t key)
     return 0;
 }
 
-/* ------------------------------------------------------------------ the rank-one update */
-/* T[:, c] += col * row[c] for every c with row[c] != 0, each entry rounded twice (the product,
- * then the sum: no fused multiply-add, -ffp-contract=off), as the numpy loop of lemke.py does
- * with np.multiply and np.add. So both loops see the same numbers and take the same pivots on
- * every CPU, whatever BLAS kernel the machine has (OpenBLAS's ?ger kernels fuse some entries
- * and not others: Haswell's fuses blocks of 16 rows and rounds the remainder twice). */
-static void update_plain(double *T, const double *col, const double *row, idx n, idx ld,
-                         idx m)
-{
-    for (idx c = 0; c < m; c++) {
-        double rc = row[c];
-        if (rc == 0.0) continue; /* adds 0 * col: changes nothing but the sign of a zero */
-        double *Tc = T + ld * c;
-        for (idx i = 0; i < n; i++) Tc[i] += col[i] * rc;
-    }
-}
-
-/* The AVX2 clones (here, in _balanced.h, acceptance/_accuracy_core.h and _lu_core.h) are
- * chosen at run time where the CPU has AVX2; built with -DRIGIDLCP_NO_AVX2 (or on another
- * architecture) only the plain loops remain, with the same numbers: benchmarks/ab_builds.py
- * --ref on such a build compares the two (docs/performance.md, third pass). */
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
-#define HAVE_AVX2_CLONE 1
-#include <immintrin.h>
-/* The same loop vectorized 4 wide: each lane rounds the product and the sum as the scalar
- * loop does (AVX2 without FMA), so the numbers are the same, only sooner. */
-__attribute__((target("avx2"))) static void update_avx2(double *T, const double *col,
-                                                       const double *row, idx n, idx ld,
-                                                       idx m)
-{
-    if (ld % 4 == 0) {
-        /* columns of a multiple of 4 doubles (padded by work_init from n = 8 on): the whole
-         * column, 8 entries a step, no scalar remainder. col's padding entries are 0 (pivot
-         * copies the padded column, whose padding rows work_init zeroed), so the padding rows
-         * of T only ever get 0 * rc added: never read, they change nothing. */
-        for (idx c = 0; c < m; c++) {
-            double rc = row[c];
-            if (rc == 0.0) continue;
-            double *Tc = T + ld * c;
-            const __m256d v = _mm256_set1_pd(rc);
-            idx i = 0;
-            for (; i + 8 <= ld; i += 8) {
-                __m256d a = _mm256_loadu_pd(Tc + i), b = _mm256_loadu_pd(Tc + i + 4);
-                a = _mm256_add_pd(a, _mm256_mul_pd(_mm256_loadu_pd(col + i), v));
-                b = _mm256_add_pd(b, _mm256_mul_pd(_mm256_loadu_pd(col + i + 4), v));
-                _mm256_storeu_pd(Tc + i, a);
-                _mm256_storeu_pd(Tc + i + 4, b);
-            }
-            if (i < ld)
-                _mm256_storeu_pd(Tc + i, _mm256_add_pd(_mm256_loadu_pd(Tc + i),
-                                                       _mm256_mul_pd(_mm256_loadu_pd(col + i), v)));
-        }
-        return;
-    }
-    for (idx c = 0; c < m; c++) {
-        double rc = row[c];
-        if (rc == 0.0) continue;
-        double *Tc = T + ld * c;
-        for (idx i = 0; i < n; i++) Tc[i] += col[i] * rc;
-    }
-}
-static int use_avx2 = -1; /* -1: not decided yet */
-static int cpu_avx2(void)
-{
-    if (use_avx2 < 0) {
-        __builtin_cpu_init();
-        use_avx2 = __builtin_cpu_supports("avx2") ? 1 : 0;
-    }
-    return use_avx2;
-}
-#else
-#define HAVE_AVX2_CLONE 0
-#endif
+#include "_lemke_update.h" /* update_plain / update_avx2, sync_column, pivot_lazy */
 
 /* ------------------------------------------------------------------ the pivot */
 static int64_t pivot(Lemke *L, idx r, idx s)
 {
     const idx n = L->n, ld = L->ld, m = n + 2;
+    if (L->lazy) {
+        pivot_lazy(L, r, s);
+        goto swap;
+    }
     double *T = L->T, *row = L->row, *col = L->col;
     double *Ts = T + ld * s;
     double p = Ts[r];
@@ -166,6 +108,7 @@ static int64_t pivot(Lemke *L, idx r, idx s)
     else
 #endif
         update_plain(T, col, row, n, ld, m);
+swap:;
     int64_t entering = L->nonbasic[s], leaving = L->basic[r];
     L->basic[r] = entering;
     L->nonbasic[s] = leaving;
@@ -189,6 +132,7 @@ static idx lexico_min(Lemke *L, const idx *rows, const double *alpha, idx m)
     double *V = L->V; /* m x nw, column-major */
     double vmax = 0.0, ainv = -1.0 / 0.0;
     for (idx k = 0; k < nw; k++) {
+        if (L->lazy) sync_column(L, L->slot_of[L->wj[k]]);
         const double *Tk = T + L->ld * L->slot_of[L->wj[k]];
         for (idx i = 0; i < m; i++) {
             double v = -Tk[rows[i]] / alpha[i];
@@ -417,6 +361,7 @@ static int run(Lemke *L, long long max_iter, int64_t *trace, idx trace_len,
         entering = leaving < n ? leaving + n : leaving - n;
         ent = entering;
         s = (idx)L->slot_of[entering];
+        if (L->lazy) sync_column(L, s);
         const double *a = T + ld * s;
         double amin = column_min(a, n);
         amax = -amin;

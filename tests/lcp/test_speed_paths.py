@@ -1,9 +1,10 @@
 """The speed changes of issue 23 change no answer and no refusal.
 
-* The C kernel's work array of `solve_eq` / `solve_batch` (lcp/_lemke_c.c: T's columns padded
-  to a multiple of 4 doubles from n = 8, the block 64-byte aligned, on the stack up to n = 28
-  and malloc'd above) gives the z, pivots, basis and status of the general path, whose
-  dictionary comes from Python with no padding (`_lemke_kernel.run`), bit for bit: on sizes
+* The C kernel's work array of `solve_eq` / `solve_batch` (lcp/_lemke_c.c: T's columns
+  padded to a multiple of 4 doubles from n = 8, the block 64-byte aligned, on the stack up to
+  n = 32 and malloc'd above; its columns updated lazily, when read) gives the z, pivots, basis
+  and status of the general path, whose dictionary comes from Python with no padding and is
+  updated eagerly (`_lemke_kernel.run`), bit for bit: on sizes
   that are and are not multiples of 4, on both sides of the stack/heap boundary, on random,
   degenerate (ties, duplicated rows and columns, zeros in q) and badly scaled problems.
 * `lcp.LCP(M, q)`'s quick route for plain finite float64 data gives the arrays the general
@@ -29,8 +30,8 @@ from .test_fast_lemke import assert_same_answer, same
 compiled = pytest.mark.skipif(not kernel.enabled(), reason="the C extension is not built or is off")
 
 #: Around the padding threshold (n = 8; n = 16 before), the stack/heap boundary of the work
-#: block (n = 28/29), not multiples of 4, and larger.
-SIZES = (3, 7, 8, 9, 10, 12, 13, 15, 16, 17, 23, 27, 28, 29, 31, 33, 50, 61, 64, 65)
+#: block (n = 32/33; 28/29 before), not multiples of 4, and larger.
+SIZES = (3, 7, 8, 9, 10, 12, 13, 15, 16, 17, 23, 27, 28, 29, 31, 32, 33, 50, 61, 64, 65)
 
 
 def _problem(n: int, kind: str, seed: int) -> tuple[np.ndarray, np.ndarray]:
@@ -143,12 +144,26 @@ def test_padded_kernel_takes_the_pivots_of_the_unpadded_loop(n, kind):
     """Every outcome (solved, ray, pivot limit, cycling), not only the accepted ones: the code
     and pivot count of `solve_eq` (padded work array) against lemke() on the same equilibrated
     data (its dictionary from Python, unpadded), and z in the user's units when solved."""
+    _same_pivots(n, kind, range(3))
+
+
+@compiled
+@pytest.mark.parametrize("kind", ["psd", "general", "degenerate", "ties"])
+def test_lazy_updates_take_the_pivots_of_the_eager_loop(kind):
+    """The work array's dictionary is updated lazily (lcp/_lemke_run.h: sync_column; at most
+    ECAP = 128 pivots kept, then every column brought up to date), Python's eagerly: at n = 150
+    these runs take 90 (psd), 151 with ties (ties), 5838 to a ray (general) and 16000 to the
+    pivot limit (degenerate) pivots: the same codes, pivots and z."""
+    _same_pivots(150, kind, range(1))
+
+
+def _same_pivots(n: int, kind: str, seeds) -> None:
     from rigidlcp.lcp.acceptance.scaling import ruiz
     from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL, lemke
 
     status = {kernel.SOLVED: ("solved",), kernel.RAY: ("ray", "infeasible"),
               kernel.MAX_ITER: ("max_iter",)}
-    for seed in range(3):
+    for seed in seeds:
         M, q = _problem(n, kind, seed)
         eq = ruiz(M, q)
         z, basis = np.empty(n), np.empty(n, dtype=np.intp)
