@@ -52,7 +52,8 @@ setup(
     ext_modules=[
         Extension("rigidlcp.lcp._lemke_c", sources=["lcp/_lemke_c.c"], optional=True,
                   depends=["lcp/_lemke_run.h", "lcp/_lemke_py.h", "lcp/_lemke_problem.h",
-                           "lcp/_lemke_measure.h", "lcp/_lemke_solution.h", "lcp/_balanced.h",
+                           "lcp/_lemke_measure.h", "lcp/_lemke_solution.h", "lcp/_solve_entry.h",
+                           "lcp/_batch_solutions.h", "lcp/_balanced.h",
                            "lcp/_blas.h", "lcp/_buffer.h",
                            "lcp/acceptance/_accuracy_core.h", "lcp/acceptance/_bound_core.h",
                            "lcp/acceptance/_lu_core.h", "lcp/acceptance/_inverse_core.h"]),

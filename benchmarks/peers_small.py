@@ -175,7 +175,7 @@ def lcp_construction(sizes: list[int]) -> None:
 
     from rigidlcp.lcp.problems import problem as module
 
-    quick = module._plain
+    quick = module._init
     if quick is None:
         print("lcp.LCP(M, q): no quick route (the C extension is not built)")
         return
@@ -187,13 +187,13 @@ def lcp_construction(sizes: list[int]) -> None:
             best = {"general": np.inf, "quick": np.inf}
             for _ in range(3):
                 for name, check in (("general", None), ("quick", quick)):
-                    module._plain = check
+                    module._init = check
                     t = min(timeit.repeat(lambda: lcp.LCP(M, q), number=20000, repeat=5))  # noqa: B023
                     best[name] = min(best[name], t / 20000)
             print(f"lcp.LCP(M, q) at n = {n}: general validation {1e6 * best['general']:.2f} us, "
                   f"quick route {1e6 * best['quick']:.2f} us")
     finally:
-        module._plain = quick
+        module._init = quick
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -1,10 +1,21 @@
 /* The Python side of one dictionary (included by lcp/_lemke_c.c): the buffer checks of the
- * arguments (opt_vector, release, problem_data; get_buffer from _buffer.h) and the entry points of lcp/_lemke_kernel.py and
- * lcp.LCP that work on one dictionary or on the data as given: run, setup, check, plain. The
+ * arguments (opt_vector, release, problem_data; get_buffer from _buffer.h) and the entry
+ * points of lcp/_lemke_kernel.py and lcp.LCP that work on one dictionary or on the data as
+ * given: run, setup, check, plain, and lcp.LCP's quick __init__ (lcp_setup, lcp_init). The
  * includer includes <Python.h>, <float.h>, <math.h>, acceptance/_accuracy_core.h
  * (abs_max_finite) and _lemke_run.h. */
 #ifndef RIGIDLCP_LEMKE_PY_H
 #define RIGIDLCP_LEMKE_PY_H
+
+#ifndef Py_T_OBJECT_EX /* Python < 3.12: structmember.h's names (the slots of a
+                        * class: lcp_setup here, solve_setup in _lemke_solution.h) */
+#include <structmember.h>
+#define SLOT_OBJECT_EX T_OBJECT_EX
+#define SLOT_READONLY READONLY
+#else
+#define SLOT_OBJECT_EX Py_T_OBJECT_EX
+#define SLOT_READONLY Py_READONLY
+#endif
 
 /* ------------------------------------------------------------------ Python binding */
 #include "_buffer.h" /* get_buffer: shared with solvers/_pivot_c.c */
@@ -191,6 +202,47 @@ static int native_double(const Py_buffer *v)
     return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
 }
 
+/* Are oq a C-contiguous native float64 vector of n >= 1 entries and oM a C-contiguous native
+ * float64 n x n matrix, all entries finite? Returns n, with both buffers held (the caller
+ * releases vM and vq), or 0 with none held, never an error. */
+static idx plain_buffers(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+{
+    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
+    if (PyObject_GetBuffer(oq, vq, flags) < 0) {
+        PyErr_Clear();
+        return 0;
+    }
+    if (PyObject_GetBuffer(oM, vM, flags) < 0) {
+        PyErr_Clear();
+        PyBuffer_Release(vq);
+        return 0;
+    }
+    idx n = vq->ndim == 1 ? vq->shape[0] : 0;
+    int ok = n >= 1 && native_double(vq) && native_double(vM) && vM->ndim == 2 &&
+             vM->shape[0] == n && vM->shape[1] == n;
+    if (ok) {
+        const double *M = (const double *)vM->buf, *q = (const double *)vq->buf;
+        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
+        int finite = abs_max_finite(M, n * n, &top);
+        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
+        ok = finite;
+    }
+    if (ok) return n;
+    PyBuffer_Release(vM);
+    PyBuffer_Release(vq);
+    return 0;
+}
+
+/* The same test, the buffers released (0 or 1). */
+static int plain_data(PyObject *oM, PyObject *oq)
+{
+    Py_buffer vM, vq;
+    if (!plain_buffers(oM, oq, &vM, &vq)) return 0;
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    return 1;
+}
+
 /* plain(M, q) -> bool: lcp.LCP's quick route -- is q a C-contiguous native float64 vector of
  * n >= 1 entries and M a C-contiguous native float64 n x n matrix, all entries finite? (Then
  * M and q need no conversion, only the copies.) False for anything else, never an error: the
@@ -203,31 +255,108 @@ static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_TypeError, "plain(M, q): two arguments");
         return NULL;
     }
-    Py_buffer vq, vM;
-    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
-    if (PyObject_GetBuffer(args[1], &vq, flags) < 0) {
-        PyErr_Clear();
-        Py_RETURN_FALSE;
+    if (plain_data(args[0], args[1])) Py_RETURN_TRUE;
+    Py_RETURN_FALSE;
+}
+
+/* lcp.LCP's __init__, its quick route in one call (lcp/problems/problem.py):
+ *   lcp_setup(LCP, ndarray, empty) -> bool: the class (its four fields M, q, name, meta plain
+ *     object slots: their offsets are read from its member descriptors), numpy.ndarray and
+ *     numpy.empty; False when the fields are not such slots (lcp_init then always declines).
+ *   lcp_init(self, M, q, name, meta) -> bool: when M and q are numpy arrays (exactly) of plain
+ *     finite data (plain_buffers), the four slots receive copies of M and q, name and meta
+ *     ({} when None) and True is returned; else False and nothing is set (the Python
+ *     validation runs and raises the typed error). A copy is numpy.empty of the shape (float64,
+ *     C order, its own data) and the bytes of the data: what M.copy() makes, without numpy's
+ *     general copy machinery (casts, iterators, overlap test: half the constructor's time). */
+static PyObject *s_lcp_cls, *s_lcp_ndarray, *s_lcp_empty;
+static Py_ssize_t s_lcp_off[4] = {-1};
+
+static PyObject *py_lcp_setup(PyObject *self, PyObject *args)
+{
+    PyObject *cls, *nd, *empty;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O!O", &PyType_Type, &cls, &PyType_Type, &nd, &empty))
+        return NULL;
+    static const char *const names[4] = {"M", "q", "name", "meta"};
+    Py_ssize_t off[4];
+    int ok = ((PyTypeObject *)cls)->tp_dictoffset == 0;
+    for (int k = 0; ok && k < 4; k++) {
+        PyObject *dsc = PyDict_GetItemString(((PyTypeObject *)cls)->tp_dict, names[k]);
+        ok = dsc && Py_IS_TYPE(dsc, &PyMemberDescr_Type);
+        if (ok) {
+            PyMemberDef *md = ((PyMemberDescrObject *)dsc)->d_member;
+            ok = md->type == SLOT_OBJECT_EX && !(md->flags & SLOT_READONLY) && md->offset > 0;
+            off[k] = md->offset;
+        }
     }
-    if (PyObject_GetBuffer(args[0], &vM, flags) < 0) {
-        PyErr_Clear();
-        PyBuffer_Release(&vq);
-        Py_RETURN_FALSE;
+    s_lcp_off[0] = -1;
+    PyObject **slots[3] = {&s_lcp_cls, &s_lcp_ndarray, &s_lcp_empty};
+    PyObject *given[3] = {cls, nd, empty};
+    for (int k = 0; k < 3; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
     }
-    idx n = vq.ndim == 1 ? vq.shape[0] : 0;
-    int ok = n >= 1 && native_double(&vq) && native_double(&vM) && vM.ndim == 2 &&
-             vM.shape[0] == n && vM.shape[1] == n;
-    if (ok) {
-        const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
-        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
-        int finite = abs_max_finite(M, n * n, &top);
-        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
-        ok = finite;
+    if (ok) memcpy(s_lcp_off, off, sizeof off);
+    return PyBool_FromLong(ok);
+}
+
+/* A new float64 array of `shape` (an int or a tuple) holding the `bytes` bytes at src. */
+static PyObject *copy_of(PyObject *shape, const void *src, idx bytes)
+{
+    PyObject *arr = PyObject_Vectorcall(s_lcp_empty, &shape, 1, NULL);
+    if (!arr) return NULL;
+    Py_buffer v;
+    if (PyObject_GetBuffer(arr, &v, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) {
+        Py_DECREF(arr);
+        return NULL;
+    }
+    if (v.len != bytes) {
+        PyErr_SetString(PyExc_ValueError, "lcp_init: numpy.empty gave an array of another size");
+        PyBuffer_Release(&v);
+        Py_DECREF(arr);
+        return NULL;
+    }
+    memcpy(v.buf, src, (size_t)bytes);
+    PyBuffer_Release(&v);
+    return arr;
+}
+
+static PyObject *py_lcp_init(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "lcp_init(self, M, q, name, meta): five arguments");
+        return NULL;
+    }
+    PyObject *obj = args[0];
+    Py_buffer vM, vq;
+    idx n;
+    if (s_lcp_off[0] <= 0 || !PyObject_TypeCheck(obj, (PyTypeObject *)s_lcp_cls) ||
+        Py_TYPE(args[1]) != (PyTypeObject *)s_lcp_ndarray ||
+        Py_TYPE(args[2]) != (PyTypeObject *)s_lcp_ndarray ||
+        !(n = plain_buffers(args[1], args[2], &vM, &vq)))
+        Py_RETURN_FALSE;
+    PyObject *v[4] = {NULL, NULL, args[3], args[4]};
+    PyObject *size = PyLong_FromSsize_t(n), *shape = size ? PyTuple_Pack(2, size, size) : NULL;
+    if (shape) {
+        v[0] = copy_of(shape, vM.buf, n * n * 8);
+        v[1] = v[0] ? copy_of(size, vq.buf, n * 8) : NULL;
     }
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vq);
-    if (ok) Py_RETURN_TRUE;
-    Py_RETURN_FALSE;
+    Py_XDECREF(shape);
+    Py_XDECREF(size);
+    if (v[1] && v[3] == Py_None && !(v[3] = PyDict_New())) Py_CLEAR(v[1]);
+    else if (v[1] && v[3] != Py_None) Py_INCREF(v[3]);
+    if (!v[1]) {
+        Py_XDECREF(v[0]);
+        return NULL;
+    }
+    Py_INCREF(v[2]);
+    for (int k = 0; k < 4; k++) /* the slot may hold a value (__init__ called again) */
+        Py_XSETREF(*(PyObject **)((char *)obj + s_lcp_off[k]), v[k]);
+    Py_RETURN_TRUE;
 }
 
 /* An optional float64 vector of length n (None: NULL). */
