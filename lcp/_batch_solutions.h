@@ -9,7 +9,7 @@
  *     acc[p, 0] = 0 (assessed in C), measured[p, :2] = (raw, scaled) with scaled <= tol,
  *     acc[p, 1] (berr) <= tol, acc[p, 2] (ferr) <= ferr_tol; a NaN fails each test -- the
  *     Solution `solved_lcp(z, w, "lemke", pivots[p], raw, scaled, basis, message, info, berr,
- *     ferr)` that _lemke_batch built, with z = Z[p] and w = W[p] copied into arrays of their own,
+ *     ferr)` that _lemke_batch built, with z = Z[p] and w = W[p] (views of the rows, as there),
  *     basis the indices j of basic[p, j] != 0 (int64, ascending: np.flatnonzero(basic[p])),
  *     info {"equilibrated": equilibrated} (+ "polished": True when acc[p, 3] != 0); None for
  *     every other problem (the Python finishes it: numpy's judge or lcp.solve).
@@ -19,7 +19,7 @@
 #define RIGIDLCP_BATCH_SOLUTIONS_H
 
 /* A new numpy array (numpy.empty) of n float64 (integer 0) or intp entries holding the n
- * 8-byte entries at src. */
+ * 8-byte entries at src (the basis). */
 static PyObject *array_of(idx n, int integer, const void *src)
 {
     PyObject *arr = new_array(n, integer);
@@ -87,7 +87,7 @@ static PyObject *py_batch_solutions(PyObject *self, PyObject *args)
             idx nb = 0;
             for (idx j = 0; j < n; j++)
                 if (B[p * n + j]) basis[nb++] = j;
-            PyObject *z = array_of(n, 0, Z + p * n), *w = z ? array_of(n, 0, W + p * n) : NULL;
+            PyObject *z = PySequence_GetItem(oZ, p), *w = z ? PySequence_GetItem(oW, p) : NULL;
             PyObject *b = w ? array_of(nb, 1, basis) : NULL;
             sol = b ? solution(z, w, piv[p], raw, scaled, b, a[3] != 0.0, a[1], a[2],
                                equilibrated)
@@ -114,6 +114,98 @@ done:
     release(&vp);
     release(&vc);
     return list;
+}
+
+/* stack_lcps(problems, LCP) -> [(n, indices, Ms, qs), ...] or None: solve_many's grouping of
+ * a list of lcp.LCPs by size, in C: for each size n, in the order of its first problem, the
+ * list of the indices of the problems of that size and their M and q copied into new stacks
+ * (numpy.empty((k, n, n)) and ((k, n))), as np.concatenate(...).reshape(...) stacks them. None
+ * (the Python groups them itself, with its checks and messages) unless every entry is an
+ * lcp.LCP (or a subclass) whose M is a C-contiguous native float64 n x n array and q a
+ * native float64 vector of n entries. */
+static PyObject *stack_array(PyObject *shape)
+{
+    return PyObject_Vectorcall(s_empty, &shape, 1, NULL);
+}
+
+static PyObject *py_stack_lcps(PyObject *self, PyObject *args)
+{
+    PyObject *list, *cls;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O!", &PyList_Type, &list, &PyType_Type, &cls)) return NULL;
+    if (!s_empty) {
+        PyErr_SetString(PyExc_RuntimeError, "stack_lcps: solve_setup was not called");
+        return NULL;
+    }
+    idx k = PyList_GET_SIZE(list), groups = 0;
+    idx *ns = (idx *)malloc((size_t)(k + 1) * (2 * sizeof(idx) + 2 * sizeof(void *)));
+    if (!ns) return PyErr_NoMemory();
+    idx *sizes = ns + k + 1; /* the distinct sizes, in order */
+    const double **data = (const double **)(sizes + k + 1);
+    PyObject *result = NULL, *M = NULL, *q = NULL;
+    for (idx p = 0; p < k; p++) { /* each problem's n and data pointers (the arrays are the
+                                   * problems' own: alive, and no Python runs until the end) */
+        PyObject *obj = PyList_GET_ITEM(list, p);
+        Py_buffer vM, vq;
+        if (!PyObject_TypeCheck(obj, (PyTypeObject *)cls)) goto decline;
+        if (!(M = PyObject_GetAttrString(obj, "M")) || !(q = PyObject_GetAttrString(obj, "q")))
+            goto fail;
+        idx n = plain_arrays(M, q, &vM, &vq, 0);
+        if (n > 0) {
+            data[2 * p] = (const double *)vM.buf, data[2 * p + 1] = (const double *)vq.buf;
+            PyBuffer_Release(&vM);
+            PyBuffer_Release(&vq);
+        }
+        Py_CLEAR(M);
+        Py_CLEAR(q);
+        if (n < 1) goto decline;
+        ns[p] = n;
+        idx g = 0;
+        while (g < groups && sizes[g] != n) g++;
+        if (g == groups) sizes[groups++] = n;
+    }
+    if (!(result = PyList_New(groups))) goto fail;
+    for (idx g = 0; g < groups; g++) {
+        idx n = sizes[g], count = 0, j = 0;
+        for (idx p = 0; p < k; p++) count += ns[p] == n;
+        PyObject *indices = PyList_New(count), *Ms = NULL, *qs = NULL;
+        PyObject *shape3 = Py_BuildValue("(nnn)", count, n, n), *shape2 = NULL;
+        if (indices && shape3 && (shape2 = Py_BuildValue("(nn)", count, n)))
+            if ((Ms = stack_array(shape3))) qs = stack_array(shape2);
+        Py_XDECREF(shape3);
+        Py_XDECREF(shape2);
+        Py_buffer vMs = {0}, vqs = {0};
+        int ok = qs && own_buffer(Ms, &vMs, count * n * n * 8) == 0 &&
+                 own_buffer(qs, &vqs, count * n * 8) == 0;
+        for (idx p = 0; ok && p < k; p++) {
+            if (ns[p] != n) continue;
+            PyObject *i = PyLong_FromSsize_t(p);
+            if (!(ok = i != NULL)) break;
+            PyList_SET_ITEM(indices, j, i);
+            memcpy((double *)vMs.buf + j * n * n, data[2 * p], (size_t)(n * n) * 8);
+            memcpy((double *)vqs.buf + j * n, data[2 * p + 1], (size_t)n * 8);
+            j++;
+        }
+        release(&vMs);
+        release(&vqs);
+        PyObject *entry = ok ? Py_BuildValue("(nOOO)", n, indices, Ms, qs) : NULL;
+        Py_XDECREF(indices);
+        Py_XDECREF(Ms);
+        Py_XDECREF(qs);
+        if (!entry) goto fail;
+        PyList_SET_ITEM(result, g, entry);
+    }
+    free(ns);
+    return result;
+decline:
+    free(ns);
+    Py_RETURN_NONE;
+fail:
+    Py_XDECREF(M);
+    Py_XDECREF(q);
+    Py_XDECREF(result);
+    free(ns);
+    return NULL;
 }
 
 #endif /* RIGIDLCP_BATCH_SOLUTIONS_H */

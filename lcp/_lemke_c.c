@@ -35,7 +35,8 @@
  *   _lemke_solution.h solve_lcp: solve_fast's work, the verdict and the Solution in one call;
  *                     solve_default: lcp.solve's default call, from the problem object
  *   _solve_entry.h    Entry: lcp.solve as an object whose default call goes to api._FAST
- *   _batch_solutions.h batch_solutions: lcp.solve_many's verdicts and Solutions
+ *   _batch_solutions.h batch_solutions, stack_lcps: lcp.solve_many's stacks, verdicts and
+ *                     Solutions
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -358,6 +359,8 @@ static PyMethodDef methods[] = {
     {"batch_solutions", py_batch_solutions, METH_VARARGS,
      "batch_solutions(Z, W, basic, codes, pivots, acc, measured, tol, ferr_tol, equilibrated) -> "
      "list of Solution or None (see lcp/_batch_solutions.h)."},
+    {"stack_lcps", py_stack_lcps, METH_VARARGS,
+     "stack_lcps(problems, LCP) -> [(n, indices, Ms, qs), ...] or None: solve_many's stacks."},
     {"solve_default", py_solve_default, METH_O,
      "solve_default(problem) -> Solution or None: lcp.solve's default call on an lcp.LCP (see "
      "lcp/_lemke_solution.h)."},

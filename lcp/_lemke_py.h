@@ -203,9 +203,9 @@ static int native_double(const Py_buffer *v)
 }
 
 /* Are oq a C-contiguous native float64 vector of n >= 1 entries and oM a C-contiguous native
- * float64 n x n matrix, all entries finite? Returns n, with both buffers held (the caller
- * releases vM and vq), or 0 with none held, never an error. */
-static idx plain_buffers(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+ * float64 n x n matrix (all entries finite, when `finite`)? Returns n, with both buffers held
+ * (the caller releases vM and vq), or 0 with none held, never an error. */
+static idx plain_arrays(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq, int finite)
 {
     const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
     if (PyObject_GetBuffer(oq, vq, flags) < 0) {
@@ -220,17 +220,23 @@ static idx plain_buffers(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *v
     idx n = vq->ndim == 1 ? vq->shape[0] : 0;
     int ok = n >= 1 && native_double(vq) && native_double(vM) && vM->ndim == 2 &&
              vM->shape[0] == n && vM->shape[1] == n;
-    if (ok) {
+    if (ok && finite) {
         const double *M = (const double *)vM->buf, *q = (const double *)vq->buf;
         double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
-        int finite = abs_max_finite(M, n * n, &top);
-        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
-        ok = finite;
+        int all = abs_max_finite(M, n * n, &top);
+        for (idx i = 0; i < n; i++) all &= fabs(q[i]) <= DBL_MAX;
+        ok = all;
     }
     if (ok) return n;
     PyBuffer_Release(vM);
     PyBuffer_Release(vq);
     return 0;
+}
+
+/* plain_arrays with the finiteness test. */
+static idx plain_buffers(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+{
+    return plain_arrays(oM, oq, vM, vq, 1);
 }
 
 /* The same test, the buffers released (0 or 1). */

@@ -58,11 +58,20 @@ def solve_many(
     from .problems.friction import FrictionContact2D
 
     problems = list(problems)
+    stacks = _stack_lcps(problems)
+    if stacks is not None:  # every entry an lcp.LCP of plain data, grouped and stacked in C
+        out: list[Solution | None] = [None] * len(problems)
+        for _n, idx, Ms, qs in stacks:
+            sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]],
+                                repair)
+            for i, sol in zip(idx, sols):
+                out[i] = sol
+        return out  # type: ignore[return-value]
     for i, p in enumerate(problems):
         if type(p) is not LCP and not isinstance(p, (LCP, MLCP, FrictionContact2D)):
             raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
                                  f"lcp.FrictionContact2D, got {type(p).__name__}")
-    out: list[Solution | None] = [None] * len(problems)
+    out = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
         if not (type(p) is LCP or isinstance(p, LCP)) or not p.M.flags.c_contiguous:
@@ -80,6 +89,18 @@ def solve_many(
         for i, sol in zip(idx, sols):
             out[i] = sol
     return out  # type: ignore[return-value]
+
+
+def _stack_lcps(problems: list) -> list | None:
+    """The grouping below done in C (lcp/_batch_solutions.h: stack_lcps) when every problem is
+    an lcp.LCP whose M is C-contiguous native float64 (n x n) and q a float64 vector: for each
+    size, in the order of its first problem, (n, indices, Ms, qs) with the stacks
+    np.concatenate would make; else None (and when the C calls are not built)."""
+    from .solvers.fast_lemke import _solve_lcp  # its import gives the C calls their objects
+
+    if _solve_lcp is None:
+        return None
+    return _kernel._lemke_c.stack_lcps(problems, LCP)
 
 
 def _stacked(Ms, qs) -> tuple[np.ndarray, np.ndarray]:

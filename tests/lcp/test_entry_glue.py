@@ -31,6 +31,7 @@ from rigidlcp.lcp import api
 from rigidlcp.lcp.problems import problem as problem_module
 from rigidlcp.lcp.solvers import fast_lemke
 
+from .test_batch import assert_same_as_loop
 from .test_fast_lemke import assert_same_answer, fields, same
 from .test_speed_paths import SIZES, _problem
 
@@ -265,4 +266,32 @@ def test_the_batch_verdict_in_c_is_the_pythons(seed):
         assert (out[1] is not None) == accepted, (t, f)
         if accepted:
             assert same_outcome(out[1], many[1])
-            assert out[1].z.base is None and not np.shares_memory(out[1].z, Z)
+
+
+@compiled
+def test_stack_lcps_groups_and_stacks_as_the_python():
+    """Sizes in the order of their first problem, the indices of each, and the stacks of
+    np.concatenate; None (the Python's grouping) for anything but plain lcp.LCPs."""
+    from rigidlcp.lcp import batch
+
+    problems = [lcp.LCP(*_problem(n, "general", s)) for s, n in enumerate((3, 5, 3, 1, 5, 3))]
+    problems[1].M.flags.writeable = False  # read-only data are stacked as they are
+    stacks = batch._stack_lcps(problems)
+    groups: dict[int, list[int]] = {}
+    for i, p in enumerate(problems):
+        groups.setdefault(p.q.size, []).append(i)
+    assert [(n, idx) for n, idx, _, _ in stacks] == list(groups.items())
+    for n, idx, Ms, qs in stacks:
+        assert same(Ms, np.concatenate([problems[i].M for i in idx]).reshape(len(idx), n, n))
+        assert same(qs, np.concatenate([problems[i].q for i in idx]).reshape(len(idx), n))
+    assert batch._stack_lcps([]) == []
+    mlcp = lcp.MLCP(np.eye(1), np.ones((1, 2)), np.ones((2, 1)), np.eye(2), np.zeros(1),
+                    -np.ones(2))
+    fortran = lcp.LCP(np.eye(3), -np.ones(3))
+    object.__setattr__(fortran, "M", np.asfortranarray(np.eye(3) + 0.5))
+    column = lcp.LCP(np.eye(3), -np.ones(3))
+    object.__setattr__(column, "q", -np.ones((3, 1)))
+    for odd in (mlcp, fortran, column, "not a problem"):
+        assert batch._stack_lcps([*problems, odd]) is None
+    assert_same_as_loop(problems)
+    assert_same_as_loop([*problems, mlcp, fortran])
