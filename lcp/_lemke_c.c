@@ -391,6 +391,8 @@ static PyMethodDef methods[] = {
      "slots, lcp_init always declines)."},
     {"lcp_init", (PyCFunction)(void (*)(void))py_lcp_init, METH_FASTCALL,
      "lcp_init(self, M, q, name, meta) -> bool: lcp.LCP's quick route (see lcp/_lemke_py.h)."},
+    {"lcp_method", py_lcp_method, METH_VARARGS,
+     "lcp_method(LCP, init) -> LCP's __init__ in C (the quick route; init for the rest)."},
     {"setup", py_setup, METH_VARARGS,
      "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},
     {"run", py_run, METH_VARARGS,

@@ -265,7 +265,8 @@ static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t narg
     Py_RETURN_FALSE;
 }
 
-/* lcp.LCP's __init__, its quick route in one call (lcp/problems/problem.py):
+/* lcp.LCP's __init__, its quick route in one call (lcp/problems/problem.py; lcp_method below
+ * makes it the class's __init__):
  *   lcp_setup(LCP, ndarray, empty) -> bool: the class (its four fields M, q, name, meta plain
  *     object slots: their offsets are read from its member descriptors), numpy.ndarray and
  *     numpy.empty; False when the fields are not such slots (lcp_init then always declines).
@@ -328,22 +329,16 @@ static PyObject *copy_of(PyObject *shape, const void *src, idx bytes)
     return arr;
 }
 
-static PyObject *py_lcp_init(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* The quick route on obj: 1 (the four slots set), 0 (declined: nothing set) or -1 (error). */
+static int lcp_quick(PyObject *obj, PyObject *oM, PyObject *oq, PyObject *name, PyObject *meta)
 {
-    (void)self;
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "lcp_init(self, M, q, name, meta): five arguments");
-        return NULL;
-    }
-    PyObject *obj = args[0];
     Py_buffer vM, vq;
     idx n;
     if (s_lcp_off[0] <= 0 || !PyObject_TypeCheck(obj, (PyTypeObject *)s_lcp_cls) ||
-        Py_TYPE(args[1]) != (PyTypeObject *)s_lcp_ndarray ||
-        Py_TYPE(args[2]) != (PyTypeObject *)s_lcp_ndarray ||
-        !(n = plain_buffers(args[1], args[2], &vM, &vq)))
-        Py_RETURN_FALSE;
-    PyObject *v[4] = {NULL, NULL, args[3], args[4]};
+        Py_TYPE(oM) != (PyTypeObject *)s_lcp_ndarray ||
+        Py_TYPE(oq) != (PyTypeObject *)s_lcp_ndarray || !(n = plain_buffers(oM, oq, &vM, &vq)))
+        return 0;
+    PyObject *v[4] = {NULL, NULL, name, meta};
     PyObject *size = PyLong_FromSsize_t(n), *shape = size ? PyTuple_Pack(2, size, size) : NULL;
     if (shape) {
         v[0] = copy_of(shape, vM.buf, n * n * 8);
@@ -357,12 +352,84 @@ static PyObject *py_lcp_init(PyObject *self, PyObject *const *args, Py_ssize_t n
     else if (v[1] && v[3] != Py_None) Py_INCREF(v[3]);
     if (!v[1]) {
         Py_XDECREF(v[0]);
-        return NULL;
+        return -1;
     }
     Py_INCREF(v[2]);
     for (int k = 0; k < 4; k++) /* the slot may hold a value (__init__ called again) */
         Py_XSETREF(*(PyObject **)((char *)obj + s_lcp_off[k]), v[k]);
-    Py_RETURN_TRUE;
+    return 1;
+}
+
+static PyObject *py_lcp_init(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "lcp_init(self, M, q, name, meta): five arguments");
+        return NULL;
+    }
+    int r = lcp_quick(args[0], args[1], args[2], args[3], args[4]);
+    if (r < 0) return NULL;
+    return PyBool_FromLong(r);
+}
+
+/* lcp_method(LCP, init) -> LCP's __init__ as a method of the class written in C: the quick
+ * route for LCP(M, q[, name[, meta]]) (positional or by keyword), and init -- the Python
+ * __init__, general route and argument errors alike -- for everything else, called with the
+ * same arguments. It saves the Python frame of __init__ for the common call. */
+static PyObject *s_lcp_py_init, *s_lcp_names[4], *s_lcp_noname;
+
+static PyObject *lcp_dunder_init(PyObject *self, PyObject *const *args, size_t nargsf,
+                                 PyObject *kwnames)
+{
+    Py_ssize_t nargs = PyVectorcall_NARGS(nargsf), nkw = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
+    PyObject *a[4] = {NULL, NULL, s_lcp_noname, Py_None}; /* the defaults: name "", meta None */
+    int given = 0, ok = nargs <= 4;
+    for (Py_ssize_t i = 0; ok && i < nargs; i++) a[i] = args[i], given |= 1 << i;
+    for (Py_ssize_t k = 0; ok && k < nkw; k++) { /* M, q, name, meta by keyword */
+        PyObject *key = PyTuple_GET_ITEM(kwnames, k);
+        int j = 0;
+        while (j < 4 && key != s_lcp_names[j] &&
+               !(PyUnicode_Check(key) && PyUnicode_Compare(key, s_lcp_names[j]) == 0))
+            j++;
+        ok = j < 4 && !(given & (1 << j));
+        if (ok) a[j] = args[nargs + k], given |= 1 << j;
+    }
+    if (PyErr_Occurred()) return NULL;
+    if (ok && a[0] && a[1]) {
+        int r = lcp_quick(self, a[0], a[1], a[2], a[3]);
+        if (r < 0) return NULL;
+        if (r) Py_RETURN_NONE;
+    }
+    /* anything else (the general route, missing or unknown arguments): the Python __init__ */
+    PyObject *small[8], **stack = nargs + nkw < 8 ? small
+                                  : (PyObject **)PyMem_Malloc((nargs + nkw + 1) * sizeof(PyObject *));
+    if (!stack) return PyErr_NoMemory();
+    stack[0] = self;
+    memcpy(stack + 1, args, (size_t)(nargs + nkw) * sizeof(PyObject *));
+    PyObject *out = PyObject_Vectorcall(s_lcp_py_init, stack, nargs + 1, kwnames);
+    if (stack != small) PyMem_Free(stack);
+    return out;
+}
+
+static PyMethodDef lcp_init_def = {
+    "__init__", (PyCFunction)(void (*)(void))lcp_dunder_init, METH_FASTCALL | METH_KEYWORDS,
+    "__init__($self, /, M, q, name='', meta=None)\n--\n\n"
+    "w = M z + q, 0 <= z perp w >= 0: M n x n, q of length n (validated, copied)."};
+
+static PyObject *py_lcp_method(PyObject *self, PyObject *args)
+{
+    PyObject *cls, *init;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O", &PyType_Type, &cls, &init)) return NULL;
+    if (!s_lcp_noname) {
+        static const char *const names[4] = {"M", "q", "name", "meta"};
+        for (int k = 0; k < 4; k++)
+            if (!(s_lcp_names[k] = PyUnicode_InternFromString(names[k]))) return NULL;
+        if (!(s_lcp_noname = PyUnicode_FromString(""))) return NULL;
+    }
+    Py_INCREF(init);
+    Py_XSETREF(s_lcp_py_init, init);
+    return PyDescr_NewMethod((PyTypeObject *)cls, &lcp_init_def);
 }
 
 /* An optional float64 vector of length n (None: NULL). */

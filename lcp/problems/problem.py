@@ -124,6 +124,9 @@ class LCP:
 
 if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty):
     _init = _kernel._lemke_c.lcp_init
+    # the common call LCP(M, q) without the Python frame of __init__: a method written in C
+    # takes the quick route and calls the __init__ above for anything else (lcp/_lemke_py.h)
+    LCP.__init__ = _kernel._lemke_c.lcp_method(LCP, LCP.__init__)
 
 
 @dataclass(frozen=True, eq=False)

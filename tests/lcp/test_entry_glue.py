@@ -295,3 +295,21 @@ def test_stack_lcps_groups_and_stacks_as_the_python():
         assert batch._stack_lcps([*problems, odd]) is None
     assert_same_as_loop(problems)
     assert_same_as_loop([*problems, mlcp, fortran])
+
+
+def test_the_constructor_takes_its_arguments_as_the_python_one():
+    """LCP's __init__ (written in C when built) takes M, q, name, meta by position or keyword;
+    missing, repeated or unknown arguments raise the Python __init__'s TypeError."""
+    M, q = np.eye(2) + 0.5, -np.ones(2)
+    assert str(inspect.signature(lcp.LCP)) == "(M, q, name='', meta=None)"
+    for P in (lcp.LCP(M, q, "a", {"k": 1}), lcp.LCP(M=M, q=q, name="a", meta={"k": 1}),
+              lcp.LCP(M, q=q, meta={"k": 1}, name="a")):
+        assert same(P.M, M) and same(P.q, q) and (P.name, P.meta) == ("a", {"k": 1})
+    for args, kwargs, message in (((M,), {}, "missing 1 required positional argument: 'q'"),
+                                  ((M, q), {"foo": 1}, "unexpected keyword argument 'foo'"),
+                                  ((M, q), {"q": q}, "multiple values for argument 'q'"),
+                                  ((M, q, "", None, 5), {}, "positional arguments")):
+        with pytest.raises(TypeError, match=message):
+            lcp.LCP(*args, **kwargs)
+    with pytest.raises(lcp.InvalidProblem, match="NaN or Inf"):
+        lcp.LCP(M=M, q=np.array([np.nan, 1.0]))
