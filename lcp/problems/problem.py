@@ -21,8 +21,9 @@ from ..errors import InvalidProblem, NotApplicable
 from ..io.files import atomic_write
 
 #: LCP.__init__'s quick route (lcp/_lemke_py.h: lcp_init), set below once the class exists;
-#: None when the C extension is not built.
-_init = None
+#: None when the C extension is not built (and with it LCP.__init__ in C, `_py_init` the Python
+#: one it replaces).
+_init = _py_init = None
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
@@ -126,7 +127,8 @@ if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty):
     _init = _kernel._lemke_c.lcp_init
     # the common call LCP(M, q) without the Python frame of __init__: a method written in C
     # takes the quick route and calls the __init__ above for anything else (lcp/_lemke_py.h)
-    LCP.__init__ = _kernel._lemke_c.lcp_method(LCP, LCP.__init__)
+    _py_init = LCP.__init__  # the Python __init__ (benchmarks and tests switch back to it)
+    LCP.__init__ = _kernel._lemke_c.lcp_method(LCP, _py_init)
 
 
 @dataclass(frozen=True, eq=False)

@@ -205,22 +205,21 @@ def test_lcp_is_slotted_frozen_and_copied_through_its_constructor():
 
 
 @pytest.mark.parametrize("quick", [True, False])
-def test_the_quick_route_sets_what_the_general_route_sets(quick):
-    saved = problem_module._init
-    if not quick:
-        problem_module._init = None
-    try:
-        rng = np.random.default_rng(3)
-        M, q = rng.standard_normal((5, 5)), rng.standard_normal(5)
-        meta = {"a": 1}
-        P = lcp.LCP(M, q, "x", meta)
+def test_the_quick_route_sets_what_the_general_route_sets(quick, monkeypatch):
+    if not quick:  # the Python __init__ without its quick route
+        monkeypatch.setattr(problem_module, "_init", None)
+        if problem_module._py_init is not None:
+            monkeypatch.setattr(lcp.LCP, "__init__", problem_module._py_init)
+    rng = np.random.default_rng(3)
+    M, q = rng.standard_normal((5, 5)), rng.standard_normal(5)
+    meta = {"a": 1}
+    P = lcp.LCP(M, q, "x", meta)
 
-        class Sub(lcp.LCP):
-            pass
+    class Sub(lcp.LCP):
+        pass
 
-        S = Sub(M, q)
-    finally:
-        problem_module._init = saved
+    S = Sub(M, q)
+    monkeypatch.undo()
     G = lcp.LCP(M.tolist(), q.tolist(), "x", meta)  # lists: the general route
     assert same(P.M, G.M) and same(P.q, G.q) and P.meta is meta and P.name == "x"
     assert P.M.flags.owndata and P.M.flags.c_contiguous and P.M.flags.writeable
