@@ -137,28 +137,30 @@ static PyObject *py_stack_lcps(PyObject *self, PyObject *args)
         PyErr_SetString(PyExc_RuntimeError, "stack_lcps: solve_setup was not called");
         return NULL;
     }
-    idx k = PyList_GET_SIZE(list), groups = 0;
-    idx *ns = (idx *)malloc((size_t)(k + 1) * (2 * sizeof(idx) + 2 * sizeof(void *)));
+    static PyObject *key_M, *key_q;
+    if (!key_M && (!(key_M = PyUnicode_InternFromString("M")) ||
+                   !(key_q = PyUnicode_InternFromString("q"))))
+        return NULL;
+    idx k = PyList_GET_SIZE(list), groups = 0, held = 0;
+    idx *ns = (idx *)malloc((size_t)(k + 1) * (2 * sizeof(idx) + 4 * sizeof(void *)));
     if (!ns) return PyErr_NoMemory();
     idx *sizes = ns + k + 1; /* the distinct sizes, in order */
     const double **data = (const double **)(sizes + k + 1);
-    PyObject *result = NULL, *M = NULL, *q = NULL;
-    for (idx p = 0; p < k; p++) { /* each problem's n and data pointers (the arrays are the
-                                   * problems' own: alive, and no Python runs until the end) */
+    PyObject **refs = (PyObject **)(data + 2 * (k + 1)), *result = NULL;
+    for (idx p = 0; p < k; p++) { /* each problem's n and data pointers; its M and q are held
+                                   * to the end (an attribute may be made on the fly) */
         PyObject *obj = PyList_GET_ITEM(list, p);
         Py_buffer vM, vq;
         if (!PyObject_TypeCheck(obj, (PyTypeObject *)cls)) goto decline;
-        if (!(M = PyObject_GetAttrString(obj, "M")) || !(q = PyObject_GetAttrString(obj, "q")))
-            goto fail;
-        idx n = plain_arrays(M, q, &vM, &vq, 0);
-        if (n > 0) {
-            data[2 * p] = (const double *)vM.buf, data[2 * p + 1] = (const double *)vq.buf;
-            PyBuffer_Release(&vM);
-            PyBuffer_Release(&vq);
-        }
-        Py_CLEAR(M);
-        Py_CLEAR(q);
+        if (!(refs[held] = PyObject_GetAttr(obj, key_M))) goto fail;
+        held++;
+        if (!(refs[held] = PyObject_GetAttr(obj, key_q))) goto fail;
+        held++;
+        idx n = plain_arrays(refs[held - 2], refs[held - 1], &vM, &vq, 0);
         if (n < 1) goto decline;
+        data[2 * p] = (const double *)vM.buf, data[2 * p + 1] = (const double *)vq.buf;
+        PyBuffer_Release(&vM);
+        PyBuffer_Release(&vq);
         ns[p] = n;
         idx g = 0;
         while (g < groups && sizes[g] != n) g++;
@@ -195,17 +197,16 @@ static PyObject *py_stack_lcps(PyObject *self, PyObject *args)
         if (!entry) goto fail;
         PyList_SET_ITEM(result, g, entry);
     }
+    goto done;
+decline:
+    result = Py_NewRef(Py_None);
+    goto done;
+fail:
+    Py_CLEAR(result);
+done:
+    while (held) Py_DECREF(refs[--held]);
     free(ns);
     return result;
-decline:
-    free(ns);
-    Py_RETURN_NONE;
-fail:
-    Py_XDECREF(M);
-    Py_XDECREF(q);
-    Py_XDECREF(result);
-    free(ns);
-    return NULL;
 }
 
 #endif /* RIGIDLCP_BATCH_SOLUTIONS_H */
