@@ -387,7 +387,7 @@ static PyMethodDef methods[] = {
     {"plain", (PyCFunction)(void (*)(void))py_plain, METH_FASTCALL,
      "plain(M, q) -> bool: C-contiguous native float64 q (n >= 1) and M (n x n), all finite."},
     {"lcp_setup", py_lcp_setup, METH_VARARGS,
-     "lcp_setup(LCP, ndarray, empty) -> bool: lcp_init's class (False: its fields are not plain "
+     "lcp_setup(LCP, ndarray, empty, float64) -> bool: lcp_init's class (False: its fields are not plain "
      "slots, lcp_init always declines)."},
     {"lcp_init", (PyCFunction)(void (*)(void))py_lcp_init, METH_FASTCALL,
      "lcp_init(self, M, q, name, meta) -> bool: lcp.LCP's quick route (see lcp/_lemke_py.h)."},

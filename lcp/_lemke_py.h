@@ -202,23 +202,58 @@ static int native_double(const Py_buffer *v)
     return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
 }
 
+/* numpy.dtype('float64') itself (lcp_setup gives it; NULL before). An array whose dtype is this
+ * very object holds native float64 values, so its buffer is asked for without a format string:
+ * numpy builds one and compares it by strcmp for every buffer with a format, a tenth of the
+ * glue of a small solve. Any other dtype object (a float64 with metadata, an unpickled one,
+ * another type) is tested by its format as before. */
+static PyObject *s_f64, *s_dtype_key;
+
+static int is_float64(PyObject *obj)
+{
+    if (!s_f64) return 0;
+    PyObject *d = PyObject_GetAttr(obj, s_dtype_key);
+    if (!d) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = d == s_f64;
+    Py_DECREF(d);
+    return ok;
+}
+
+/* get_buffer(obj, view, name, 'd', size, 0): the same buffer and errors, its format string
+ * asked for only when the dtype is not numpy's float64 itself. */
+static int get_float64(PyObject *obj, Py_buffer *view, const char *name, idx size)
+{
+    if (!is_float64(obj)) return get_buffer(obj, view, name, 'd', size, 0);
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    if (view->itemsize != 8 || view->len / 8 != size) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd float64 values", name, size);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
 /* Are oq a C-contiguous native float64 vector of n >= 1 entries and oM a C-contiguous native
  * float64 n x n matrix (all entries finite, when `finite`)? Returns n, with both buffers held
  * (the caller releases vM and vq), or 0 with none held, never an error. */
 static idx plain_arrays(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq, int finite)
 {
-    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
-    if (PyObject_GetBuffer(oq, vq, flags) < 0) {
+    int fq = is_float64(oq), fM = is_float64(oM); /* then no format string is needed */
+    if (PyObject_GetBuffer(oq, vq, PyBUF_C_CONTIGUOUS | (fq ? 0 : PyBUF_FORMAT)) < 0) {
         PyErr_Clear();
         return 0;
     }
-    if (PyObject_GetBuffer(oM, vM, flags) < 0) {
+    if (PyObject_GetBuffer(oM, vM, PyBUF_C_CONTIGUOUS | (fM ? 0 : PyBUF_FORMAT)) < 0) {
         PyErr_Clear();
         PyBuffer_Release(vq);
         return 0;
     }
     idx n = vq->ndim == 1 ? vq->shape[0] : 0;
-    int ok = n >= 1 && native_double(vq) && native_double(vM) && vM->ndim == 2 &&
+    int ok = n >= 1 && (fq ? vq->itemsize == 8 : native_double(vq)) &&
+             (fM ? vM->itemsize == 8 : native_double(vM)) && vM->ndim == 2 &&
              vM->shape[0] == n && vM->shape[1] == n;
     if (ok && finite) {
         const double *M = (const double *)vM->buf, *q = (const double *)vq->buf;
@@ -267,9 +302,10 @@ static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t narg
 
 /* lcp.LCP's __init__, its quick route in one call (lcp/problems/problem.py; lcp_method below
  * makes it the class's __init__):
- *   lcp_setup(LCP, ndarray, empty) -> bool: the class (its four fields M, q, name, meta plain
- *     object slots: their offsets are read from its member descriptors), numpy.ndarray and
- *     numpy.empty; False when the fields are not such slots (lcp_init then always declines).
+ *   lcp_setup(LCP, ndarray, empty, float64) -> bool: the class (its four fields M, q, name,
+ *     meta plain object slots: their offsets are read from its member descriptors),
+ *     numpy.ndarray, numpy.empty and numpy.dtype('float64'); False when the fields are not
+ *     such slots (lcp_init then always declines).
  *   lcp_init(self, M, q, name, meta) -> bool: when M and q are numpy arrays (exactly) of plain
  *     finite data (plain_buffers), the four slots receive copies of M and q, name and meta
  *     ({} when None) and True is returned; else False and nothing is set (the Python
@@ -281,10 +317,13 @@ static Py_ssize_t s_lcp_off[4] = {-1};
 
 static PyObject *py_lcp_setup(PyObject *self, PyObject *args)
 {
-    PyObject *cls, *nd, *empty;
+    PyObject *cls, *nd, *empty, *f64;
     (void)self;
-    if (!PyArg_ParseTuple(args, "O!O!O", &PyType_Type, &cls, &PyType_Type, &nd, &empty))
+    if (!PyArg_ParseTuple(args, "O!O!OO", &PyType_Type, &cls, &PyType_Type, &nd, &empty, &f64))
         return NULL;
+    if (!s_dtype_key && !(s_dtype_key = PyUnicode_InternFromString("dtype"))) return NULL;
+    Py_INCREF(f64);
+    Py_XSETREF(s_f64, f64);
     static const char *const names[4] = {"M", "q", "name", "meta"};
     Py_ssize_t off[4];
     int ok = ((PyTypeObject *)cls)->tp_dictoffset == 0;
@@ -459,8 +498,8 @@ static idx problem_data(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
         return -1;
     }
-    if (get_buffer(oq, vq, "q", 'd', n, 0) < 0) return -1;
-    if (get_buffer(oM, vM, "M", 'd', n * n, 0) < 0) return -1;
+    if (get_float64(oq, vq, "q", n) < 0) return -1;
+    if (get_float64(oM, vM, "M", n * n) < 0) return -1;
     return n;
 }
 

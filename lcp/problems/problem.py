@@ -123,7 +123,8 @@ class LCP:
         return f"<LCP{label} n={self.n}>"
 
 
-if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty):
+if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty,
+                                                      np.dtype(np.float64)):
     _init = _kernel._lemke_c.lcp_init
     # the common call LCP(M, q) without the Python frame of __init__: a method written in C
     # takes the quick route and calls the __init__ above for anything else (lcp/_lemke_py.h)

@@ -312,3 +312,25 @@ def test_the_constructor_takes_its_arguments_as_the_python_one():
             lcp.LCP(*args, **kwargs)
     with pytest.raises(lcp.InvalidProblem, match="NaN or Inf"):
         lcp.LCP(M=M, q=np.array([np.nan, 1.0]))
+
+
+@compiled
+@pytest.mark.parametrize("dtype", ["unpickled", "metadata"])
+def test_float64_arrays_with_another_dtype_object_are_tested_by_their_format(dtype):
+    """The C calls skip numpy's format string for arrays whose dtype is numpy's float64 itself;
+    a float64 array with another dtype object (unpickled, or with metadata) is tested by its
+    format as before: the same quick route, the same Solution."""
+    M, q = _problem(6, "psd", 2)
+    if dtype == "unpickled":
+        M2, q2 = pickle.loads(pickle.dumps(M)), pickle.loads(pickle.dumps(q))
+    else:
+        f64 = np.dtype(np.float64, metadata={"unit": "N"})
+        M2, q2 = M.astype(f64), q.astype(f64)
+    assert M2.dtype is not np.dtype(np.float64) and M2.dtype == np.float64
+    assert kernel._lemke_c.lcp_init(lcp.LCP(M, q), M2, q2, "", None) is True
+    P, P2 = lcp.LCP(M, q), lcp.LCP(np.eye(6), np.ones(6))
+    object.__setattr__(P2, "M", M2)
+    object.__setattr__(P2, "q", q2)
+    assert same_outcome(fast_lemke.entry(P2), fast_lemke.solve_lemke(P2))
+    assert fast_lemke.entry(P2) is not None
+    assert same(fast_lemke.entry(P2).z, fast_lemke.entry(P).z)
