@@ -7,6 +7,7 @@ MLCP(A, C, D, B, a, b): A u + C v + a = 0,    w = D u + B v + b,    0 <= v  perp
 
 from __future__ import annotations
 
+import inspect
 import json
 import os
 from dataclasses import dataclass, field
@@ -130,6 +131,10 @@ if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty,
     # takes the quick route and calls the __init__ above for anything else (lcp/_lemke_py.h)
     _py_init = LCP.__init__  # the Python __init__ (benchmarks and tests switch back to it)
     LCP.__init__ = _kernel._lemke_c.lcp_method(LCP, _py_init)
+    # the class's signature stays the Python __init__'s (inspect reads a C __init__ from its
+    # text signature, and Python 3.13's inspect cannot bind a method descriptor to the class)
+    _signature = inspect.signature(_py_init)
+    LCP.__signature__ = _signature.replace(parameters=list(_signature.parameters.values())[1:])
 
 
 @dataclass(frozen=True, eq=False)

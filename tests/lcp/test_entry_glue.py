@@ -300,7 +300,8 @@ def test_the_constructor_takes_its_arguments_as_the_python_one():
     """LCP's __init__ (written in C when built) takes M, q, name, meta by position or keyword;
     missing, repeated or unknown arguments raise the Python __init__'s TypeError."""
     M, q = np.eye(2) + 0.5, -np.ones(2)
-    assert str(inspect.signature(lcp.LCP)) == "(M, q, name='', meta=None)"
+    assert str(inspect.signature(lcp.LCP)) == (
+        "(M: 'Any', q: 'Any', name: 'str' = '', meta: 'dict | None' = None) -> 'None'")
     for P in (lcp.LCP(M, q, "a", {"k": 1}), lcp.LCP(M=M, q=q, name="a", meta={"k": 1}),
               lcp.LCP(M, q=q, meta={"k": 1}, name="a")):
         assert same(P.M, M) and same(P.q, q) and (P.name, P.meta) == ("a", {"k": 1})
