@@ -7,7 +7,10 @@ q ~ N(0, 1)) are timed in each of these ways, by the CPU time of the calling thr
   natural        lcp.solve(lcp.LCP(M, q))
   prebuilt       lcp.solve(P)
   LCP            lcp.LCP(M, q)
-  solve_lemke    lcp.solvers.fast_lemke.solve_lemke(P)   (the fast path, without lcp.solve)
+  solve_lemke    lcp.solvers.fast_lemke.solve_lemke(P)   (the fast path in Python, without
+                                                         lcp.solve)
+  entry          lcp.solvers.fast_lemke.entry(P)         (the same steps in C, solve_default:
+                                                         what lcp.solve(P) calls)
   C call         its one C call, _lemke_c.solve_lcp       (solve, acceptance, M z, measure,
                                                          the Solution)
   solve+accept   _lemke_c.solve_accept                   (the solve and its acceptance)
@@ -60,6 +63,7 @@ def parts(n: int, repeats: int) -> list[float]:
         (lcp.solve, problems),
         (lcp.LCP, pairs),
         (fast_lemke.solve_lemke, problems),
+        (fast_lemke.entry, problems),
         (lambda M, q: c.solve_lcp(M, q, tol, max_iter, upto), pairs),
         (lambda M, q: c.solve_accept(M, q, tol, max_iter, z, basis), pairs),
         (lambda M, q: c.solve_eq(M, q, None, None, None, tol, max_iter, z, basis), pairs),
@@ -78,8 +82,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     print(f"CPU us per call, best of {args.repeats}; load average {os.getloadavg()[0]:.2f}; "
           f"M z by numpy's own gemv from C: {kernel.numpy_gemv()}")
-    ways = ("natural", "prebuilt", "LCP", "solve_lemke", "C call", "solve+accept", "solve",
-            "np.dot")
+    ways = ("natural", "prebuilt", "LCP", "solve_lemke", "entry", "C call", "solve+accept",
+            "solve", "np.dot")
     print(f"{'n':>4} " + " ".join(f"{w:>13}" for w in ways))
     for n in [int(s) for s in args.sizes.split(",") if s.strip()]:
         times = parts(n, args.repeats)

@@ -33,7 +33,11 @@
  *                     scaled dictionary (+ AVX2 pass over M), solve_problem, the work array,
  *                     the acceptance of the answer
  *   _lemke_measure.h  the acceptance measure: abs_row_sums, lcp_measure, lcp_measure_batch
- *   _lemke_solution.h solve_lcp: solve_fast's work, the verdict and the Solution in one call
+ *   _lemke_solution.h solve_lcp: solve_fast's work, the verdict and the Solution in one call;
+ *                     solve_default: lcp.solve's default call, from the problem object
+ *   _solve_entry.h    Entry: lcp.solve as an object whose default call goes to api._FAST
+ *   _batch_solutions.h batch_solutions, stack_lcps: lcp.solve_many's stacks, verdicts and
+ *                     Solutions
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -52,6 +56,8 @@ typedef Py_ssize_t idx;
 #include "_lemke_problem.h"
 #include "_lemke_measure.h"
 #include "_lemke_solution.h" /* solve_setup, solve_lcp: solve_fast and its Solution */
+#include "_solve_entry.h"     /* Entry: lcp.solve's default call straight to C */
+#include "_batch_solutions.h" /* batch_solutions: lcp.solve_many's Solutions */
 
 /* solve_eq(M, q, r, c, d, tol, max_iter, z, basis) -> (code, pivots, nbasis, bounds): one LCP
  * as lcp.solve gives it to lemke() by default, on its equilibrated data: r = c = None for the
@@ -351,6 +357,17 @@ static PyMethodDef methods[] = {
     {"solve_lcp", (PyCFunction)(void (*)(void))py_solve_lcp, METH_FASTCALL,
      "solve_lcp(M, q, tol, max_iter, upto) -> Solution, or solve_fast's numbers and (z, w, "
      "basis): see lcp/_lemke_solution.h."},
+    {"batch_solutions", py_batch_solutions, METH_VARARGS,
+     "batch_solutions(Z, W, basic, codes, pivots, acc, measured, tol, ferr_tol, equilibrated) -> "
+     "list of Solution or None (see lcp/_batch_solutions.h)."},
+    {"stack_lcps", py_stack_lcps, METH_VARARGS,
+     "stack_lcps(problems, LCP) -> [(n, indices, Ms, qs), ...] or None: solve_many's stacks."},
+    {"solve_default", py_solve_default, METH_O,
+     "solve_default(problem) -> Solution or None: lcp.solve's default call on an lcp.LCP (see "
+     "lcp/_lemke_solution.h)."},
+    {"entry_setup", py_entry_setup, METH_VARARGS,
+     "entry_setup(registry, kernel_dict, lemke, finish, ndarray, tol, upto): solve_default's "
+     "objects."},
     {"gemv_setup", py_gemv_setup, METH_VARARGS,
      "gemv_setup(address, ilp64): numpy's cblas_dgemv for M z (0: none; see lcp/_blas.h)."},
     {"gemv", py_gemv, METH_VARARGS,
@@ -370,6 +387,13 @@ static PyMethodDef methods[] = {
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},
     {"plain", (PyCFunction)(void (*)(void))py_plain, METH_FASTCALL,
      "plain(M, q) -> bool: C-contiguous native float64 q (n >= 1) and M (n x n), all finite."},
+    {"lcp_setup", py_lcp_setup, METH_VARARGS,
+     "lcp_setup(LCP, ndarray, empty, float64) -> bool: lcp_init's class (False: its fields are not plain "
+     "slots, lcp_init always declines)."},
+    {"lcp_init", (PyCFunction)(void (*)(void))py_lcp_init, METH_FASTCALL,
+     "lcp_init(self, M, q, name, meta) -> bool: lcp.LCP's quick route (see lcp/_lemke_py.h)."},
+    {"lcp_method", py_lcp_method, METH_VARARGS,
+     "lcp_method(LCP, init) -> LCP's __init__ in C (the quick route; init for the rest)."},
     {"setup", py_setup, METH_VARARGS,
      "setup(T, M, q, d) -> (mu, nu, delta): the normalized dictionary (see lcp/lemke.py)."},
     {"run", py_run, METH_VARARGS,
@@ -381,4 +405,10 @@ static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_lemke_c",
                                     "Lemke's pivot loop in C (see lcp/_lemke_kernel.py).", -1,
                                     methods};
 
-PyMODINIT_FUNC PyInit__lemke_c(void) { return PyModule_Create(&module); }
+PyMODINIT_FUNC PyInit__lemke_c(void)
+{
+    if (PyType_Ready(&EntryType) < 0) return NULL;
+    PyObject *m = PyModule_Create(&module);
+    if (m && PyModule_AddObjectRef(m, "Entry", (PyObject *)&EntryType) < 0) Py_CLEAR(m);
+    return m;
+}

@@ -1,10 +1,21 @@
 /* The Python side of one dictionary (included by lcp/_lemke_c.c): the buffer checks of the
- * arguments (opt_vector, release, problem_data; get_buffer from _buffer.h) and the entry points of lcp/_lemke_kernel.py and
- * lcp.LCP that work on one dictionary or on the data as given: run, setup, check, plain. The
+ * arguments (opt_vector, release, problem_data; get_buffer from _buffer.h) and the entry
+ * points of lcp/_lemke_kernel.py and lcp.LCP that work on one dictionary or on the data as
+ * given: run, setup, check, plain, and lcp.LCP's quick __init__ (lcp_setup, lcp_init). The
  * includer includes <Python.h>, <float.h>, <math.h>, acceptance/_accuracy_core.h
  * (abs_max_finite) and _lemke_run.h. */
 #ifndef RIGIDLCP_LEMKE_PY_H
 #define RIGIDLCP_LEMKE_PY_H
+
+#ifndef Py_T_OBJECT_EX /* Python < 3.12: structmember.h's names (the slots of a
+                        * class: lcp_setup here, solve_setup in _lemke_solution.h) */
+#include <structmember.h>
+#define SLOT_OBJECT_EX T_OBJECT_EX
+#define SLOT_READONLY READONLY
+#else
+#define SLOT_OBJECT_EX Py_T_OBJECT_EX
+#define SLOT_READONLY Py_READONLY
+#endif
 
 /* ------------------------------------------------------------------ Python binding */
 #include "_buffer.h" /* get_buffer: shared with solvers/_pivot_c.c */
@@ -192,6 +203,88 @@ static int native_double(const Py_buffer *v)
     return v->itemsize == 8 && f[0] == 'd' && f[1] == 0;
 }
 
+/* numpy.dtype('float64') itself (lcp_setup gives it; NULL before). An array whose dtype is this
+ * very object holds native float64 values, so its buffer is asked for without a format string:
+ * numpy builds one and compares it by strcmp for every buffer with a format, a tenth of the
+ * glue of a small solve. Any other dtype object (a float64 with metadata, an unpickled one,
+ * another type) is tested by its format as before. */
+static PyObject *s_f64, *s_dtype_key;
+
+static int is_float64(PyObject *obj)
+{
+    if (!s_f64) return 0;
+    PyObject *d = PyObject_GetAttr(obj, s_dtype_key);
+    if (!d) {
+        PyErr_Clear();
+        return 0;
+    }
+    int ok = d == s_f64;
+    Py_DECREF(d);
+    return ok;
+}
+
+/* get_buffer(obj, view, name, 'd', size, 0): the same buffer and errors, its format string
+ * asked for only when the dtype is not numpy's float64 itself. */
+static int get_float64(PyObject *obj, Py_buffer *view, const char *name, idx size)
+{
+    if (!is_float64(obj)) return get_buffer(obj, view, name, 'd', size, 0);
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    if (view->itemsize != 8 || view->len / 8 != size) {
+        PyErr_Format(PyExc_ValueError, "%s: expected %zd float64 values", name, size);
+        PyBuffer_Release(view);
+        return -1;
+    }
+    return 0;
+}
+
+/* Are oq a C-contiguous native float64 vector of n >= 1 entries and oM a C-contiguous native
+ * float64 n x n matrix (all entries finite, when `finite`)? Returns n, with both buffers held
+ * (the caller releases vM and vq), or 0 with none held, never an error. */
+static idx plain_arrays(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq, int finite)
+{
+    int fq = is_float64(oq), fM = is_float64(oM); /* then no format string is needed */
+    if (PyObject_GetBuffer(oq, vq, PyBUF_C_CONTIGUOUS | (fq ? 0 : PyBUF_FORMAT)) < 0) {
+        PyErr_Clear();
+        return 0;
+    }
+    if (PyObject_GetBuffer(oM, vM, PyBUF_C_CONTIGUOUS | (fM ? 0 : PyBUF_FORMAT)) < 0) {
+        PyErr_Clear();
+        PyBuffer_Release(vq);
+        return 0;
+    }
+    idx n = vq->ndim == 1 ? vq->shape[0] : 0;
+    int ok = n >= 1 && (fq ? vq->itemsize == 8 : native_double(vq)) &&
+             (fM ? vM->itemsize == 8 : native_double(vM)) && vM->ndim == 2 &&
+             vM->shape[0] == n && vM->shape[1] == n;
+    if (ok && finite) {
+        const double *M = (const double *)vM->buf, *q = (const double *)vq->buf;
+        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
+        int all = abs_max_finite(M, n * n, &top);
+        for (idx i = 0; i < n; i++) all &= fabs(q[i]) <= DBL_MAX;
+        ok = all;
+    }
+    if (ok) return n;
+    PyBuffer_Release(vM);
+    PyBuffer_Release(vq);
+    return 0;
+}
+
+/* plain_arrays with the finiteness test. */
+static idx plain_buffers(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq)
+{
+    return plain_arrays(oM, oq, vM, vq, 1);
+}
+
+/* The same test, the buffers released (0 or 1). */
+static int plain_data(PyObject *oM, PyObject *oq)
+{
+    Py_buffer vM, vq;
+    if (!plain_buffers(oM, oq, &vM, &vq)) return 0;
+    PyBuffer_Release(&vM);
+    PyBuffer_Release(&vq);
+    return 1;
+}
+
 /* plain(M, q) -> bool: lcp.LCP's quick route -- is q a C-contiguous native float64 vector of
  * n >= 1 entries and M a C-contiguous native float64 n x n matrix, all entries finite? (Then
  * M and q need no conversion, only the copies.) False for anything else, never an error: the
@@ -204,31 +297,179 @@ static PyObject *py_plain(PyObject *self, PyObject *const *args, Py_ssize_t narg
         PyErr_SetString(PyExc_TypeError, "plain(M, q): two arguments");
         return NULL;
     }
-    Py_buffer vq, vM;
-    const int flags = PyBUF_FORMAT | PyBUF_C_CONTIGUOUS;
-    if (PyObject_GetBuffer(args[1], &vq, flags) < 0) {
-        PyErr_Clear();
-        Py_RETURN_FALSE;
+    if (plain_data(args[0], args[1])) Py_RETURN_TRUE;
+    Py_RETURN_FALSE;
+}
+
+/* lcp.LCP's __init__, its quick route in one call (lcp/problems/problem.py; lcp_method below
+ * makes it the class's __init__):
+ *   lcp_setup(LCP, ndarray, empty, float64) -> bool: the class (its four fields M, q, name,
+ *     meta plain object slots: their offsets are read from its member descriptors),
+ *     numpy.ndarray, numpy.empty and numpy.dtype('float64'); False when the fields are not
+ *     such slots (lcp_init then always declines).
+ *   lcp_init(self, M, q, name, meta) -> bool: when M and q are numpy arrays (exactly) of plain
+ *     finite data (plain_buffers), the four slots receive copies of M and q, name and meta
+ *     ({} when None) and True is returned; else False and nothing is set (the Python
+ *     validation runs and raises the typed error). A copy is numpy.empty of the shape (float64,
+ *     C order, its own data) and the bytes of the data: what M.copy() makes, without numpy's
+ *     general copy machinery (casts, iterators, overlap test: half the constructor's time). */
+static PyObject *s_lcp_cls, *s_lcp_ndarray, *s_lcp_empty;
+static Py_ssize_t s_lcp_off[4] = {-1};
+
+static PyObject *py_lcp_setup(PyObject *self, PyObject *args)
+{
+    PyObject *cls, *nd, *empty, *f64;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O!OO", &PyType_Type, &cls, &PyType_Type, &nd, &empty, &f64))
+        return NULL;
+    if (!s_dtype_key && !(s_dtype_key = PyUnicode_InternFromString("dtype"))) return NULL;
+    Py_INCREF(f64);
+    Py_XSETREF(s_f64, f64);
+    static const char *const names[4] = {"M", "q", "name", "meta"};
+    Py_ssize_t off[4];
+    int ok = ((PyTypeObject *)cls)->tp_dictoffset == 0;
+    for (int k = 0; ok && k < 4; k++) {
+        PyObject *dsc = PyDict_GetItemString(((PyTypeObject *)cls)->tp_dict, names[k]);
+        ok = dsc && Py_IS_TYPE(dsc, &PyMemberDescr_Type);
+        if (ok) {
+            PyMemberDef *md = ((PyMemberDescrObject *)dsc)->d_member;
+            ok = md->type == SLOT_OBJECT_EX && !(md->flags & SLOT_READONLY) && md->offset > 0;
+            off[k] = md->offset;
+        }
     }
-    if (PyObject_GetBuffer(args[0], &vM, flags) < 0) {
-        PyErr_Clear();
-        PyBuffer_Release(&vq);
-        Py_RETURN_FALSE;
+    s_lcp_off[0] = -1;
+    PyObject **slots[3] = {&s_lcp_cls, &s_lcp_ndarray, &s_lcp_empty};
+    PyObject *given[3] = {cls, nd, empty};
+    for (int k = 0; k < 3; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
     }
-    idx n = vq.ndim == 1 ? vq.shape[0] : 0;
-    int ok = n >= 1 && native_double(&vq) && native_double(&vM) && vM.ndim == 2 &&
-             vM.shape[0] == n && vM.shape[1] == n;
-    if (ok) {
-        const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
-        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
-        int finite = abs_max_finite(M, n * n, &top);
-        for (idx i = 0; i < n; i++) finite &= fabs(q[i]) <= DBL_MAX;
-        ok = finite;
+    if (ok) memcpy(s_lcp_off, off, sizeof off);
+    return PyBool_FromLong(ok);
+}
+
+/* A new float64 array of `shape` (an int or a tuple) holding the `bytes` bytes at src. */
+static PyObject *copy_of(PyObject *shape, const void *src, idx bytes)
+{
+    PyObject *arr = PyObject_Vectorcall(s_lcp_empty, &shape, 1, NULL);
+    if (!arr) return NULL;
+    Py_buffer v;
+    if (PyObject_GetBuffer(arr, &v, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) {
+        Py_DECREF(arr);
+        return NULL;
+    }
+    if (v.len != bytes) {
+        PyErr_SetString(PyExc_ValueError, "lcp_init: numpy.empty gave an array of another size");
+        PyBuffer_Release(&v);
+        Py_DECREF(arr);
+        return NULL;
+    }
+    memcpy(v.buf, src, (size_t)bytes);
+    PyBuffer_Release(&v);
+    return arr;
+}
+
+/* The quick route on obj: 1 (the four slots set), 0 (declined: nothing set) or -1 (error). */
+static int lcp_quick(PyObject *obj, PyObject *oM, PyObject *oq, PyObject *name, PyObject *meta)
+{
+    Py_buffer vM, vq;
+    idx n;
+    if (s_lcp_off[0] <= 0 || !PyObject_TypeCheck(obj, (PyTypeObject *)s_lcp_cls) ||
+        Py_TYPE(oM) != (PyTypeObject *)s_lcp_ndarray ||
+        Py_TYPE(oq) != (PyTypeObject *)s_lcp_ndarray || !(n = plain_buffers(oM, oq, &vM, &vq)))
+        return 0;
+    PyObject *v[4] = {NULL, NULL, name, meta};
+    PyObject *size = PyLong_FromSsize_t(n), *shape = size ? PyTuple_Pack(2, size, size) : NULL;
+    if (shape) {
+        v[0] = copy_of(shape, vM.buf, n * n * 8);
+        v[1] = v[0] ? copy_of(size, vq.buf, n * 8) : NULL;
     }
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vq);
-    if (ok) Py_RETURN_TRUE;
-    Py_RETURN_FALSE;
+    Py_XDECREF(shape);
+    Py_XDECREF(size);
+    if (v[1] && v[3] == Py_None && !(v[3] = PyDict_New())) Py_CLEAR(v[1]);
+    else if (v[1] && v[3] != Py_None) Py_INCREF(v[3]);
+    if (!v[1]) {
+        Py_XDECREF(v[0]);
+        return -1;
+    }
+    Py_INCREF(v[2]);
+    for (int k = 0; k < 4; k++) /* the slot may hold a value (__init__ called again) */
+        Py_XSETREF(*(PyObject **)((char *)obj + s_lcp_off[k]), v[k]);
+    return 1;
+}
+
+static PyObject *py_lcp_init(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "lcp_init(self, M, q, name, meta): five arguments");
+        return NULL;
+    }
+    int r = lcp_quick(args[0], args[1], args[2], args[3], args[4]);
+    if (r < 0) return NULL;
+    return PyBool_FromLong(r);
+}
+
+/* lcp_method(LCP, init) -> LCP's __init__ as a method of the class written in C: the quick
+ * route for LCP(M, q[, name[, meta]]) (positional or by keyword), and init -- the Python
+ * __init__, general route and argument errors alike -- for everything else, called with the
+ * same arguments. It saves the Python frame of __init__ for the common call. */
+static PyObject *s_lcp_py_init, *s_lcp_names[4], *s_lcp_noname;
+
+static PyObject *lcp_dunder_init(PyObject *self, PyObject *const *args, size_t nargsf,
+                                 PyObject *kwnames)
+{
+    Py_ssize_t nargs = PyVectorcall_NARGS(nargsf), nkw = kwnames ? PyTuple_GET_SIZE(kwnames) : 0;
+    PyObject *a[4] = {NULL, NULL, s_lcp_noname, Py_None}; /* the defaults: name "", meta None */
+    int given = 0, ok = nargs <= 4;
+    for (Py_ssize_t i = 0; ok && i < nargs; i++) a[i] = args[i], given |= 1 << i;
+    for (Py_ssize_t k = 0; ok && k < nkw; k++) { /* M, q, name, meta by keyword */
+        PyObject *key = PyTuple_GET_ITEM(kwnames, k);
+        int j = 0;
+        while (j < 4 && key != s_lcp_names[j] &&
+               !(PyUnicode_Check(key) && PyUnicode_Compare(key, s_lcp_names[j]) == 0))
+            j++;
+        ok = j < 4 && !(given & (1 << j));
+        if (ok) a[j] = args[nargs + k], given |= 1 << j;
+    }
+    if (PyErr_Occurred()) return NULL;
+    if (ok && a[0] && a[1]) {
+        int r = lcp_quick(self, a[0], a[1], a[2], a[3]);
+        if (r < 0) return NULL;
+        if (r) Py_RETURN_NONE;
+    }
+    /* anything else (the general route, missing or unknown arguments): the Python __init__ */
+    PyObject *small[8], **stack = nargs + nkw < 8 ? small
+                                  : (PyObject **)PyMem_Malloc((nargs + nkw + 1) * sizeof(PyObject *));
+    if (!stack) return PyErr_NoMemory();
+    stack[0] = self;
+    memcpy(stack + 1, args, (size_t)(nargs + nkw) * sizeof(PyObject *));
+    PyObject *out = PyObject_Vectorcall(s_lcp_py_init, stack, nargs + 1, kwnames);
+    if (stack != small) PyMem_Free(stack);
+    return out;
+}
+
+static PyMethodDef lcp_init_def = {
+    "__init__", (PyCFunction)(void (*)(void))lcp_dunder_init, METH_FASTCALL | METH_KEYWORDS,
+    "__init__($self, /, M, q, name='', meta=None)\n--\n\n"
+    "w = M z + q, 0 <= z perp w >= 0: M n x n, q of length n (validated, copied)."};
+
+static PyObject *py_lcp_method(PyObject *self, PyObject *args)
+{
+    PyObject *cls, *init;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O", &PyType_Type, &cls, &init)) return NULL;
+    if (!s_lcp_noname) {
+        static const char *const names[4] = {"M", "q", "name", "meta"};
+        for (int k = 0; k < 4; k++)
+            if (!(s_lcp_names[k] = PyUnicode_InternFromString(names[k]))) return NULL;
+        if (!(s_lcp_noname = PyUnicode_FromString(""))) return NULL;
+    }
+    Py_INCREF(init);
+    Py_XSETREF(s_lcp_py_init, init);
+    return PyDescr_NewMethod((PyTypeObject *)cls, &lcp_init_def);
 }
 
 /* An optional float64 vector of length n (None: NULL). */
@@ -258,8 +499,8 @@ static idx problem_data(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq
         if (!PyErr_Occurred()) PyErr_SetString(PyExc_ValueError, "q: empty");
         return -1;
     }
-    if (get_buffer(oq, vq, "q", 'd', n, 0) < 0) return -1;
-    if (get_buffer(oM, vM, "M", 'd', n * n, 0) < 0) return -1;
+    if (get_float64(oq, vq, "q", n) < 0) return -1;
+    if (get_float64(oM, vM, "M", n * n) < 0) return -1;
     return n;
 }
 

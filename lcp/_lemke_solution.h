@@ -14,6 +14,8 @@
  *     (code, pivots, nbasis, acode, berr, ferr, refined, raw, scaled, z, w, basis): the
  *     numbers of `solve_fast` and its arrays (basis of length nbasis) for the Python to
  *     finish (not solved, not assessed here, not measured here, or not accepted).
+ *   solve_default(problem) -> a Solution or None: lcp.solve's default call on an lcp.LCP,
+ *     `solve_lemke`'s Python steps done here (below); entry_setup gives it its objects.
  * M z is numpy's own cblas_dgemv called directly when lcp/_lemke_kernel.py found and checked it
  * (_blas.h), else numpy.dot called from here. The includer includes _lemke_py.h, _blas.h,
  * _lemke_problem.h and _lemke_measure.h first. */
@@ -29,14 +31,6 @@ static const char *const s_names[14] = {
 static PyObject *s_keys[14], *s_solved, *s_lemke, *s_zero, *s_equilibrated, *s_polished;
 /* the byte offsets of the Solution's 14 slots (s_off[0] = -1: not known, set by name) */
 static Py_ssize_t s_off[14] = {-1};
-#ifndef Py_T_OBJECT_EX /* Python < 3.12: structmember.h's names */
-#include <structmember.h>
-#define SLOT_OBJECT_EX T_OBJECT_EX
-#define SLOT_READONLY READONLY
-#else
-#define SLOT_OBJECT_EX Py_T_OBJECT_EX
-#define SLOT_READONLY Py_READONLY
-#endif
 
 static PyObject *py_solve_setup(PyObject *self, PyObject *args)
 {
@@ -99,16 +93,18 @@ static PyObject *new_array(idx n, int integer)
     return out;
 }
 
-/* solved_lcp(z, w, "lemke", pivots, raw, scaled, basis, message, info, berr, ferr): a new
- * Solution (object.__new__, i.e. the type's tp_alloc) whose slots receive the 14 fields, in
- * the dataclass's order; by name (setattr) when the slots are not known. */
+/* solved_lcp(z, w, "lemke", pivots, raw, scaled, basis, message, info, berr, ferr), info =
+ * {"equilibrated": equilibrated} (and "polished": True when refined): a new Solution
+ * (object.__new__, i.e. the type's tp_alloc) whose slots receive the 14 fields, in the
+ * dataclass's order; by name (setattr) when the slots are not known. */
 static PyObject *solution(PyObject *z, PyObject *w, long long pivots, double raw, double scaled,
-                          PyObject *basis, int refined, double berr, double ferr)
+                          PyObject *basis, int refined, double berr, double ferr,
+                          PyObject *equilibrated)
 {
     PyObject *info = PyDict_New(), *sol = NULL;
     PyObject *v[14] = {NULL};
     if (!info) return NULL;
-    if (PyDict_SetItem(info, s_equilibrated, Py_True) < 0 ||
+    if (PyDict_SetItem(info, s_equilibrated, equilibrated) < 0 ||
         (refined && PyDict_SetItem(info, s_polished, Py_True) < 0))
         goto fail;
     v[0] = z, v[1] = w, v[2] = s_solved, v[3] = s_lemke;
@@ -144,33 +140,37 @@ fail:
     return sol;
 }
 
-static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+/* The data pointer of an array made here by numpy.empty (its dtype known): a writable
+ * C-contiguous buffer of `bytes` bytes, asked for without PyBUF_FORMAT (numpy then builds no
+ * format string: that and its check were a tenth of the C call's overhead at n = 10). */
+static int own_buffer(PyObject *obj, Py_buffer *view, idx bytes)
 {
-    (void)self;
-    if (nargs != 5) {
-        PyErr_SetString(PyExc_TypeError, "solve_lcp: five arguments");
-        return NULL;
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    if (view->len != bytes) {
+        PyErr_SetString(PyExc_ValueError, "solve_lcp: an output array of the wrong size");
+        PyBuffer_Release(view);
+        return -1;
     }
-    if (!s_cls) {
-        PyErr_SetString(PyExc_RuntimeError, "solve_lcp: solve_setup was not called");
-        return NULL;
-    }
-    double tol = PyFloat_AsDouble(args[2]);
-    long long max_iter = PyLong_AsLongLong(args[3]);
-    idx upto = PyLong_AsSsize_t(args[4]);
-    if (PyErr_Occurred()) return NULL;
+    return 0;
+}
+
+/* solve_lcp's work on M and q (max_iter < 0: lemke()'s default 1000 + 100 n): the Solution, or
+ * the tuple of numbers and arrays; NULL with an error (ValueError, BufferError or TypeError for
+ * data the C call does not take: the caller's general path). */
+static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long max_iter, idx upto)
+{
     Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0};
     PyObject *result = NULL, *z = NULL, *w = NULL, *basis = NULL;
     int64_t bbuf[64], *b = NULL;
-    idx n = problem_data(args[0], args[1], &vM, &vq);
+    idx n = problem_data(oM, oq, &vM, &vq);
     if (n < 0) goto done;
     if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
         PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
         goto done;
     }
+    if (max_iter < 0) max_iter = 1000 + 100 * (long long)n;
     if (!(z = new_array(n, 0)) || !(w = new_array(n, 0))) goto done;
-    if (get_buffer(z, &vz, "z", 'd', n, 0) < 0 || get_buffer(w, &vw, "w", 'd', n, 0) < 0)
-        goto done;
+    if (own_buffer(z, &vz, n * 8) < 0 || own_buffer(w, &vw, n * 8) < 0) goto done;
     b = n <= 64 ? bbuf : (int64_t *)malloc((size_t)n * sizeof(int64_t));
     if (!b) {
         PyErr_NoMemory();
@@ -196,7 +196,7 @@ static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t 
         goto done;
     }
     if (code == 0 && acode == 0 && !measured) {
-        PyObject *call[3] = {args[0], z, w};
+        PyObject *call[3] = {oM, z, w};
         PyObject *out = PyObject_Vectorcall(s_dot, call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;
         Py_DECREF(out);
@@ -205,14 +205,15 @@ static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t 
     if (!(basis = new_array(nb, 1))) goto done;
     if (nb) {
         Py_buffer vb = {0};
-        if (get_buffer(basis, &vb, "basis", 'q', nb, 0) < 0) goto done;
+        if (own_buffer(basis, &vb, nb * (idx)sizeof(int64_t)) < 0) goto done;
         memcpy(vb.buf, b, (size_t)nb * sizeof(int64_t));
         PyBuffer_Release(&vb);
     }
     int refined = (int)res[2];
     /* solve_lemke's verdict (NaN fails every test: then the Python measures or refuses) */
     if (code == 0 && acode == 0 && got[1] <= s_tol && res[0] <= s_tol && res[1] <= s_ferr_tol)
-        result = solution(z, w, pivots, got[0], got[1], basis, refined, res[0], res[1]);
+        result = solution(z, w, pivots, got[0], got[1], basis, refined, res[0], res[1],
+                          Py_True);
     else
         result = Py_BuildValue("iLniddiddOOO", code, pivots, nb, acode, res[0], res[1], refined,
                                got[0], got[1], z, w, basis);
@@ -225,6 +226,133 @@ done:
     Py_XDECREF(z);
     Py_XDECREF(w);
     Py_XDECREF(basis);
+    return result;
+}
+
+static PyObject *py_solve_lcp(PyObject *self, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)self;
+    if (nargs != 5) {
+        PyErr_SetString(PyExc_TypeError, "solve_lcp: five arguments");
+        return NULL;
+    }
+    if (!s_cls) {
+        PyErr_SetString(PyExc_RuntimeError, "solve_lcp: solve_setup was not called");
+        return NULL;
+    }
+    double tol = PyFloat_AsDouble(args[2]);
+    long long max_iter = PyLong_AsLongLong(args[3]);
+    idx upto = PyLong_AsSsize_t(args[4]);
+    if (PyErr_Occurred()) return NULL;
+    return lcp_answer(args[0], args[1], tol, max_iter, upto);
+}
+
+/* ------------------------------------------------------------ lcp.solve's default call
+ * solve_default(problem) -> Solution or None: lcp/solvers/fast_lemke.py's `solve_lemke`, its
+ * Python steps done here (lcp.solve calls it for `solve(P)` / `solve(P, "lemke")` on an
+ * lcp.LCP with default options): the registry's "lemke" must be the built-in lemke,
+ * equilibrated by default, and the compiled kernel on (lcp._lemke_kernel._use), read at every
+ * call; M and q numpy arrays; then `solve_lcp(M, q, DEFAULT_TOL, 1000 + 100 n, upto)`. Its
+ * Solution is returned; its tuple goes to `finish(M, q, out)` (solve_lemke's own steps after
+ * the call); data the C call refuses (ValueError, BufferError, TypeError) give None, as
+ * solve_lemke's `except` does. entry_setup(registry, kernel_dict, lemke, finish, ndarray,
+ * DEFAULT_TOL, upto) gives it those objects. */
+static PyObject *s_registry, *s_kernel_dict, *s_lemke_fn, *s_finish, *s_ndarray, *s_info;
+static PyObject *s_use_key, *s_func_key, *s_equilibrate_key, *s_M_key, *s_q_key;
+static double s_default_tol;
+static idx s_upto;
+
+static PyObject *py_entry_setup(PyObject *self, PyObject *args)
+{
+    PyObject *registry, *kernel_dict, *lemke, *finish, *ndarray;
+    double tol;
+    Py_ssize_t upto;
+    (void)self;
+    if (!PyArg_ParseTuple(args, "O!O!OOO!dn", &PyDict_Type, &registry, &PyDict_Type,
+                          &kernel_dict, &lemke, &finish, &PyType_Type, &ndarray, &tol, &upto))
+        return NULL;
+    if (!s_use_key) {
+        if (!(s_use_key = PyUnicode_InternFromString("_use")) ||
+            !(s_func_key = PyUnicode_InternFromString("func")) ||
+            !(s_equilibrate_key = PyUnicode_InternFromString("equilibrate")) ||
+            !(s_M_key = PyUnicode_InternFromString("M")) ||
+            !(s_q_key = PyUnicode_InternFromString("q")))
+            return NULL;
+    }
+    PyObject **slots[5] = {&s_registry, &s_kernel_dict, &s_lemke_fn, &s_finish, &s_ndarray};
+    PyObject *given[5] = {registry, kernel_dict, lemke, finish, ndarray};
+    for (int k = 0; k < 5; k++) {
+        Py_INCREF(given[k]);
+        Py_XSETREF(*slots[k], given[k]);
+    }
+    Py_CLEAR(s_info);
+    s_default_tol = tol;
+    s_upto = upto;
+    Py_RETURN_NONE;
+}
+
+/* Is `info` (registry["lemke"]) the built-in lemke, equilibrated by default? 1, 0 or -1
+ * (error). The last one that was is remembered: a MethodInfo is frozen, and registering a
+ * method makes a new one. */
+static int builtin_lemke(PyObject *info)
+{
+    if (info == s_info) return 1;
+    PyObject *func = PyObject_GetAttr(info, s_func_key);
+    if (!func) return -1;
+    int ok = func == s_lemke_fn;
+    Py_DECREF(func);
+    if (ok) {
+        PyObject *eq = PyObject_GetAttr(info, s_equilibrate_key);
+        if (!eq) return -1;
+        ok = PyObject_IsTrue(eq);
+        Py_DECREF(eq);
+        if (ok < 0) return -1;
+    }
+    if (ok) {
+        Py_INCREF(info);
+        Py_XSETREF(s_info, info);
+    }
+    return ok;
+}
+
+static PyObject *py_solve_default(PyObject *self, PyObject *problem)
+{
+    (void)self;
+    if (!s_finish || !s_cls) {
+        PyErr_SetString(PyExc_RuntimeError, "solve_default: entry_setup was not called");
+        return NULL;
+    }
+    PyObject *M = NULL, *q = NULL, *result = NULL;
+    if (!(M = PyObject_GetAttr(problem, s_M_key)) || !(q = PyObject_GetAttr(problem, s_q_key)))
+        goto done;
+    PyObject *info = PyDict_GetItemWithError(s_registry, s_lemke); /* borrowed */
+    PyObject *use = info ? PyDict_GetItemWithError(s_kernel_dict, s_use_key) : NULL;
+    if (PyErr_Occurred()) goto done;
+    int ok = Py_TYPE(M) == (PyTypeObject *)s_ndarray && Py_TYPE(q) == (PyTypeObject *)s_ndarray
+             && info && use;
+    if (ok && (ok = builtin_lemke(info)) > 0) ok = PyObject_IsTrue(use);
+    if (ok < 0) goto done;
+    if (!ok) { /* not the built-in lemke, or the kernel off, or not arrays: the general path */
+        result = Py_NewRef(Py_None);
+        goto done;
+    }
+    PyObject *out = lcp_answer(M, q, s_default_tol, -1, s_upto);
+    if (!out) {
+        if (PyErr_ExceptionMatches(PyExc_ValueError) || PyErr_ExceptionMatches(PyExc_BufferError)
+            || PyErr_ExceptionMatches(PyExc_TypeError)) {
+            PyErr_Clear(); /* e.g. Fortran order, read-only, q 0-d: the general path */
+            result = Py_NewRef(Py_None);
+        }
+    } else if (PyTuple_CheckExact(out)) {
+        PyObject *call[3] = {M, q, out};
+        result = PyObject_Vectorcall(s_finish, call, 3, NULL);
+        Py_DECREF(out);
+    } else {
+        result = out;
+    }
+done:
+    Py_XDECREF(M);
+    Py_XDECREF(q);
     return result;
 }
 

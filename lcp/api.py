@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
+import rigidlcp.lcp._lemke_kernel as _kernel
 import rigidlcp.lcp.registry as registry
 
 from .acceptance.residual import TOL
@@ -88,6 +89,12 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
             sol = fast(problem)  # the same answer, when the first attempt is accepted
             if sol is not None:
                 return sol
+    return _general(problem, method, equilibrate, repair, fallback, options)
+
+
+def _general(problem, method: str, equilibrate: bool | None, repair: bool,
+             fallback: bool | str | tuple[str, ...], options: dict) -> Solution:
+    """`solve` after its fast path (which declined or does not apply): the general path."""
     friction = not isinstance(problem, (LCP, MLCP))
     if friction:  # imported only then: lcp.friction loads scipy.sparse
         from .problems.friction import FrictionContact2D
@@ -120,6 +127,14 @@ def solve(problem: LCP | MLCP, method: str = "lemke", *, equilibrate: bool | Non
     run = Run(problem, lcp, lambda name: _returning_solutions(get_method(name)), TOL,
               _fallbacks(fallback))
     return solve_checked(run, method, on, bool(repair), options)
+
+
+if _kernel.COMPILED:
+    #: `solve` as an object whose default call -- solve(P) or solve(P, "lemke") on an lcp.LCP,
+    #: no keywords -- goes to _FAST and then _general from C, without the Python frame of
+    #: `solve` (lcp/_solve_entry.h); every other call is `solve` itself. It passes for the
+    #: function (doc, name, signature through __wrapped__, repr, pickling by name).
+    solve = _kernel._lemke_c.Entry(solve, LCP, globals())
 
 
 def _returning_solutions(info: MethodInfo) -> MethodInfo:
@@ -177,14 +192,15 @@ _FAST_METHODS = ("lemke", "pivoting")
 
 
 def _fast(method: str):
-    """lcp.solvers.fast_lemke.solve_lemke or lcp.solvers.fast_pivoting.solve_pivoting
-    (imported on first use: they load the method's module, hence numpy's LAPACK paths)."""
+    """lcp.solvers.fast_lemke.entry (solve_lemke, in C when built) or
+    lcp.solvers.fast_pivoting.solve_pivoting (imported on first use: they load the method's
+    module, hence numpy's LAPACK paths)."""
     global _FAST, _FAST_PIVOTING
     if method == "lemke":
         if _FAST is None:
-            from .solvers.fast_lemke import solve_lemke
+            from .solvers.fast_lemke import entry
 
-            _FAST = solve_lemke
+            _FAST = entry
         return _FAST
     if _FAST_PIVOTING is None:
         from .solvers.fast_pivoting import solve_pivoting

@@ -58,11 +58,20 @@ def solve_many(
     from .problems.friction import FrictionContact2D
 
     problems = list(problems)
+    stacks = _stack_lcps(problems)
+    if stacks is not None:  # every entry an lcp.LCP of plain data, grouped and stacked in C
+        out: list[Solution | None] = [None] * len(problems)
+        for _n, idx, Ms, qs in stacks:
+            sols = _solve_stack(Ms, qs, method, options, lambda j, idx=idx: problems[idx[j]],
+                                repair)
+            for i, sol in zip(idx, sols):
+                out[i] = sol
+        return out  # type: ignore[return-value]
     for i, p in enumerate(problems):
         if type(p) is not LCP and not isinstance(p, (LCP, MLCP, FrictionContact2D)):
             raise InvalidProblem(f"problems[{i}] must be an lcp.LCP, lcp.MLCP or "
                                  f"lcp.FrictionContact2D, got {type(p).__name__}")
-    out: list[Solution | None] = [None] * len(problems)
+    out = [None] * len(problems)
     groups: dict[int, list[int]] = {}
     for i, p in enumerate(problems):
         if not (type(p) is LCP or isinstance(p, LCP)) or not p.M.flags.c_contiguous:
@@ -80,6 +89,18 @@ def solve_many(
         for i, sol in zip(idx, sols):
             out[i] = sol
     return out  # type: ignore[return-value]
+
+
+def _stack_lcps(problems: list) -> list | None:
+    """The grouping below done in C (lcp/_batch_solutions.h: stack_lcps) when every problem is
+    an lcp.LCP whose M is C-contiguous native float64 (n x n) and q a float64 vector: for each
+    size, in the order of its first problem, (n, indices, Ms, qs) with the stacks
+    np.concatenate would make; else None (and when the C calls are not built)."""
+    from .solvers.fast_lemke import _solve_lcp  # its import gives the C calls their objects
+
+    if _solve_lcp is None:
+        return None
+    return _kernel._lemke_c.stack_lcps(problems, LCP)
 
 
 def _stacked(Ms, qs) -> tuple[np.ndarray, np.ndarray]:
@@ -157,6 +178,7 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     `solve` itself, which answers it as a single call does."""
     from .acceptance.accuracy import FERR_TOL, _accuracy_c
     from .acceptance.residual import TOL
+    from .solvers.fast_lemke import _solve_lcp  # its import gives the C calls their objects
     from .solvers.lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
 
     k, n = qs.shape
@@ -178,37 +200,42 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
     if acc is None:  # every answer to judge_lcp
         acc = np.ones((k, 4))
-    raw, scaled = measured[:, 0], measured[:, 1]
-    acode, berr, ferr, refined = acc.T
-    # judge_lcp's verdict, for all at once (NaN -- a problem not measured -- fails every test)
-    solved = codes == _kernel.SOLVED
-    accepted = (solved & (acode == 0) & (scaled <= TOL) & (berr <= TOL)
-                & (ferr <= FERR_TOL)).tolist()
-    numpy_judged = (solved & (acode == 1)).tolist()  # to judge_lcp's numpy steps
-    rows, cols = np.nonzero(basic)  # the basis of problem i: cols[starts[i]:ends[i]]
-    ends = np.cumsum(np.bincount(rows, minlength=k)).tolist()
-    starts = [0, *ends[:-1]]
-    piv, raw, scaled = pivots.tolist(), raw.tolist(), scaled.tolist()
-    berr, ferr, refined = berr.tolist(), ferr.tolist(), refined.tolist()
-    Zs, Ws = list(Z), list(W)  # each problem's row (a view)
-    sols: list[Solution] = []
-    for i in range(k):
-        basis = cols[starts[i]:ends[i]]
-        if accepted[i]:  # assessed in C, measured above
-            sols.append(solved_lcp(
-                Zs[i], Ws[i], "lemke", piv[i], raw[i], scaled[i], basis,
-                "" if piv[i] else _Q_NONNEGATIVE,
-                {"equilibrated": on, "polished": True} if refined[i] else {"equilibrated": on},
-                berr[i], ferr[i]))
-            continue
-        if numpy_judged[i]:
-            ok, z, w, r, sc, a = judge_lcp(Ms[i], qs[i], Zs[i], basis)
-            if ok:
-                info = {"equilibrated": on, "polished": True} if a.refined else {
-                    "equilibrated": on}
-                sols.append(solved_lcp(z, w, "lemke", piv[i], r, sc, basis,
-                                       "" if piv[i] else _Q_NONNEGATIVE, info, a.berr, a.ferr))
-                continue
-        # see the docstring: the single call gives the answer and its evidence
-        sols.append(solve(problem_of(i), "lemke", repair=repair, **options))
+    if _solve_lcp is not None:  # the verdicts and the Solutions in C (lcp/_batch_solutions.h)
+        sols = _kernel._lemke_c.batch_solutions(Z, W, basic, codes, pivots, acc, measured, TOL,
+                                                FERR_TOL, on)
+    else:
+        sols = [None] * k
+    for i in (i for i, sol in enumerate(sols) if sol is None):
+        sols[i] = _finish(i, Ms, qs, Z, W, basic, codes, pivots, acc, measured, on, options,
+                          problem_of, repair)
     return sols
+
+
+def _finish(i: int, Ms, qs, Z, W, basic, codes, pivots, acc, measured, on: bool,
+            options: dict, problem_of, repair: bool) -> Solution:
+    """Problem i of `_lemke_batch` when `batch_solutions` did not accept it (or is not built):
+    judge_lcp's verdict on the numbers of the C loop (lcp.residual's TOL, lcp.accuracy's
+    FERR_TOL; a NaN fails every test), numpy's judge_lcp where the C acceptance did not handle
+    the answer, else `solve` itself, which answers it as a single call does."""
+    from .acceptance.accuracy import FERR_TOL
+    from .acceptance.residual import TOL
+
+    acode, berr, ferr, refined = acc[i].tolist()
+    raw, scaled = measured[i, :2].tolist()
+    piv = int(pivots[i])
+    basis = np.flatnonzero(basic[i])
+    solved = codes[i] == _kernel.SOLVED
+    if solved and acode == 0 and scaled <= TOL and berr <= TOL and ferr <= FERR_TOL:
+        # assessed in C, measured (batch_solutions not built)
+        return solved_lcp(Z[i], W[i], "lemke", piv, raw, scaled, basis,
+                          "" if piv else _Q_NONNEGATIVE,
+                          {"equilibrated": on, "polished": True} if refined else {
+                              "equilibrated": on}, berr, ferr)
+    if solved and acode == 1:  # to judge_lcp's numpy steps
+        ok, z, w, r, sc, a = judge_lcp(Ms[i], qs[i], Z[i], basis)
+        if ok:
+            info = {"equilibrated": on, "polished": True} if a.refined else {"equilibrated": on}
+            return solved_lcp(z, w, "lemke", piv, r, sc, basis, "" if piv else _Q_NONNEGATIVE,
+                              info, a.berr, a.ferr)
+    # see _lemke_batch's docstring: the single call gives the answer and its evidence
+    return solve(problem_of(i), "lemke", repair=repair, **options)

@@ -7,6 +7,7 @@ MLCP(A, C, D, B, a, b): A u + C v + a = 0,    w = D u + B v + b,    0 <= v  perp
 
 from __future__ import annotations
 
+import inspect
 import json
 import os
 from dataclasses import dataclass, field
@@ -20,9 +21,10 @@ import rigidlcp.lcp._lemke_kernel as _kernel
 from ..errors import InvalidProblem, NotApplicable
 from ..io.files import atomic_write
 
-_ND = np.ndarray
-#: The quick route's test (lcp/_lemke_c.c: plain); None when the C extension is not built.
-_plain = _kernel._lemke_c.plain if _kernel.COMPILED else None
+#: LCP.__init__'s quick route (lcp/_lemke_py.h: lcp_init), set below once the class exists;
+#: None when the C extension is not built (and with it LCP.__init__ in C, `_py_init` the Python
+#: one it replaces).
+_init = _py_init = None
 
 
 def as_matrix(name: str, value: Any, shape: tuple[int | None, int | None]) -> np.ndarray:
@@ -74,9 +76,13 @@ def _fmt(shape: tuple[int | None, ...]) -> str:
     return "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, slots=True)
 class LCP:
-    """w = M z + q, 0 <= z perp w >= 0. M is n x n, q has length n (n >= 1)."""
+    """w = M z + q, 0 <= z perp w >= 0. M is n x n, q has length n (n >= 1).
+
+    Its four fields are slots (no per-object __dict__), set once by __init__: a small solve
+    builds one per call (issue 23). Pickled and copied through its constructor (__reduce__).
+    """
 
     M: np.ndarray
     q: np.ndarray
@@ -84,21 +90,23 @@ class LCP:
     meta: dict = field(default_factory=dict)
 
     def __init__(self, M: Any, q: Any, name: str = "", meta: dict | None = None) -> None:
-        # written out (the dataclass keeps its fields, repr and replace): half the cost of the
-        # generated __init__ and __post_init__ for the common call
-        d = self.__dict__  # frozen: the fields are set once, here
-        if type(M) is _ND and type(q) is _ND and _plain is not None and _plain(M, q):
-            # plain finite float64 data, C-contiguous (one test in C for dtype, shape, order and
-            # finiteness): the copies `as_matrix` and `as_vector` would make (anything else,
-            # including a NaN, takes the general route below and its error message)
-            d["M"], d["q"] = M.copy(), q.copy()
-        else:
-            M = as_matrix("M", M, (None, None))
-            if M.shape[0] != M.shape[1]:
-                raise InvalidProblem(f"M must be square, got shape {M.shape}")
-            d["M"], d["q"] = M, as_vector("q", q, M.shape[0])
-        d["name"] = name
-        d["meta"] = {} if meta is None else meta
+        # written out (the dataclass keeps its fields, repr and replace). Plain finite float64
+        # numpy arrays, C-contiguous, of the right shapes: one C call tests them (dtype, shape,
+        # order, finiteness) and fills the slots with their copies, name and meta -- the copies
+        # `as_matrix` and `as_vector` would make (lcp/_lemke_py.h: lcp_init). Anything else,
+        # including a NaN, takes the general route below and its error message.
+        if _init is not None and _init(self, M, q, name, meta):
+            return
+        M = as_matrix("M", M, (None, None))
+        if M.shape[0] != M.shape[1]:
+            raise InvalidProblem(f"M must be square, got shape {M.shape}")
+        q = as_vector("q", q, M.shape[0])
+        for key, value in (("M", M), ("q", q), ("name", name),
+                           ("meta", {} if meta is None else meta)):
+            object.__setattr__(self, key, value)  # frozen: set once, here
+
+    def __reduce__(self):
+        return type(self), (self.M, self.q, self.name, self.meta)
 
     @property
     def n(self) -> int:
@@ -114,6 +122,19 @@ class LCP:
     def __repr__(self) -> str:
         label = f" {self.name!r}" if self.name else ""
         return f"<LCP{label} n={self.n}>"
+
+
+if _kernel.COMPILED and _kernel._lemke_c.lcp_setup(LCP, np.ndarray, np.empty,
+                                                      np.dtype(np.float64)):
+    _init = _kernel._lemke_c.lcp_init
+    # the common call LCP(M, q) without the Python frame of __init__: a method written in C
+    # takes the quick route and calls the __init__ above for anything else (lcp/_lemke_py.h)
+    _py_init = LCP.__init__  # the Python __init__ (benchmarks and tests switch back to it)
+    LCP.__init__ = _kernel._lemke_c.lcp_method(LCP, _py_init)
+    # the class's signature stays the Python __init__'s (inspect reads a C __init__ from its
+    # text signature, and Python 3.13's inspect cannot bind a method descriptor to the class)
+    _signature = inspect.signature(_py_init)
+    LCP.__signature__ = _signature.replace(parameters=list(_signature.parameters.values())[1:])
 
 
 @dataclass(frozen=True, eq=False)

@@ -107,13 +107,21 @@ def solve_lemke(problem) -> Solution | None:
         # BufferError): the solve, `assess_lcp`'s C steps, M z, the measure and, when the
         # verdict below is "accepted", the Solution, in one call (lcp/_lemke_solution.h)
         out = _solve_lcp(M, q, DEFAULT_TOL, max_iter, _UPTO)
-        if type(out) is not tuple:
-            return out
-        code, pivots, m, acode, berr, ferr, refined, raw, scaled, z, w, basis = out
-        if code == _kernel.NEEDS_RUIZ:
-            return _solve_ruiz(M, q, n, max_iter, z, _empty(n, dtype=_intp))
     except (ValueError, BufferError, TypeError):  # e.g. Fortran order, read-only, q 0-d
         return None
+    return out if type(out) is not tuple else _finish(M, q, out)
+
+
+def _finish(M, q, out: tuple) -> Solution | None:
+    """`solve_lemke`'s steps after its C call when that call handed its numbers back (`out`,
+    a tuple) instead of a Solution; also called by the C entry `solve_default`."""
+    code, pivots, m, acode, berr, ferr, refined, raw, scaled, z, w, basis = out
+    if code == _kernel.NEEDS_RUIZ:
+        n = q.size
+        try:
+            return _solve_ruiz(M, q, n, 1000 + 100 * n, z, _empty(n, dtype=_intp))
+        except (ValueError, BufferError, TypeError):
+            return None
     if code != _kernel.SOLVED or acode < 0:  # not solved, or numbers the check could overflow
         return None
     if acode:  # not handled in C (e.g. a singular pattern): judge_lcp's numpy steps
@@ -158,3 +166,15 @@ def _judged(M, q, z, basis, pivots: int) -> Solution | None:
     info = {"equilibrated": True, "polished": True} if acc.refined else {"equilibrated": True}
     return solved_lcp(z, w, "lemke", pivots, raw, scaled, basis,
                       "" if pivots else _Q_NONNEGATIVE, info, acc.berr, acc.ferr)
+
+
+#: What lcp.solve calls for its default call on an lcp.LCP: `solve_lemke`, or the same steps
+#: with no Python frame when the C call is built (`_lemke_c.solve_default`,
+#: lcp/_lemke_solution.h: the registry and kernel tests, problem.M and problem.q, `solve_lcp`,
+#: then `_finish` when it hands its numbers back): the same Solution or None
+#: (tests/lcp/test_solve_fast.py).
+entry = solve_lemke
+if _solve_lcp is not None:
+    _kernel._lemke_c.entry_setup(registry._REGISTRY, vars(_kernel), _lemke, _finish, np.ndarray,
+                                 DEFAULT_TOL, _UPTO)
+    entry = _kernel._lemke_c.solve_default
