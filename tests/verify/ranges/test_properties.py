@@ -101,3 +101,22 @@ def test_typed_errors():
     with pytest.raises(NotSteady):
         steady_ranges(short)
     assert issubclass(NotSteady, RigidLCPError) and issubclass(BadObservable, RigidLCPError)
+
+
+def test_steady_ranges_takes_a_matrix_and_refuses_other_observables_typed():
+    """Audit of issue 21 (bad input): steady_ranges took only a dict, and anything else (a
+    string, a matrix as event_ranges accepts) raised AttributeError ('str' object has no
+    attribute 'items'). A matrix's rows are the observables user[k], as in event_ranges: a row
+    equal to mu_g's own vector has mu_g's range; anything else is BadObservable."""
+    from rigidlcp.verify.ranges.observables import mu_g_vector
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.05)
+    for bad in ("all", "mu_g", object(), [["a", "b"]]):
+        with pytest.raises(BadObservable):
+            steady_ranges(s, bad)
+    res = steady_ranges(s, np.vstack([mu_g_vector(s), -mu_g_vector(s)]), time_limit=30)
+    mu, user, neg = res.ranges["mu_g"], res.ranges["user[0]"], res.ranges["user[1]"]
+    assert user.lo.value == pytest.approx(mu.lo.value, abs=1e-12)
+    assert user.hi.value == pytest.approx(mu.hi.value, abs=1e-12)
+    assert neg.lo.value == pytest.approx(-mu.hi.value, abs=1e-12)
+    assert neg.hi.value == pytest.approx(-mu.lo.value, abs=1e-12)
