@@ -153,7 +153,8 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
         nb = no_solution_beyond(M, q, U, time_limit=time_limit)
         proved, message = nb.proved is True, nb.message
     scope = ("every solution" if proved
-             else f"every solution with z <= {U:.3g} (no bound proved: {message})")
+             else f"every solution with z <= {U:.3g} (no bound proved: "
+                  f"{message.removeprefix('no bound proved: ')})")
     face_lps = _face_lps(M, q, z_star) if z_star is not None else None
     pat_star = _pattern(M, q, z_star) if z_star is not None else None
     every, face, selected = {}, {}, {}

@@ -120,3 +120,16 @@ def test_steady_ranges_takes_a_matrix_and_refuses_other_observables_typed():
     assert user.hi.value == pytest.approx(mu.hi.value, abs=1e-12)
     assert neg.lo.value == pytest.approx(-mu.hi.value, abs=1e-12)
     assert neg.hi.value == pytest.approx(-mu.lo.value, abs=1e-12)
+
+
+def test_an_unproved_box_is_said_once_in_the_scope():
+    """Audit: on docs/verification.md's own example (2x1 from rest: LCP(M, 0) has a nonzero
+    solution, so no bound on |z| is proved) each range's scope read "(no bound proved: no
+    bound proved: the MILP's point ...)"."""
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.1)
+    ep = models.event_problem(s, models.initial_state(s))
+    res = event_ranges(ep, lcp.solve(ep.lcp), time_limit=10)
+    assert not res.bound_proved
+    for r in res.every.values():
+        assert r.scope.count("no bound proved") == 1, r.scope
