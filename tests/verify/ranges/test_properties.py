@@ -133,3 +133,28 @@ def test_an_unproved_box_is_said_once_in_the_scope():
     assert not res.bound_proved
     for r in res.every.values():
         assert r.scope.count("no bound proved") == 1, r.scope
+
+
+_ANY_OBSERVABLES = st.one_of(
+    st.none(), st.text(max_size=5), st.integers(), st.floats(),
+    st.lists(st.floats(), max_size=7),
+    st.lists(st.lists(st.floats(), min_size=0, max_size=7), max_size=3),
+    st.lists(st.lists(st.text(max_size=2), max_size=3), max_size=2),
+    st.dictionaries(st.text(max_size=3), st.lists(st.floats(), max_size=7), max_size=3),
+    st.builds(object))
+
+
+@settings(max_examples=200)
+@given(_ANY_OBSERVABLES, st.integers(1, 6))
+def test_user_observables_are_checked_vectors_or_bad_observable(obs, size):
+    """Whatever a user passes as observables: finite vectors of the stated size, named, or
+    BadObservable (never another exception): the one checker of event_ranges and
+    steady_ranges."""
+    from rigidlcp.verify.ranges.observables import user_observables
+    try:
+        out = user_observables(obs, size)
+    except BadObservable:
+        return
+    assert isinstance(out, dict)
+    for name, v in out.items():
+        assert isinstance(name, str) and v.shape == (size,) and np.all(np.isfinite(v))
