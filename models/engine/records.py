@@ -101,6 +101,8 @@ class Run:
 
         out = {"status": self.status, "message": self.message, "events": self.n_events,
                "wall_time_s": round(self.wall_time, 4), "method": self.method,
+               # events answered by the fallback, not by `method` (issue 23.1)
+               "fallback_solves": sum(1 for r in self.records if r.fallback),
                **regime(self.status)}
         if self.closed is not None:  # the dense backend's closed-solution search
             out["closed_search"] = dict(self.closed)

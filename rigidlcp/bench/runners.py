@@ -32,6 +32,10 @@ _TIMEOUT, _DIED = object(), object()
 STARTUP = 300.0
 #: Seconds allowed beyond the time limit for passing the problem and the answer around.
 GRACE = 2.0
+#: Seconds the untimed warm-up solve of a method in a fresh worker may take (imports, numba's
+#: compilation), whatever the solves' limit: under that limit, a warm-up killed there left the
+#: compilation to the first timed solve (QuantEcon's lcp_lemke, --time-limit 5, loaded machine).
+WARM_UP_LIMIT = 120.0
 
 
 # --------------------------------------------------------------------------------------------
@@ -157,6 +161,7 @@ class LocalRunner:
         self.proc = None
         self.conn = None
         self.warm: set[str] = set()  # methods already run once by the current worker
+        self.cold: set[str] = set()  # methods whose warm-up timed out: not warmed up again
         #: {method: seconds of each warm-up solve} (untimed in the results, reported apart)
         self.warmups: dict[str, list[float]] = {}
 
@@ -184,10 +189,13 @@ class LocalRunner:
 
     def _warm_up(self, method: str, time_limit: float) -> None:
         """One untimed solve of WARM_UP per method in a fresh worker (imports, numba's
-        compilation, caches); its wall time is kept in `warmups`."""
-        if method not in self.warm:
+        compilation, caches), up to max(time_limit, WARM_UP_LIMIT) seconds; its wall time is
+        kept in `warmups`. A method whose warm-up timed out is not warmed up again."""
+        if method not in self.warm and method not in self.cold:
             self.warm.add(method)
-            raw = self.solve(WARM_UP, method, time_limit)
+            raw = self.solve(WARM_UP, method, max(time_limit, WARM_UP_LIMIT))
+            if raw.get("kind") == "timeout":
+                self.cold.add(method)
             self.warmups.setdefault(method, []).append(float(raw.get("time", math.nan)))
 
     def solve(self, problem, method: str, time_limit: float) -> dict:

@@ -274,7 +274,7 @@ def cmd_simulate(args) -> int:
                       f" / {counts['NS_wall']}"),
                      ("sliding pp/plane/wall", f"{counts['sliding_pp']} / "
                       f"{counts['sliding_plane']} / {counts['sliding_wall']}"),
-                     ("fallback solves", sum(r.fallback for r in run.records))]
+                     ("fallback solves", summary["fallback_solves"])]
         if args.out:
             rows.append(("saved", str(path)))
         width = max(len(k) for k, _ in rows)

@@ -32,3 +32,14 @@ def test_simulate_credits_the_method_that_answered(liar):
     np.testing.assert_allclose(run.records[-1].R, own.records[-1].R, atol=1e-9)
     stopped = models.simulate(system, seed=3, max_events=4, method="test-mine", fallback=None)
     assert not stopped.records and stopped.status == "solver_failed"
+
+
+def test_the_summary_counts_the_events_the_fallback_answered(liar):
+    """Audit of issue 23.1: run.summary() (run.json's "summary", `simulate --json`) said
+    "method": "test-mine" with no count of the events the fallback answered (only the
+    command's table had "fallback solves"): a script reading the JSON credited the method."""
+    system = models.System(models.rectangular(3, 1), mu_pp=0.3, mu_plane=0.5, mu_wall=0.2)
+    run = models.simulate(system, seed=3, max_events=4, method="test-mine")
+    assert run.summary()["fallback_solves"] == len(run.records) > 0
+    own = models.simulate(system, seed=3, max_events=4, method="lemke")
+    assert own.summary()["fallback_solves"] == 0

@@ -41,7 +41,13 @@ from rigidlcp.verify.certificates.uniqueness import (
     sign_pattern,
 )
 
-from .observables import BadObservable, alpha_rows, check_observable, mu_g_vector
+from .observables import (
+    BadObservable,
+    alpha_rows,
+    check_observable,
+    mu_g_vector,
+    user_observables,
+)
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
 
 #: A witness is accepted when its independent residual is at most this.
@@ -115,11 +121,8 @@ def event_observables(ep: EventProblem, observables=None, over: str = "forces",
     if over not in ("forces", "z"):
         raise ValueError(f"over must be 'forces' or 'z', got {over!r}")
     size = 2 * c if over == "forces" else ep.lcp.n
-    items = (observables.items() if isinstance(observables, dict)
-             else ((f"user[{k}]", row) for k, row in enumerate(np.atleast_2d(observables))))
-    for name, L in items:
-        v = check_observable(str(name), L, size)
-        out[str(name)] = v @ G if over == "forces" else v
+    for name, v in user_observables(observables, size).items():
+        out[name] = v @ G if over == "forces" else v
     return out
 
 
@@ -150,7 +153,8 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
         nb = no_solution_beyond(M, q, U, time_limit=time_limit)
         proved, message = nb.proved is True, nb.message
     scope = ("every solution" if proved
-             else f"every solution with z <= {U:.3g} (no bound proved: {message})")
+             else f"every solution with z <= {U:.3g} (no bound proved: "
+                  f"{message.removeprefix('no bound proved: ')})")
     face_lps = _face_lps(M, q, z_star) if z_star is not None else None
     pat_star = _pattern(M, q, z_star) if z_star is not None else None
     every, face, selected = {}, {}, {}

@@ -8,6 +8,8 @@ dict {name: vector}; a wrong length is refused (`BadObservable`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from rigidlcp.lcp.errors import RigidLCPError
@@ -67,3 +69,27 @@ def check_observable(name: str, L, size: int) -> np.ndarray:
     if not np.all(np.isfinite(v)):
         raise BadObservable(f"observable {name!r} contains NaN or Inf")
     return v
+
+
+def user_observables(observables, size: int) -> dict[str, np.ndarray]:
+    """A user's observables, each checked (check_observable): a dict {name: vector} or a
+    matrix whose rows are named "user[k]"; None gives none. A string or any other object is
+    BadObservable (the named sets "mu_g", "alpha", "all" are chosen apart, e.g. `which`)."""
+    if observables is None:
+        return {}
+    if isinstance(observables, Mapping):
+        items = observables.items()
+    elif isinstance(observables, (str, bytes)):
+        raise BadObservable(f"observables must be a dict {{name: vector}} or a matrix, got "
+                            f"{observables!r}")
+    else:
+        try:
+            rows = np.atleast_2d(np.asarray(observables, dtype=float))
+        except (TypeError, ValueError):
+            raise BadObservable("observables must be a dict {name: vector} or a numeric "
+                                f"matrix, got {type(observables).__name__}") from None
+        if rows.ndim != 2:
+            raise BadObservable(f"observables must be a matrix (one row per observable), got "
+                                f"{rows.ndim} dimensions")
+        items = ((f"user[{k}]", row) for k, row in enumerate(rows))
+    return {str(name): check_observable(str(name), L, size) for name, L in items}

@@ -23,7 +23,7 @@ from rigidlcp.models.system import System
 from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
-from .observables import check_observable, steady_observables
+from .observables import steady_observables, user_observables
 from .proportional import exact as proportional_exact
 from .proportional import velocities as proportional_velocities
 from .proportional import velocity_scale
@@ -163,8 +163,9 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                   progress: Callable[[int, int, str], None] | None = None) -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
-    in them). observables: {name: L over x = [R; S]} added to `which` ("mu_g", "alpha":
-    also every angular acceleration, "all": also every R and S). time_limit: seconds per end.
+    in them). observables: {name: L over x = [R; S]}, or a matrix whose rows are named
+    "user[k]", added to `which` ("mu_g", "alpha": also every angular acceleration, "all":
+    also every R and S; another object is BadObservable). time_limit: seconds per end.
     box: the force box when no bound is proved. kinematics: "auto" ("proportional" where
     verify.ranges.proportional.exact holds, else "lazy"), "proportional" (no velocities in
     the MILP; witnesses move at (alpha, gamma) t, t = 1 or the run's V / gamma), "lazy"
@@ -188,8 +189,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
             start = (last["R"], last["S"], omega, V, s_run)
     form = formulate(system, box, V_mode)
     obs = steady_observables(system, which, form.dyn)
-    for name, L in (observables or {}).items():
-        obs[str(name)] = check_observable(str(name), L, 2 * system.c)
+    obs.update(user_observables(observables, 2 * system.c))
     unproved = f"all valid steady states with every R <= {form.U:.4g} (no bound proved)"
     ranges, run_values, own = {}, {}, {}
     if kinematics == "auto":

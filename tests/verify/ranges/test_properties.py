@@ -101,3 +101,60 @@ def test_typed_errors():
     with pytest.raises(NotSteady):
         steady_ranges(short)
     assert issubclass(NotSteady, RigidLCPError) and issubclass(BadObservable, RigidLCPError)
+
+
+def test_steady_ranges_takes_a_matrix_and_refuses_other_observables_typed():
+    """Audit of issue 21 (bad input): steady_ranges took only a dict, and anything else (a
+    string, a matrix as event_ranges accepts) raised AttributeError ('str' object has no
+    attribute 'items'). A matrix's rows are the observables user[k], as in event_ranges: a row
+    equal to mu_g's own vector has mu_g's range; anything else is BadObservable."""
+    from rigidlcp.verify.ranges.observables import mu_g_vector
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.05)
+    for bad in ("all", "mu_g", object(), [["a", "b"]]):
+        with pytest.raises(BadObservable):
+            steady_ranges(s, bad)
+    res = steady_ranges(s, np.vstack([mu_g_vector(s), -mu_g_vector(s)]), time_limit=30)
+    mu, user, neg = res.ranges["mu_g"], res.ranges["user[0]"], res.ranges["user[1]"]
+    assert user.lo.value == pytest.approx(mu.lo.value, abs=1e-12)
+    assert user.hi.value == pytest.approx(mu.hi.value, abs=1e-12)
+    assert neg.lo.value == pytest.approx(-mu.hi.value, abs=1e-12)
+    assert neg.hi.value == pytest.approx(-mu.lo.value, abs=1e-12)
+
+
+def test_an_unproved_box_is_said_once_in_the_scope():
+    """Audit: on docs/verification.md's own example (2x1 from rest: LCP(M, 0) has a nonzero
+    solution, so no bound on |z| is proved) each range's scope read "(no bound proved: no
+    bound proved: the MILP's point ...)"."""
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.1)
+    ep = models.event_problem(s, models.initial_state(s))
+    res = event_ranges(ep, lcp.solve(ep.lcp), time_limit=10)
+    assert not res.bound_proved
+    for r in res.every.values():
+        assert r.scope.count("no bound proved") == 1, r.scope
+
+
+_ANY_OBSERVABLES = st.one_of(
+    st.none(), st.text(max_size=5), st.integers(), st.floats(),
+    st.lists(st.floats(), max_size=7),
+    st.lists(st.lists(st.floats(), min_size=0, max_size=7), max_size=3),
+    st.lists(st.lists(st.text(max_size=2), max_size=3), max_size=2),
+    st.dictionaries(st.text(max_size=3), st.lists(st.floats(), max_size=7), max_size=3),
+    st.builds(object))
+
+
+@settings(max_examples=200)
+@given(_ANY_OBSERVABLES, st.integers(1, 6))
+def test_user_observables_are_checked_vectors_or_bad_observable(obs, size):
+    """Whatever a user passes as observables: finite vectors of the stated size, named, or
+    BadObservable (never another exception): the one checker of event_ranges and
+    steady_ranges."""
+    from rigidlcp.verify.ranges.observables import user_observables
+    try:
+        out = user_observables(obs, size)
+    except BadObservable:
+        return
+    assert isinstance(out, dict)
+    for name, v in out.items():
+        assert isinstance(name, str) and v.shape == (size,) and np.all(np.isfinite(v))
