@@ -122,7 +122,7 @@ class MilpModel:
 
         self.now = clock(clock_name)
         self.clock = clock_name
-        self._deadline = np.inf
+        self._deadline = [np.inf]  # a box the callback reads (no reference back to self)
 
         if kinematics not in ("lazy", "lazy-a_t", "big-M", "proportional"):
             raise ValueError("kinematics must be 'lazy', 'lazy-a_t', 'big-M' or "
@@ -173,9 +173,11 @@ class MilpModel:
 
         self.h, self.lp = model(True), model(False)
         if clock_name == "cpu":
+            deadline = self._deadline
+
             def interrupt(kind, message, data_out, data_in, user_data) -> None:
                 # set either way: HiGHS keeps the flag from one run to the next
-                data_in.user_interrupt = time.process_time() >= self._deadline
+                data_in.user_interrupt = time.process_time() >= deadline[0]
 
             self.h.setCallback(interrupt, None)
             self.h.startCallback(highspy.cb.HighsCallbackType.kCallbackMipInterrupt)
@@ -274,7 +276,7 @@ class MilpModel:
         cost = np.asarray(cost, float)[self.keep]
         h.changeColsCost(cost.size, np.arange(cost.size, dtype=np.int32), cost)
         if self.clock == "cpu":
-            self._deadline = time.process_time() + float(time_limit)
+            self._deadline[0] = time.process_time() + float(time_limit)
             h.setOptionValue("time_limit", BACKSTOP_FACTOR * float(time_limit) + BACKSTOP_S)
         else:
             h.setOptionValue("time_limit", float(time_limit))

@@ -2,7 +2,9 @@
 steady_ranges(clock="cpu"), disk_split_bound(clock_name="cpu")):
 
 * the clock changes when a search stops, never what a finished search answers: every end of
-  the small systems (issue 21's 10x1 rows, random small arrays) is the same with either clock;
+  the small systems (issue 21's 10x1 rows, random small arrays) is the same with either clock
+  (on random arrays also a "failed" end or "no valid steady state": the deep profile met both
+  at mu_pp ~ 1e-7, with either clock);
 * a CPU limit reached is a time limit, never a bound or "optimal", and it does not leak into
   the next solve of the same model (HiGHS keeps the interrupt flag between runs: a model whose
   callback only ever *set* it answered "time limit" at once from then on);
@@ -24,7 +26,7 @@ from rigidlcp.verify.ranges.disk_split import disk_split_bound
 from rigidlcp.verify.ranges.milp import MilpModel, clock
 from rigidlcp.verify.ranges.observables import mu_g_vector
 from rigidlcp.verify.ranges.result import OPTIMAL, TIME_LIMIT
-from rigidlcp.verify.ranges.steady import formulate
+from rigidlcp.verify.ranges.steady import NotSteady, formulate
 
 
 def _system(lx, ly, mpp, mpl, gamma):
@@ -37,14 +39,25 @@ def _ends(r):
             for name, rg in r.ranges.items() for side in ("lo", "hi")}
 
 
-def _same_ends(system, which="mu_g"):
-    wall = steady_ranges(system, which=which, time_limit=60, split=False, clock="wall")
-    cpu = steady_ranges(system, which=which, time_limit=60, split=False, clock="cpu")
-    a, b = _ends(wall), _ends(cpu)
+def _answer(system, which, clock_name):
+    try:
+        return _ends(steady_ranges(system, which=which, time_limit=60, split=False,
+                                   clock=clock_name))
+    except NotSteady as e:  # an answer too ("no valid steady state")
+        return str(e)
+
+
+def _same_ends(system, which="mu_g", all_optimal=True):
+    a, b = _answer(system, which, "wall"), _answer(system, which, "cpu")
+    if isinstance(a, str) or isinstance(b, str):
+        assert a == b
+        return
     assert a.keys() == b.keys()
     for k in a:
-        assert a[k][0] == b[k][0] == OPTIMAL, (k, a[k], b[k])
-        assert b[k][1] == pytest.approx(a[k][1], abs=1e-9), k
+        assert a[k][0] == b[k][0], (k, a[k], b[k])
+        assert a[k][0] == OPTIMAL or not all_optimal, (k, a[k])
+        if a[k][0] == OPTIMAL:
+            assert b[k][1] == pytest.approx(a[k][1], abs=1e-9), k
 
 
 @pytest.mark.parametrize("mpp, mpl, gamma", [(0.05, 0.1, 0.01), (0.1, 0.2, 0.02)])
@@ -56,7 +69,7 @@ def test_rows_10x1_same_ends_with_either_clock(mpp, mpl, gamma):
 @given(lx=st.integers(2, 4), ly=st.integers(1, 2), mpp=st.floats(0.0, 0.4),
        mpl=st.floats(0.05, 0.4), gamma=st.floats(0.01, 0.4))
 def test_small_arrays_same_ends_with_either_clock(lx, ly, mpp, mpl, gamma):
-    _same_ends(_system(lx, ly, mpp, mpl, gamma), which="alpha")
+    _same_ends(_system(lx, ly, mpp, mpl, gamma), which="alpha", all_optimal=False)
 
 
 @pytest.fixture(scope="module")
