@@ -287,9 +287,28 @@ class MilpModel:
             sol.col_value = list(x[self.keep])
             sol.value_valid = True
             h.setSolution(sol)
+        t0 = self.now()
         with quiet_highs():
             h.run()
         st = h.getModelStatus()
+        left = float(time_limit) - (self.now() - t0)
+        if st == hs.HighsModelStatus.kInfeasible and left > 0:
+            # "infeasible" only when HiGHS says so twice, the second time without presolve:
+            # its presolve declared a feasible MILP infeasible (rect 3x2 at mu_pp ~ 1.2e-7,
+            # tests/verify/ranges/test_milp_recheck.py); a claim not re-checked in time stays
+            # a time limit
+            h.clearSolver()
+            h.setOptionValue("presolve", "off")
+            if self.clock == "wall":
+                h.setOptionValue("time_limit", left)
+            try:
+                with quiet_highs():
+                    h.run()
+            finally:
+                h.setOptionValue("presolve", "choose")
+            st = h.getModelStatus()
+        elif st == hs.HighsModelStatus.kInfeasible:
+            return TIME_LIMIT, None
         has_x = h.getInfo().primal_solution_status == 2
         x = self._full(np.asarray(h.getSolution().col_value)) if has_x else None
         if st == hs.HighsModelStatus.kOptimal:

@@ -4,7 +4,8 @@ steady_ranges(clock="cpu"), disk_split_bound(clock_name="cpu")):
 * the clock changes when a search stops, never what a finished search answers: every end of
   the small systems (issue 21's 10x1 rows, random small arrays) is the same with either clock
   (on random arrays also a "failed" end or "no valid steady state": the deep profile met both
-  at mu_pp ~ 1e-7, with either clock);
+  at mu_pp ~ 1e-7, with either clock; the second was HiGHS's presolve, now re-checked:
+  test_milp_recheck.py);
 * a CPU limit reached is a time limit, never a bound or "optimal", and it does not leak into
   the next solve of the same model (HiGHS keeps the interrupt flag between runs: a model whose
   callback only ever *set* it answered "time limit" at once from then on);

@@ -57,7 +57,8 @@ def _milp_ends(system):
 def _check_reaches_never_passes(system, max_cases=20000, must_close=True):
     ends = _milp_ends(system)
     if not must_close:  # a random system: compared only where the MILP decided both ends
-        # (the deep profile met "failed" ends and NotSteady at mu_pp ~ 1e-7)
+        # (the deep profile met "failed" ends and NotSteady at mu_pp ~ 1e-7; the NotSteady was
+    # HiGHS's presolve, now re-checked: test_milp_recheck.py)
         assume(ends is not None)
     assert ends is not None
     lo, hi = ends
