@@ -169,7 +169,7 @@ def _set_case(h, z: np.ndarray, k: int, ia: int, ib: int, ic: int, col: int, rhs
 
 
 def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],
-                    deep: float = 0.0) -> None:
+                    deep: float = 0.0, clock_name: str = "wall") -> None:
     """Give each end left at the time limit the proved bound of `cap_split_bound` (End.bound,
     and a note), where it applies; with deep > 0 also that of verify.ranges.disk_split's case
     split (deep seconds per end; the better bound is kept, and a case point satisfying every
@@ -189,7 +189,7 @@ def bound_open_ends(form: Formulation, ranges: dict, obs: dict[str, np.ndarray],
             dres = None
             if deep > 0:
                 target = np.inf if end.best is None else sense * end.best
-                dres = disk_split_bound(form, sense * L, target, deep)
+                dres = disk_split_bound(form, sense * L, target, deep, clock_name=clock_name)
             if dres is not None:
                 end.seconds += dres.seconds
                 wit = None if dres.candidate is None else witness_of(form, dres.candidate)

@@ -71,7 +71,7 @@ from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .bounds import rotation_cap
-from .milp import certified_result
+from .milp import certified_result, clock
 from .observables import alpha_rows
 from .steady import Formulation, _equalities, least_R, velocity_box
 from .witness import SteadyWitness, make_witness
@@ -303,13 +303,15 @@ class _Cases:
 
 
 def disk_split_bound(form: Formulation, cost: np.ndarray, target: float, time_limit: float,
-                     tol: float = 1e-9, max_cases: int | None = None
+                     tol: float = 1e-9, max_cases: int | None = None, clock_name: str = "wall"
                      ) -> DiskSplitBound | None:
     """A proved lower bound of cost . x (x = [R; S]) over every valid steady state (module
     docstring), splitting until every case is bounded at >= target - tol, the time limit or
     max_cases; None where it does not apply (no proved force box for cost, no rotation cap,
-    T_u not of the form it needs)."""
-    t0 = time.perf_counter()
+    T_u not of the form it needs). clock_name: the time limit in "wall" or "cpu" seconds
+    (verify.ranges.milp.clock); `seconds` is wall time either way."""
+    now = clock(clock_name)
+    t0, c0 = time.perf_counter(), now()
     system, dyn = form.system, form.dyn
     M = rotation_cap(system, dyn)
     if M is None or M <= 0 or form.R_hi is None or not form.proved_for(cost):
@@ -334,7 +336,7 @@ def disk_split_bound(form: Formulation, cost: np.ndarray, target: float, time_li
         heapq.heappush(heap, (b, tick, disks, contacts, x))
 
     push(np.full(system.p, OPEN), {}, -np.inf)
-    while heap and time.perf_counter() - t0 < time_limit and (
+    while heap and now() - c0 < time_limit and (
             max_cases is None or n_cases < max_cases):
         b, tk, disks, contacts, x = heapq.heappop(heap)
         kids = None if x is None else cases.split(disks, contacts, x, cases.violation(x))

@@ -36,6 +36,21 @@ MAX_SEEDS = 10
 #: "lazy-a_t": a_t counts as 0 within this times max(|gamma|, g) (a larger set of contacts
 #: asked only makes the check stricter; its cuts stay valid).
 AT_ZERO = 1e-7
+#: clock "cpu": HiGHS's own (wall-clock) limit is kept as a backstop at this many times the
+#: CPU limit plus BACKSTOP_S seconds (a search that never reaches a MIP callback, e.g. a
+#: very long root LP, still stops).
+BACKSTOP_FACTOR, BACKSTOP_S = 20.0, 60.0
+
+
+def clock(name: str):
+    """The clock of a time limit: "wall" (time.perf_counter) or "cpu" (time.process_time,
+    this process's CPU seconds: a limit then means the same work whatever the machine's
+    load)."""
+    if name == "wall":
+        return time.perf_counter
+    if name == "cpu":
+        return time.process_time
+    raise ValueError(f"clock must be 'wall' or 'cpu', got {name!r}")
 
 
 def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,
@@ -94,10 +109,20 @@ class MilpModel:
     (verify.ranges.proportional: where `proportional.exact` holds, the forces of this MILP
     are those of every valid steady state, a point's velocities are (alpha, gamma) t, so no
     cut is needed); columns and points keep the Formulation's layout outside (the velocity
-    entries 0)."""
+    entries 0).
 
-    def __init__(self, form: Formulation, kinematics: str = "lazy"):
+    clock: how `solve`'s time limit is counted, "wall" (HiGHS's own time_limit) or "cpu"
+    (this process's CPU seconds, time.process_time, checked in HiGHS's MIP interrupt
+    callback, with HiGHS's wall-clock limit kept as a backstop at BACKSTOP_FACTOR times the
+    limit plus BACKSTOP_S): either way a search stopped by it is a time limit, never a
+    bound."""
+
+    def __init__(self, form: Formulation, kinematics: str = "lazy", clock_name: str = "wall"):
         import highspy
+
+        self.now = clock(clock_name)
+        self.clock = clock_name
+        self._deadline = [np.inf]  # a box the callback reads (no reference back to self)
 
         if kinematics not in ("lazy", "lazy-a_t", "big-M", "proportional"):
             raise ValueError("kinematics must be 'lazy', 'lazy-a_t', 'big-M' or "
@@ -147,6 +172,16 @@ class MilpModel:
             return h
 
         self.h, self.lp = model(True), model(False)
+        if clock_name == "cpu":
+            deadline = self._deadline
+
+            def interrupt(kind, message, data_out, data_in, user_data) -> None:
+                # set either way: HiGHS keeps the flag from one run to the next
+                data_in.user_interrupt = time.process_time() >= deadline[0]
+
+            self.h.setCallback(interrupt, None)
+            self.h.startCallback(highspy.cb.HighsCallbackType.kCallbackMipInterrupt)
+            self.h.startCallback(highspy.cb.HighsCallbackType.kCallbackSimplexInterrupt)
         self.starts: list[np.ndarray] = []
         self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
         self.V_ref: float | None = None  # proportional witnesses' V (if of gamma's sign)
@@ -206,9 +241,9 @@ class MilpModel:
         admitted by the velocities (else it is None)."""
         if not self.lazy:  # big-M: the velocities are in; proportional: none needed
             return self._solve(cost, time_limit, extra)
-        t0 = time.perf_counter()
+        t0 = self.now()
         while True:
-            left = time_limit - (time.perf_counter() - t0)
+            left = time_limit - (self.now() - t0)
             if left <= 0:
                 return TIME_LIMIT, None
             st, x = self._solve(cost, left, extra)
@@ -240,7 +275,11 @@ class MilpModel:
         h.clearSolver()
         cost = np.asarray(cost, float)[self.keep]
         h.changeColsCost(cost.size, np.arange(cost.size, dtype=np.int32), cost)
-        h.setOptionValue("time_limit", float(time_limit))
+        if self.clock == "cpu":
+            self._deadline[0] = time.process_time() + float(time_limit)
+            h.setOptionValue("time_limit", BACKSTOP_FACTOR * float(time_limit) + BACKSTOP_S)
+        else:
+            h.setOptionValue("time_limit", float(time_limit))
         starts = [*self.starts, *extra]
         # the best valid state as the MIP start (a later setSolution replaces an earlier one)
         for x in sorted(starts, key=lambda x: float(cost @ x[self.keep]))[:1]:
@@ -248,15 +287,34 @@ class MilpModel:
             sol.col_value = list(x[self.keep])
             sol.value_valid = True
             h.setSolution(sol)
+        t0 = self.now()
         with quiet_highs():
             h.run()
         st = h.getModelStatus()
+        left = float(time_limit) - (self.now() - t0)
+        if st == hs.HighsModelStatus.kInfeasible and left > 0:
+            # "infeasible" only when HiGHS says so twice, the second time without presolve:
+            # its presolve declared a feasible MILP infeasible (rect 3x2 at mu_pp ~ 1.2e-7,
+            # tests/verify/ranges/test_milp_recheck.py); a claim not re-checked in time stays
+            # a time limit
+            h.clearSolver()
+            h.setOptionValue("presolve", "off")
+            if self.clock == "wall":
+                h.setOptionValue("time_limit", left)
+            try:
+                with quiet_highs():
+                    h.run()
+            finally:
+                h.setOptionValue("presolve", "choose")
+            st = h.getModelStatus()
+        elif st == hs.HighsModelStatus.kInfeasible:
+            return TIME_LIMIT, None
         has_x = h.getInfo().primal_solution_status == 2
         x = self._full(np.asarray(h.getSolution().col_value)) if has_x else None
         if st == hs.HighsModelStatus.kOptimal:
             return OPTIMAL, x
         if st == hs.HighsModelStatus.kInfeasible:
             return INFEASIBLE, None
-        if st == hs.HighsModelStatus.kTimeLimit:
+        if st in (hs.HighsModelStatus.kTimeLimit, hs.HighsModelStatus.kInterrupt):
             return TIME_LIMIT, x
         return "failed", x

@@ -23,6 +23,7 @@ from rigidlcp.models.system import System
 from .cap_split import bound_open_ends
 from .kinematics import realizable
 from .milp import MilpModel
+from .milp import clock as milp_clock
 from .observables import steady_observables, user_observables
 from .proportional import exact as proportional_exact
 from .proportional import velocities as proportional_velocities
@@ -160,7 +161,8 @@ def _run_system(target) -> tuple[System, dict[str, np.ndarray] | None]:
 def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g",
                   time_limit: float = 60.0, box: float | None = None,
                   V_mode: str | None = None, kinematics: str = "auto", split: bool | float = True,
-                  progress: Callable[[int, int, str], None] | None = None) -> SteadyRanges:
+                  progress: Callable[[int, int, str], None] | None = None,
+                  clock: str = "wall") -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]}, or a matrix whose rows are named
@@ -172,8 +174,11 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     (velocities checked on each optimum, verify.ranges.milp) or "big-M" (in the MILP).
     split: an end left at the time limit gets a proved bound by verify.ranges.cap_split where
     it applies (a number s: also disk_split's, s seconds per end). progress(done, total,
-    name): called after each end's search (total: 2 per observable). Raises NotSteady (none
-    valid, run not steady)."""
+    name): called after each end's search (total: 2 per observable). clock: time_limit and
+    the disk split's seconds counted on the wall clock ("wall") or as this process's CPU
+    time ("cpu": the same work whatever the machine's load; verify.ranges.milp.MilpModel).
+    Raises NotSteady (none valid, run not steady)."""
+    milp_clock(clock)  # a wrong clock refused before any work (ValueError)
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
@@ -197,7 +202,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     elif kinematics == "proportional" and not proportional_exact(form):
         raise ValueError(f"kinematics 'proportional' is not exact here (gamma "
                          f"{system.gamma:g}, V {form.V_mode}): use 'lazy' or 'big-M'")
-    model = MilpModel(form, kinematics)
+    model = MilpModel(form, kinematics, clock)
     model.V_ref = None if start is None else float(start[3])
     if start is not None:
         model.starts.append(form.start(*start))
@@ -224,7 +229,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                     new.seconds += old.seconds
                     setattr(ranges[name], side, new)
     if split:  # a proved bound on each end still open (verify.ranges.cap_split)
-        bound_open_ends(form, ranges, obs, 0.0 if split is True else float(split))
+        bound_open_ends(form, ranges, obs, 0.0 if split is True else float(split), clock)
     for name, L in obs.items():
         if last is not None:
             run_values[name] = float(L @ np.concatenate([last["R"], last["S"]]))

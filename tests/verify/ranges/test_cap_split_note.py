@@ -48,7 +48,7 @@ def test_a_deep_witness_brings_its_own_tolerance(monkeypatch):
 
     R, S = np.array([1.0]), np.array([-1.0 + 2.0 ** -52])  # L . x = 2^-52: rounding noise
     wit = SimpleNamespace(R=R, S=S, residual=1e-12)
-    monkeypatch.setattr(cap_split, "disk_split_bound", lambda *a: SimpleNamespace(
+    monkeypatch.setattr(cap_split, "disk_split_bound", lambda *a, **kw: SimpleNamespace(
         candidate=object(), bound=-0.5, seconds=0.0, cases=2, empty=0, open=1))
     monkeypatch.setattr(cap_split, "witness_of", lambda form, cand: wit)
     monkeypatch.setattr(cap_split, "cap_split_bound", lambda form, L: cap_split.CapSplitBound(

@@ -1,0 +1,57 @@
+"""An "infeasible" from HiGHS is re-checked without presolve (verify.ranges.milp.MilpModel):
+found by the deep profile of tests/verify/ranges/test_clock.py, rect 3x2 at mu_pp =
+1.192092896e-07, mu_plane 0.25, gamma 0.328125 was reported "no valid steady state" (HiGHS's
+presolve said infeasible) while a valid steady state exists. The state is derived here
+independently of the MILP: the contact states of the minimum of mu_g at mu_pp = 1e-3 (a nearby
+system), their forces by one linear program at mu_pp = 1.192092896e-07 (`state_extreme`),
+their velocities by `state_velocities`, and `steady_check`'s independent residual.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigidlcp import models
+from rigidlcp.verify.ranges import steady_ranges
+from rigidlcp.verify.ranges.milp import MilpModel
+from rigidlcp.verify.ranges.observables import mu_g_vector
+from rigidlcp.verify.ranges.result import OPTIMAL
+from rigidlcp.verify.ranges.steady import formulate, state_extreme, state_velocities
+from rigidlcp.verify.ranges.witness import steady_check
+
+TINY = 1.192092896e-07
+
+
+def _system(mpp):
+    return models.System(models.rectangular(3, 2), mu_pp=mpp, mu_plane=0.25, mu_wall=0.0,
+                         gamma=0.328125)
+
+
+def _a_valid_state():
+    near = steady_ranges(_system(1e-3), which="mu_g", time_limit=60, split=False)
+    s = np.asarray(near.mu_g.lo.witness.s)
+    system = _system(TINY)
+    form = formulate(system)
+    L = mu_g_vector(system)
+    status, x, _ = state_extreme(form, s, L, +1)
+    assert status == OPTIMAL
+    omega, V = state_velocities(form, s)
+    c = system.c
+    res, _ = steady_check(system, omega, V, x[:c], x[c:])
+    assert res <= 1e-8
+    return system, form, float(L @ x)
+
+
+def test_feasible_milp_not_reported_infeasible():
+    system, form, value = _a_valid_state()
+    for kin in ("proportional", "lazy"):
+        model = MilpModel(form, kin)
+        cost = np.zeros(form.A.shape[1])
+        cost[:2 * system.c] = mu_g_vector(system)
+        st, x = model.solve(cost, 60.0)
+        assert st == OPTIMAL, kin
+        assert float(cost @ x) <= value + 1e-9
+    r = steady_ranges(system, which="mu_g", time_limit=60, split=False)  # no NotSteady
+    assert r.mu_g.lo.status == OPTIMAL
+    assert r.mu_g.lo.value <= value + 1e-9
+    assert r.mu_g.lo.witness.residual <= 1e-8
