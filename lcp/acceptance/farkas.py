@@ -6,28 +6,33 @@ is found by HiGHS on the *equilibrated* problem (lcp.scaling: M~ = R M C, q~ = R
 
     min q~^T y   subject to   M~^T y <= 0,   sum(y) = 1,   y >= 0,                      (1)
 
-and it is checked in floating point, not taken from the solver: with g = M~^T y and gap
+and it is checked, not taken from the solver. First in floating point: with g = M~^T y and gap
 -q~^T y > 0, every feasible z~ obeys gap <= max(g, 0)^T z~, so no feasible point has
-|z~|_1 < radius = gap / max(g_+). The certificate is accepted when gap >= GAP (the data are
-O(1) after equilibration) and radius >= RADIUS ~ 4.5e14 (rounding of M~^T y then cannot hide a
-feasible point of reasonable size), and when HiGHS also finds the primal feasibility problem
-{z~ >= 0, M~ z~ + q~ >= 0} infeasible. Below that radius the float data cannot tell "no
-solution" from "a solution of size ~1/eps": no claim is made (the status says so). y maps back
-to the user's problem as R y~ (the sign conditions are invariant under positive scalings).
-When (1)'s y leaves HiGHS's tolerance in M~^T y, it is projected onto the active constraints
-(`_polish`), and failing that the most robust certificate (`_interior`, margin t > 0) is tried.
+|z~|_1 < radius = gap / max(g_+). That bounds the size of feasible points but proves no
+infeasibility: float data whose M^T y = 0 holds only to rounding may have a solution just
+beyond the radius (a P-matrix singular to working precision does: the bench's first
+"infeasible" sets had |z| ~ 1e16 solutions behind float certificates of radius 9e14). So the
+status "infeasible" needs the exact check below; a certificate that passes only the float test
+(gap >= GAP, radius >= RADIUS, and HiGHS finds {z~ >= 0, M~ z~ + q~ >= 0} infeasible) is kept
+as evidence (`Farkas.exact` False) and said, never reported as "infeasible" (lcp.trust).
+y maps back to the user's problem as R y~ (the sign conditions are invariant under positive
+scalings). When (1)'s y leaves HiGHS's tolerance in M~^T y, it is projected onto the active
+constraints (`_polish`), and failing that the most robust certificate (`_interior`, margin
+t > 0) is tried.
 
-**Exact re-check.** A certificate that the float test rejects on its radius (M~^T y has
-entries of rounding size, e.g. 3.6e-15, where the exact certificate has 0) is not thrown
-away: `exact_certificate` looks for a rational y >= 0 on y's support with the nearly active
-rows of M~^T y exactly 0 (python-flint's exact row reduction, free unknowns set to y's
-values as small fractions), and checks y >= 0, M^T y <= 0, q^T y < 0 in exact rational
-arithmetic on the float data as given (each double is a rational number). Such a y proves
-that the LCP *as stored* has no feasible point: no tolerance and no radius are involved, and
-the LP's primal check is not needed.
+**Exact check.** Every candidate that the float test does not reject for a wrong sign is
+checked in exact rational arithmetic on the data as stored (each double is a rational
+number; the equilibration's factors are powers of 2, so M~ and q~ are exact too):
+`exact_certificate` tries y itself, y as small fractions, and (n <= EXACT_MAX_N) a rational
+y >= 0 on y's support with the nearly active rows of M~^T y made exactly 0 (python-flint's
+exact row reduction, free unknowns set to y's values as small fractions); it checks y >= 0,
+M^T y <= 0, q^T y < 0 exactly. Such a y proves that the LCP *as stored* has no feasible point:
+no tolerance and no radius are involved, and the LP's primal check is not needed. Beyond
+EXACT_DIRECT_MAX_N unknowns no exact check is made, so no "infeasible" is claimed.
 
-A P-matrix LCP always has a solution, so it never gets a certificate (unless its solution is
-beyond `radius` in the equilibrated units, i.e. M is singular to working precision).
+A P-matrix LCP always has a solution, so it never gets an exact certificate (a float one only
+when its solution is beyond `radius` in the equilibrated units, i.e. M is singular to working
+precision).
 Copositive-plus M (e.g. M + M^T PSD): a feasible LCP is solvable (Lemke's theorem, Cottle, Pang
 & Stone Thm 4.4.13), so infeasibility of the LCP is exactly this certificate.
 """
@@ -49,8 +54,10 @@ GAP = 1e-7
 #: n <= 100, so it cannot be certified; a smaller radius would "prove" solvable LCPs whose
 #: solution is merely huge (e.g. |z~| ~ 1e16 for cond(M) ~ 1e16) infeasible.
 RADIUS = 0.1 / np.finfo(float).eps
-#: Largest n for the exact re-check (rational arithmetic, O(n^3) at worst).
+#: Largest n for the exact row reduction onto y's active rows (rational arithmetic, O(n^3)).
 EXACT_MAX_N = 200
+#: Largest n for the exact check of y itself (n^2 rational products).
+EXACT_DIRECT_MAX_N = 1000
 _HIGHS = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-10}
 
 
@@ -86,8 +93,11 @@ def check_certificate(eq: Equilibration, y_tilde: np.ndarray) -> Farkas | None:
     gap = -float(eq.q @ y)
     slack = float(np.max(np.maximum(g, 0.0)))
     radius = np.inf if slack == 0 else gap / slack
-    if not (gap >= GAP and radius >= RADIUS):
-        return exact_certificate(eq, y) if gap > 0 else None
+    if not gap > 0:
+        return None
+    exact = exact_certificate(eq, y)
+    if exact is not None or not (gap >= GAP and radius >= RADIUS):
+        return exact
     return Farkas(y=y * eq.r / float(np.sum(y * eq.r)), gap=gap, radius=float(radius))
 
 
@@ -111,7 +121,7 @@ def exact_certificate(eq: Equilibration, y: np.ndarray, active_tol: float = 1e-9
     the exact solution of {(M~^T y)_J = 0 on the rows J that y nearly makes active, sum y = 1}
     on y's support with the free unknowns at y's values (as small fractions)."""
     n = y.size
-    if n > EXACT_MAX_N:
+    if n > EXACT_DIRECT_MAX_N:
         return None
     from flint import fmpq, fmpq_mat
 
@@ -123,7 +133,7 @@ def exact_certificate(eq: Equilibration, y: np.ndarray, active_tol: float = 1e-9
     g = eq.M.T @ y
     S = np.flatnonzero(y > 1e-12 * y.max())
     J = np.flatnonzero(g > -active_tol)
-    if S.size and J.size:
+    if S.size and J.size and n <= EXACT_MAX_N:
         cands.append(_active_solution(MT, S, J, small, n))
     for cand in cands:
         if cand is None or any(v < 0 for v in cand):

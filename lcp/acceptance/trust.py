@@ -13,13 +13,16 @@ The run (called by `lcp.api.solve` with a validated problem):
    other methods tried, and then the Solution names the method that produced it
    (``sol.method``; ``info["fallback_for"]`` keeps the first method's outcome). If nothing
    passes, the status is "inaccurate": z is the method's best point, with its errors;
-4. "infeasible" is kept only with a checked Farkas certificate (lcp.farkas); otherwise the
+4. "infeasible" is kept only with a Farkas certificate checked in exact rational arithmetic
+   (lcp.farkas; a certificate that passes only the floating-point test bounds the size of
+   feasible points but proves nothing, and is noted as such in the message); otherwise the
    status becomes "failed" (the claim could not be proved), or a fallback's answer is returned;
 5. "ray", "max_iter" and "failed" are retried once with the other equilibration setting. Then,
-   if the LP finds a Farkas certificate, the status becomes "infeasible" (not for a method
-   that raised: its status stays "failed", the exception in ``info["exception"]``)
-   (``info["status_of_method"]`` keeps the method's own); else, with a fallback asked for and
-   M copositive-plus (M + M^T PSD: solvable when feasible, Lemke's theorem), the fallbacks run.
+   if the LP finds an exactly checked Farkas certificate, the status becomes "infeasible"
+   (not for a method that raised: its status stays "failed", the exception in
+   ``info["exception"]``) (``info["status_of_method"]`` keeps the method's own); else, with a
+   fallback asked for and M copositive-plus (M + M^T PSD: solvable when feasible, Lemke's
+   theorem), the fallbacks run.
 """
 
 from __future__ import annotations
@@ -221,7 +224,7 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
         sol.info["copositive_plus"] = numerically_psd(run.lcp.M + run.lcp.M.T)
     if sol.status == "infeasible":
         cert = find_certificate(run.eq(True), sol.info.get("farkas"))
-        if cert is not None:
+        if cert is not None and cert.exact:
             sol.info.update(cert.as_info())
             return finish(sol, c)
         got = run.first_fallback(name)
@@ -232,7 +235,8 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
         sol.info["status_of_method"] = "infeasible"
         sol.message = (f"the method claimed infeasibility ({sol.message or 'no reason given'}), "
                        "but no Farkas certificate (y >= 0, M^T y <= 0, q^T y < 0) passes the "
-                       "check (lcp.farkas): infeasibility is not proved")
+                       "exact check (lcp.farkas): infeasibility is not proved")
+        _note_float_certificate(sol, cert)
         return finish(sol, c)
     if sol.status in ("ray", "max_iter", "failed"):
         if repair:
@@ -247,13 +251,28 @@ def solve_checked(run: Run, name: str, equilibrate: bool, repair: bool, options:
             if got is not None:
                 return _adopt(sol, got, f"{name} had ended with status {sol.status!r} on a "
                               "copositive-plus M with no certificate of infeasibility")
-        if cert is not None and "exception" not in sol.info:  # a crash stays the method's
-            sol.info.update(cert.as_info())                   # failure (bench, fuzz)
+        if cert is not None and cert.exact and "exception" not in sol.info:
+            sol.info.update(cert.as_info())  # (a crash stays the method's failure: bench, fuzz)
             sol.info["status_of_method"] = sol.status
             sol.status = "infeasible"
             _note(sol, f"the LCP is infeasible: a Farkas certificate y (info['farkas']) was "
                   f"found by LP and checked ({cert.how})")
+        else:
+            _note_float_certificate(sol, cert)
     return finish(sol, c)
+
+
+def _note_float_certificate(sol: Solution, cert) -> None:
+    """A certificate that passes only the floating-point test bounds every feasible point's
+    size (no feasible z~ with |z~|_1 < its radius) but proves no infeasibility: the data may
+    have a solution beyond it (a P-matrix singular to working precision does). Said, and kept
+    in info as evidence, never turned into the status "infeasible"."""
+    if cert is None or cert.exact:
+        return
+    sol.info.update(cert.as_info())
+    _note(sol, f"no feasible point within |z~|_1 < {cert.radius:.3g} (equilibrated units; a "
+          "floating-point Farkas certificate, info['farkas']): infeasibility is not proved, "
+          "a solution beyond that size is not excluded")
 
 
 def _retry_other_scaling(run: Run, first: Solution, name: str, equilibrate: bool,
@@ -271,7 +290,7 @@ def _retry_other_scaling(run: Run, first: Solution, name: str, equilibrate: bool
             return None
     elif sol.status == "infeasible":
         cert = find_certificate(run.eq(True), sol.info.get("farkas"))
-        if cert is None:
+        if cert is None or not cert.exact:
             return None
         sol.info.update(cert.as_info())
         c, acc = run.measure(sol.z), None

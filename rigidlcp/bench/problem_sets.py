@@ -147,27 +147,37 @@ def murty_lcp(n: int) -> LCP:
 def infeasible_lcp(n: int, rng: np.random.Generator) -> LCP:
     """A copositive-plus LCP with no solution, with its Farkas certificate in meta["farkas_y"].
 
-    y >= 0 (a random support of size >= 1), P = I - y y'/|y|^2 the projector orthogonal to y;
-    S = P B B' P (symmetric PSD, S y = 0) and K = P (A - A') P (skew, K y = 0); M = S + K is
-    copositive-plus (M + M' = 2 S is PSD) and M'y = 0. q ~ N(0, 1) shifted along y so that
-    q'y = -|y| (strictly negative). Then y'(M z + q) = q'y < 0 for every z, so no z >= 0 has
-    M z + q >= 0.
+    Integer data, so that the certificate holds exactly in the stored doubles: y >= 0 integer
+    (a random support, one entry 1), G (k x n) integer with G y = 0 (each row a combination of
+    y_j e_i - y_i e_j); S = G^T G (symmetric PSD, S y = 0) and K = G^T T G with T skew
+    (K y = 0); M = S + K is copositive-plus (M + M^T = 2 S is PSD) and M^T y = 0 exactly. q is
+    integer with q^T y = -d, d >= 1. Then y^T (M z + q) = q^T y < 0 for every z, so no z >= 0
+    has M z + q >= 0, and `lcp.farkas`'s exact check proves it. (Built in floating point,
+    M^T y = 0 held only to rounding, and such data can be a P-matrix with a solution of size
+    ~1e16: three of the six default problems were.)
     """
     if n < 1:
         raise ValueError("n must be >= 1")
-    y = np.zeros(n)
+    y = np.zeros(n, dtype=np.int64)
     support = rng.choice(n, size=int(rng.integers(1, n + 1)), replace=False)
-    y[support] = rng.uniform(0.5, 1.5, support.size)
-    P = np.eye(n) - np.outer(y, y) / (y @ y)
-    B = rng.uniform(-1, 1, (n, max(1, n - 1)))
-    A = rng.uniform(-1, 1, (n, n)) * rng.uniform(0, 1)
-    S = P @ B @ B.T @ P
-    S = 0.5 * (S + S.T)
-    K = P @ (A - A.T) @ P
-    K = 0.5 * (K - K.T)
-    q = rng.standard_normal(n)
-    q -= (q @ y + np.linalg.norm(y)) * y / (y @ y)
-    return LCP(S + K, q, meta={"farkas_y": y.tolist()})
+    y[support] = rng.integers(1, 4, support.size)
+    s = int(support[0])
+    y[s] = 1
+    k = max(1, n - 1)
+    G = np.zeros((k, n), dtype=np.int64)
+    for row in G:
+        for i in rng.choice(n, size=min(n, 3), replace=False):
+            if i != s:  # (y_i e_s - y_s e_i) . y = y_i y_s - y_s y_i = 0
+                c = int(rng.integers(-2, 3))
+                row[s] += c * y[i]
+                row[i] -= c * y[s]
+    T = rng.integers(-2, 3, (k, k))
+    T = T - T.T
+    M = G.T @ G + G.T @ T @ G
+    q = rng.integers(-3, 4, n)
+    q[s] -= int(q @ y) + int(rng.integers(1, 4))
+    assert not (M.T @ y).any() and q @ y < 0
+    return LCP(M.astype(float), q.astype(float), meta={"farkas_y": y.astype(float).tolist()})
 
 
 # --------------------------------------------------------------------------------------------

@@ -309,3 +309,15 @@ def test_siconos_own_reader_reads_what_we_write(tmp_path, blocks):
                          capture_output=True, text=True, check=True)
     got = json.loads(out.stdout)
     assert np.array_equal(np.array(got["M"]), M) and np.array_equal(np.array(got["q"]), p.q)
+
+
+def test_infeasible_set_is_proved_infeasible_exactly():
+    """The "infeasible" set is built from integers, so its y proves infeasibility in the stored
+    doubles (M^T y = 0 and q^T y < 0 exactly), and lcp.solve's answer is "infeasible" with a
+    certificate checked in exact rationals (a float-built set had solvable members)."""
+    for p in get_set("infeasible", sizes=(4, 16), per_size=2):
+        y = np.array(p.meta["farkas_y"])
+        assert np.all(y >= 0) and not np.any(p.M.T @ y) and p.q @ y < 0
+        assert np.all(p.M == np.round(p.M)) and np.all(p.q == np.round(p.q))
+        sol = lcp.solve(p)
+        assert sol.status == "infeasible" and sol.info["farkas_exact"] is True, sol.message

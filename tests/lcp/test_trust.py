@@ -7,8 +7,12 @@ the data proves infeasibility; verify.certify's acceptance test is the definitio
 
 from __future__ import annotations
 
+from fractions import Fraction
+from pathlib import Path
+
 import numpy as np
 import pytest
+from flint import fmpq, fmpq_mat
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -19,8 +23,10 @@ from rigidlcp.lcp.acceptance.farkas import find_certificate
 from rigidlcp.lcp.acceptance.residual import TOL, check, scaled_residual
 from rigidlcp.lcp.acceptance.scaling import ruiz
 from rigidlcp.lcp.solvers.enumeration import _Scales, _singular_basis
+from rigidlcp.lcp.solvers.lemke_exact import lemke_exact
 from rigidlcp.verify import certify
 
+DATA = Path(__file__).resolve().parents[1] / "data"
 SEEDS = st.integers(0, 2**32 - 1)
 
 
@@ -134,7 +140,33 @@ def test_infeasible_carries_a_checked_farkas_certificate(n, seed, method):
     assert np.all(y >= 0) and y.sum() == pytest.approx(1.0)
     assert float(q @ y) < 0
     assert np.max(M.T @ y) <= 1e-14 * np.abs(M).max()  # rounding (the data give -eps < 0)
-    assert sol.info["farkas_radius"] >= 0.1 / np.finfo(float).eps
+    assert sol.info["farkas_exact"] is True and sol.info["farkas_radius"] == np.inf
+
+
+@pytest.mark.parametrize("method", ["lemke", "pivoting", "enumerate", "newton-min"])
+def test_a_float_certificate_of_a_solvable_lcp_is_not_infeasibility(method):
+    """The bench's old "infeasible" set, n16-0 (built in floats: M^T y = 0 only to rounding),
+    stored in tests/data. M + M^T is positive definite as stored (smallest eigenvalue 6.9e-16
+    in floats; its leading principal minors are positive in exact rationals, Sylvester), so M
+    is a P-matrix and the LCP has a unique solution, of size ~2.4e16, which Lemke's method in
+    exact rationals finds. Every method had answered
+    "infeasible" on a floating-point certificate of radius 9.3e14 - 2.8e15; none may now. The
+    certificate stays as evidence (info, message) with farkas_exact False."""
+    d = np.load(DATA / "float_certificate_p_matrix_n16.npz")
+    M, q = d["M"], d["q"]
+    n, F = q.size, [Fraction(float(v)) for v in M.ravel()]
+    S = fmpq_mat(n, n, [fmpq(*(F[i * n + j] + F[j * n + i]).as_integer_ratio())
+                        for i in range(n) for j in range(n)])  # M + M^T in exact rationals
+    for k in range(1, n + 1):
+        minor = fmpq_mat(k, k, [S[i, j] for i in range(k) for j in range(k)])
+        assert minor.det() > 0
+    exact = lemke_exact(M, q, np.ones(q.size), 1000)
+    assert exact.status == "solved" and np.max(exact.z) > 1e15  # a solution exists
+    sol = lcp.solve(lcp.LCP(M, q), method)
+    assert sol.status != "infeasible", sol.message
+    if "farkas" in sol.info:
+        assert sol.info["farkas_exact"] is False
+        assert "infeasibility is not proved" in sol.message
 
 
 def test_a_p_matrix_lcp_never_gets_a_certificate():
