@@ -301,11 +301,13 @@ def same_state(status: str, what: str) -> str:
 def closed_summary(run) -> dict:
     """The closed-solution search of the run (models/engine/closed.py) for the JSON: on or off,
     at how many events it ran, the events where a closed solution was followed, and its
-    verdict at the stop ("proved", "undecided") when the run ends in a detachment."""
+    verdict at the stop ("proved", "undecided") when the run ends in a detachment (an event's
+    or, for `rigidlcp timestep`, a step's: models/step_closed.py)."""
     out = dict(run.closed)
     verdict = None
     if run.status == "detachment" and run.closed.get("search"):
-        verdict = ("proved" if "proved: no solution of the event" in run.message
+        verdict = ("proved" if ("proved: no solution of the event" in run.message
+                               or "proved: no solution of the step" in run.message)
                    else "undecided" if "undecided" in run.message else None)
     out["at_stop"] = verdict
     return out
