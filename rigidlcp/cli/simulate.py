@@ -313,13 +313,14 @@ def closed_summary(run) -> dict:
     return out
 
 
-def closed_text(c: dict) -> str:
-    """One line of the summary for `closed_summary`."""
+def closed_text(c: dict, unit: str = "event") -> str:
+    """One line of the summary for `closed_summary` (unit: "event", or "step" for a
+    time-stepper's run)."""
     if not c["search"]:
         return "off (--no-closed-search)"
-    text = f"on: ran at {c['searched']} event(s); a closed solution followed at " + (
-        "event(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
-        else "no event")
+    text = f"on: ran at {c['searched']} {unit}(s); a closed solution followed at " + (
+        f"{unit}(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
+        else f"no {unit}")
     if c["at_stop"]:
         text += f"; at the stop: {c['at_stop']} (message)"
     return text

@@ -104,7 +104,7 @@ def cmd_timestep(args) -> int:
             if k == "closed_search":
                 from .simulate import closed_text
 
-                v = closed_text(v)
+                v = closed_text(v, "step")
             elif isinstance(v, float):
                 v = f"{v:.6g}"
             elif isinstance(v, (list, tuple)) and all(isinstance(x, float) for x in v):
