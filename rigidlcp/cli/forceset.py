@@ -91,14 +91,15 @@ def cmd_forceset(args: argparse.Namespace) -> int:
     try:
         code = _forceset(args, lat, disks, left, right, system, out, known, journal)
     except BaseException as exc:
-        if journal is not None:
-            journal.close()
-            if journal.count + len(known) and isinstance(exc, KeyboardInterrupt):
+        if journal is not None:  # kept for a resume after Ctrl-C, and a resumed run's;
+            journal.close()     # else a refusal (e.g. of --samples) leaves nothing
+            stopped = isinstance(exc, KeyboardInterrupt)
+            if stopped and journal.count + len(known):
                 import sys
 
                 print(f"\n{journal.count + len(known)} range ends saved in {journal.path}: "
                       "the same command with --resume continues", file=sys.stderr)
-            elif not journal.count + len(known):
+            if not known and not (stopped and journal.count):
                 journal.remove()
         _remove_empty(made, out)
         raise
