@@ -57,7 +57,7 @@ def register(sub) -> None:
                    "run: the range ends it settled (DIR/forceset.ends, written as they are) "
                    "are read back, only the others are computed")
     p.add_argument("--no-progress", action="store_true", help="no progress bars on stderr "
-                   "(the phases, then the range ends; shown from 200 contacts)")
+                   "(the phases, from 1000 disks; the range ends, from 200 contacts)")
     p.set_defaults(func=cmd_forceset)
 
 
@@ -159,6 +159,12 @@ class EndsBar:
             self.bar.close()
 
 
+#: The phases before the ranges (existence, dimension), the samples and the figure are shown
+#: from this many disks (about 1 CPU s in all at 1000 disks, minutes at 10^4; a smaller pile's
+#: phases end before a bar means anything); the range ends' bar from 200 contacts.
+PHASES_FROM = 1000
+
+
 def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int:
     import sys
 
@@ -168,11 +174,12 @@ def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int
     from rigidlcp.verify.statics.forceset import analyse
 
     show = not args.no_progress and lat.c >= 200
+    phased = not args.no_progress and lat.p >= PHASES_FROM
     phases = PhaseBar()
     bar = EndsBar(before=phases.close)
     try:
         fs = analyse(system, ranges=not args.no_ranges, progress=bar if show else None,
-                     jobs=args.jobs, stage=phases if show else None, known=known,
+                     jobs=args.jobs, stage=phases if phased else None, known=known,
                      record=journal)
     finally:
         bar.close()
@@ -181,7 +188,7 @@ def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int
     if args.samples and fs.exists:  # before any file is written: a refusal leaves nothing
         from rigidlcp.verify.statics.ensemble import sample
 
-        if show:
+        if phased:
             phases(f"{args.samples} uniform samples of the admissible forces")
         try:
             ens = sample(fs, n=args.samples, seed=args.seed, cap=args.cap)
@@ -196,7 +203,7 @@ def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int
         if fs.exists and not args.no_ranges:
             from rigidlcp.verify.statics.plot import plot_forceset
 
-            if show:
+            if phased:
                 phases("figure forceset.png")
             plot_forceset(fs, out / "forceset.png")
             phases.close()
