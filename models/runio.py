@@ -50,7 +50,7 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
         "message": run.message, "contacts": run.contacts, "method": run.method,
         "wall_time": run.wall_time, "events": run.n_events,
         "methods_per_event": [r.method for r in run.records],
-        "closed": run.closed,  # the dense backend's closed-solution search, or None
+        "closed": run.closed,  # the closed-solution search, or None
         "summary": run.summary(),
     }
     text = json.dumps(meta, indent=2, default=_json_default)
@@ -69,7 +69,7 @@ def save_run(run: Run, path: str | os.PathLike) -> Path:
 
 def load_run(path: str | os.PathLike) -> Run:
     """Read a run written by `save_run` (the system is rebuilt from the metadata; run.closed,
-    the closed-solution search of a dense run, is restored, None in files older than it)."""
+    the closed-solution search of the run, is restored, None in files older than it)."""
     data_path, _ = run_paths(path)
     if Path(path).is_file() and not data_path.exists():  # e.g. a text file, not PATH.npz
         npz = Path(path).with_suffix(".npz")

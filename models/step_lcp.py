@@ -73,4 +73,27 @@ def coulomb_residual(system: System, P: np.ndarray, u: np.ndarray, P_scale: floa
     return float(max(r_n.max(initial=0.0), r_t.max(initial=0.0)))
 
 
-__all__ = ["StepProblem", "coulomb_residual"]
+def solve_step(problem: lcp.LCP, opts, warm: np.ndarray | None):
+    """Warm pivoting from the previous step's basis (when given), then opts.method, then
+    opts.fallback (opts: models.timestepping.StepOptions).
+    Returns (solution, name of the method that produced it, whether a fallback was used)."""
+    tried = []
+    if warm is not None:
+        sol = lcp.solve(problem, "pivoting", active=warm, max_iter=20)
+        if sol.status == "solved":
+            return sol, "pivoting-warm", False
+        tried.append(f"pivoting-warm: {sol.status}")
+    sol = lcp.solve(problem, opts.method)
+    if sol.status == "solved" or opts.fallback is None or opts.fallback == opts.method:
+        if tried and sol.status != "solved":
+            sol.message = "; ".join(tried + [f"{opts.method}: {sol.message}"])
+        return sol, opts.method, False
+    first = sol
+    sol = lcp.solve(problem, opts.fallback)
+    if sol.status != "solved":
+        sol.message = "; ".join(tried + [f"{opts.method}: {first.status}",
+                                         f"{opts.fallback}: {sol.message}"])
+    return sol, opts.fallback, True
+
+
+__all__ = ["StepProblem", "coulomb_residual", "solve_step"]

@@ -59,7 +59,8 @@ from .event import State, initial_state
 from .lattice import InvalidSystem
 from .observables import dissipation_rate, global_friction
 from .selection import Selection, select
-from .step_lcp import StepProblem, coulomb_residual
+from .step_lcp import StepProblem, coulomb_residual, solve_step
+from .step_rules import leaving, step_failure, stop_reason
 from .system import System
 
 
@@ -82,6 +83,7 @@ class StepOptions:
     max_steps: int = 2_000_000
     t_max: float = np.inf
     selection: str = "none"
+    closed_search: bool = True
 
     def __post_init__(self) -> None:
         h = _number("h", self.h)
@@ -145,11 +147,15 @@ def moreau_jean(
     "time_limit", "event_limit" (max_steps), "detachment" (u_n > 0: the no-displacement regime
     ends), "no_solution" / "solver_failed" (a step no solver solves within check_tol).
     options: the fields of StepOptions (method, fallback, warm_start, check_tol, steady_steps,
-    record_every, max_steps, t_max, selection); bad values raise InvalidStep. selection: which
+    record_every, max_steps, t_max, selection, closed_search); bad values raise
+    InvalidStep. selection: which
     solution of a step's LCP is followed where it has more than one (models/selection.py):
     "none" (default: the solver's, warm-started from the previous step), "face-min-norm",
     "max-sum-R[:CAP]" or "random:SEED" (sum of P_n in place of sum R); a selected point must
-    pass the same Coulomb-law check as the solver's, else the solver's is kept.
+    pass the same Coulomb-law check as the solver's, else the solver's is kept. closed_search
+    (default True): when a step's solution would open a contact or translate a disk, its
+    solution of least sum P_n keeping every contact closed is followed, or its absence proved
+    (models/step_closed.py; run.closed and the message say which, as for the event engine).
     progress(run, t, omega) is called after every step with the time and the angular
     velocities reached.
     """
@@ -164,22 +170,26 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
     """The steps of `moreau_jean` (its docstring): solve (`_step`), record (`_record`), stop."""
     dyn = Dynamics(system)
     state = (initial_state(system, omega=omega, seed=seed) if state is None else state).copy()
-    h, c, p = opts.h, system.c, system.p
+    h, p = opts.h, system.p
     run = Run(system, method=f"moreau-jean h={h:g} theta={opts.theta:g} ({opts.method}"
               + (f", selection {opts.selection})" if opts.selection != "none" else ")"))
     k = _Stepper(system, dyn, opts, state)
+    run.closed = {"search": opts.closed_search, "searched": 0, "followed": []}
     start = _time.perf_counter()
     for step in range(opts.max_steps):
         got = k.step()
-        failure = _failure(got, opts)
+        failure = step_failure(got, opts)
         if failure:
             run.status = failure[0]
             run.message = f"step {step} (t = {k.t:.6g} -> {k.t + h:.6g}): {failure[1]}"
             break
+        opening, moving = leaving(got, system, h)
+        note = ""
+        if opts.closed_search and (opening.size or moving.size):
+            got, note = k.closed(got, run.closed, step)
+            opening, moving = leaving(got, system, h)
         rec, settled = k.record(got)
         k.quiet = k.quiet + 1 if settled else 0
-        opening = np.flatnonzero(got.u[:c] > 1e-9 * got.u_scale)
-        moving = _translating(got, system, h)
         changed = not np.array_equal(rec.s, k.s_prev)
         if step == 0:  # the run's records start at its initial state (plots, dissipated
             # energy from t = state.t): the first step's forces, from the initial velocities
@@ -191,9 +201,10 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
                 or step + 1 == opts.max_steps)
         if changed or last or (opts.record_every and (step + 1) % opts.record_every == 0):
             run.records.append(rec)
-        stop = _stop(k, opening, moving, opts, step)
+        stop = stop_reason(k, opening, moving, opts, step)
         if stop:
-            run.status, run.message = stop
+            run.status, run.message = stop[0], stop[1] + (
+                f"; {note}" if note and stop[0] == "detachment" else "")
             if opening.size:
                 run.contacts = opening.tolist()
             break
@@ -202,6 +213,11 @@ def _integrate(system, state, opts, omega, seed, progress) -> Run:
     else:
         run.status, run.message = "event_limit", f"{opts.max_steps} steps"
     run.final = State(k.t, k.nu[2 * p:].copy(), k.V, k.s_prev.copy())
+    if run.closed["followed"]:
+        ev = run.closed["followed"]
+        run.message += (f"; at {len(ev)} step(s) ({', '.join(str(e) for e in ev[:10])}"
+                        f"{', ...' if len(ev) > 10 else ''}) the step's solution would open a "
+                        "contact and one keeping every contact closed was followed")
     run.wall_time = _time.perf_counter() - start
     return run
 
@@ -220,6 +236,7 @@ class _Step:
     u: np.ndarray | None
     res: float
     u_scale: float
+    b: np.ndarray | None = None  # the free velocities of the step (its LCP's q)
 
 
 class _Stepper:
@@ -271,9 +288,9 @@ class _Stepper:
             warm = (sp.warm_active(self.P_prev, self.ut_prev)
                     if opts.warm_start and self.P_prev is not None else None)
             problem = sp.lcp(b, self.t + h)
-            sol, used, fell_back = _solve_step(problem, opts, warm)
+            sol, used, fell_back = solve_step(problem, opts, warm)
             res = got.res if got is not None else np.inf
-            got = _Step(sol, used, fell_back, sp, None, None, None, res, u_scale)
+            got = _Step(sol, used, fell_back, sp, None, None, None, res, u_scale, b)
             if sol.status != "solved":
                 continue
             points = [sol.z]
@@ -283,16 +300,43 @@ class _Stepper:
                 if not how.startswith("failed"):
                     points.insert(0, y)
             for z in points:
-                got.P = sp.G @ z
-                got.dnu = dyn.Minv * (dyn.H.T @ got.P) + self.free_dnu
-                got.u = dyn.H @ (self.nu + got.dnu) + dyn.u_obs(V_next)
-                P_scale = max(float(np.abs(got.P).max(initial=0.0)), self.P_floor)
-                got.res = coulomb_residual(system, got.P, got.u, P_scale, u_scale)
+                self.point(got, z, V_next)
                 if got.res <= opts.check_tol:
                     break
             if got.res <= opts.check_tol:
                 break
         return got
+
+    def point(self, got: _Step, z: np.ndarray, V_next: float) -> None:
+        """Fill got with the impulses, velocity change, velocities and residual of z."""
+        dyn = self.dyn
+        got.P = got.sp.G @ z
+        got.dnu = dyn.Minv * (dyn.H.T @ got.P) + self.free_dnu
+        got.u = dyn.H @ (self.nu + got.dnu) + dyn.u_obs(V_next)
+        P_scale = max(float(np.abs(got.P).max(initial=0.0)), self.P_floor)
+        got.res = coulomb_residual(self.system, got.P, got.u, P_scale, got.u_scale)
+
+    def closed(self, got: _Step, closed: dict, step: int) -> tuple[_Step, str]:
+        """The step's solution of least sum P_n keeping every contact closed
+        (models/step_closed.py) in place of `got`, which would open one or translate a disk,
+        when it passes the step's own checks; else `got`, with the search's verdict."""
+        from .step_closed import search_step
+
+        closed["searched"] += 1
+        sp = self.step_problem(np.zeros(self.system.c, int))
+        scale = max(got.u_scale, self.P_floor)
+        found = search_step(sp, self.dyn, got.b, self.free_dnu, scale, self.opts.check_tol)
+        if found.status != "found":
+            return got, found.message
+        new = _Step(got.sol, "closed search", False, sp, None, None, None, np.inf, got.u_scale,
+                    got.b)
+        self.point(new, found.z, self.V + self.system.gamma * self.opts.h)
+        opening, moving = leaving(new, self.system, self.opts.h)
+        if new.res > self.opts.check_tol or opening.size or moving.size:
+            return got, (f"undecided: the closed solution found fails the step's check "
+                         f"(residual {new.res:.3g}, max u_n {new.u[:self.system.c].max():.3g})")
+        closed["followed"].append(step)
+        return new, found.message
 
     def record(self, got: _Step) -> tuple[EventRecord, bool]:
         """The step's record (t + h, velocities after it, mean forces, states) and whether it
@@ -323,71 +367,6 @@ class _Stepper:
         self.t, self.V, self.nu = rec.t, rec.V, self.nu + got.dnu
         self.od_prev, self.s_prev, self.P_prev = rec.omega_dot, rec.s, got.P
         self.ut_prev, self.at_prev = rec.vt, rec.at
-
-
-def _failure(got: _Step, opts: StepOptions) -> tuple[str, str] | None:
-    """(status, message) of a step no solver solved within check_tol, else None."""
-    sol, used = got.sol, got.used
-    if sol.status != "solved":
-        return (("no_solution" if sol.status in ("ray", "infeasible") else "solver_failed"),
-                f"{used} ended with status {sol.status!r} ({sol.message or 'no message'})")
-    if not got.res <= opts.check_tol:
-        return ("solver_failed", f"Coulomb-law residual {got.res:.3g} > check_tol "
-                f"{opts.check_tol:g} ({used})")
-    return None
-
-
-#: A disk translates when its mean translational acceleration over a step exceeds this
-#: fraction of max(g, |gamma|) (as models.engine.loop's check: the arrays block every
-#: translation, to rounding).
-TRANSLATION_TOL = 1e-7
-
-
-def _translating(got: _Step, system, h: float) -> np.ndarray:
-    """The disks that the step's impulses would translate (dnu's translational part != 0) with
-    every contact closed: a mechanism of a packing (e.g. a disk pushed along the plane with no
-    wall), which the no-displacement regime excludes; the paper's arrays never have one."""
-    p = system.p
-    size = np.hypot(got.dnu[:p], got.dnu[p:2 * p]) / h
-    return np.flatnonzero(size > TRANSLATION_TOL * max(system.g, abs(system.gamma), 1e-12))
-
-
-def _stop(k: _Stepper, opening: np.ndarray, moving: np.ndarray, opts: StepOptions, step: int
-          ) -> tuple[str, str] | None:
-    """(status, message) when the run stops after this step, else None."""
-    if opening.size:
-        return ("detachment", f"t = {k.t:.6g}: contact(s) would open (u_n > 0), the "
-                f"no-displacement regime ends: {opening[:5].tolist()}")
-    if moving.size:
-        return ("detachment", f"t = {k.t:.6g}: disk(s) would translate with every contact "
-                f"closed, the no-displacement regime ends: disks {moving[:5].tolist()}")
-    if k.quiet >= opts.steady_steps:
-        return "steady", f"steady state at t = {k.t:.6g} (step {step + 1})"
-    if k.t >= opts.t_max:
-        return "time_limit", f"t_max = {opts.t_max:g} reached"
-    return None
-
-
-def _solve_step(problem: lcp.LCP, opts: StepOptions, warm: np.ndarray | None):
-    """Warm pivoting from the previous step's basis (when given), then method, then fallback.
-    Returns (solution, name of the method that produced it, whether a fallback was used)."""
-    tried = []
-    if warm is not None:
-        sol = lcp.solve(problem, "pivoting", active=warm, max_iter=20)
-        if sol.status == "solved":
-            return sol, "pivoting-warm", False
-        tried.append(f"pivoting-warm: {sol.status}")
-    sol = lcp.solve(problem, opts.method)
-    if sol.status == "solved" or opts.fallback is None or opts.fallback == opts.method:
-        if tried and sol.status != "solved":
-            sol.message = "; ".join(tried + [f"{opts.method}: {sol.message}"])
-        return sol, opts.method, False
-    first = sol
-    sol = lcp.solve(problem, opts.fallback)
-    if sol.status != "solved":
-        sol.message = "; ".join(tried + [f"{opts.method}: {first.status}",
-                                         f"{opts.fallback}: {sol.message}"])
-    return sol, opts.fallback, True
 
 
 __all__ = ["InvalidStep", "StepOptions", "StepProblem", "coulomb_residual", "moreau_jean"]

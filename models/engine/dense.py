@@ -26,7 +26,7 @@ from rigidlcp.models.event import (
 from rigidlcp.models.selection import Selection, select
 from rigidlcp.models.system import System
 
-from .loop import TRANSLATION_FACTOR, Outcome
+from .loop import Outcome, regime_left
 
 #: How an event's particular solution is chosen when it is not unique (see `DenseBackend`;
 #: "random" is given with its seed, "random:SEED"; models/selection.py).
@@ -180,17 +180,14 @@ class DenseBackend:
 def leaves_regime(ep: EventProblem, es: EventSolution, residual: float) -> bool:
     """Whether the solution es would stop the run (models/engine/loop.py's `_detached` and
     `_translating`, same thresholds): a contact opens, or a disk translates."""
-    tol_a = acceleration_tol(ep.system)
-    if np.any(es.a_n > max(tol_a, 10 * residual)):
-        return True
-    size = np.hypot(*es.trans_acc.reshape(2, ep.system.p))
-    return bool(np.any(size > max(TRANSLATION_FACTOR * tol_a, 10 * residual)))
+    return regime_left(ep.system, es.a_n, es.trans_acc, residual)
 
 
 def closed_note(backend, run):
     """Say in run.closed and run.message at which events a closed solution was followed
-    instead of a selected one that would have opened a contact (models/engine/closed.py)."""
-    if isinstance(backend, DenseBackend):
+    instead of a selected one that would have opened a contact (models/engine/closed.py; the
+    dense and the sparse backends)."""
+    if getattr(backend, "closed_events", None) is not None:
         run.closed = {"search": backend.closed_search, "searched": backend.closed_searched,
                       "followed": list(backend.closed_events)}
         if backend.closed_events:

@@ -168,6 +168,18 @@ def _detached(run: Run, state: State, out: Outcome, tol_a: float) -> bool:
 TRANSLATION_FACTOR = 100.0
 
 
+def regime_left(system: System, a_n: np.ndarray, trans_acc: np.ndarray, residual: float
+                ) -> bool:
+    """Whether a solution with these a_n and translational accelerations (vx, vy rows) would
+    stop the run (`_detached`, `_translating`, same thresholds): a contact opens, or a disk
+    translates. Both backends' closed-solution searches start from it."""
+    tol_a = acceleration_tol(system)
+    if np.any(a_n > max(tol_a, 10 * residual)):
+        return True
+    size = np.hypot(*np.asarray(trans_acc).reshape(2, system.p))
+    return bool(np.any(size > max(TRANSLATION_FACTOR * tol_a, 10 * residual)))
+
+
 def _translating(run: Run, state: State, out: Outcome, dyn: Dynamics, tol_a: float) -> bool:
     """Every contact stays closed but a disk would translate (v' != 0): a mechanism of the
     packing (a disk or a cluster free to slide, e.g. a pile touching no wall pushed along the

@@ -62,7 +62,8 @@ class Run:
     method: str = "lemke"
     final: State | None = None
     sparse_info: dict | None = None
-    #: the closed-solution search of the dense backend (models/engine/closed.py): {"search":
+    #: the closed-solution search (models/engine/closed.py; both backends and the time-stepper,
+    #: whose "followed" are steps): {"search":
     #: on/off, "followed": the events where a closed solution replaced the selected one}
     closed: dict | None = None
 
@@ -104,7 +105,7 @@ class Run:
                # events answered by the fallback, not by `method` (issue 23.1)
                "fallback_solves": sum(1 for r in self.records if r.fallback),
                **regime(self.status)}
-        if self.closed is not None:  # the dense backend's closed-solution search
+        if self.closed is not None:  # the closed-solution search
             out["closed_search"] = dict(self.closed)
         if self.records:
             last = self.last

@@ -57,7 +57,7 @@ def simulate(
     during the run (the event problems are small dense matrices, for which one thread is
     fastest, and much faster on a loaded machine); None leaves BLAS alone.
 
-    closed_search (dense backend): when an event's selected solution would open a contact or
+    closed_search (both backends): when an event's selected solution would open a contact or
     translate a disk, look for a solution of the same event keeping every contact closed and
     follow it, or prove there is none (models/engine/closed.py); run.closed lists the events
     where one was followed. It runs only where the run would otherwise stop, so a run that
@@ -65,8 +65,7 @@ def simulate(
     """
     select = _one_rule(select, selection)
     backend = _backend(system, method, select, fallback, warm_start, dump_dir, check_tol)
-    if isinstance(backend, DenseBackend):
-        backend.closed_search = bool(closed_search)
+    backend.closed_search = bool(closed_search)
     if state is None:
         state = initial_state(system, omega=omega, seed=seed)
     limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
@@ -93,7 +92,8 @@ def _backend(system: System, method: str, select: str, fallback: str | None, war
         # imported here: a dense run needs no sparse LU (scipy.sparse.linalg, ~0.1 s to load)
         from .sparse import SparseBackend
 
-        return SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback)
+        return SparseBackend(system, dyn, warm_start=warm_start, fallback=fallback,
+                             check_tol=check_tol)
     return DenseBackend(system, dyn, method=method, fallback=fallback, select=select,
                         warm_start=warm_start, dump_dir=dump_dir, check_tol=check_tol)
 

@@ -18,6 +18,13 @@ Differences from the dense path, on purpose:
   otherwise the run stops with "solver_failed".
 * records="light" (an option of the loop) keeps only the scalars of each record except the last,
   so that long runs of large arrays do not hold c-sized arrays per event.
+
+As the dense path, when an event's solution would open a contact or translate a disk, the
+closed-solution search (closed_search, on by default) looks for a solution of the same event
+keeping every contact closed, on the event LCP assembled in sparse form
+(models/engine/sparse_closed.py), follows it or proves there is none; `closed_events` and
+the verdict in the run's message as for the dense backend. A run that never detaches is the
+same with it on or off.
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rigidlcp import lcp
 from rigidlcp.models.dynamics import Dynamics
 from rigidlcp.models.event import State, initial_state
 from rigidlcp.models.sparse_event import (
@@ -39,7 +47,7 @@ from rigidlcp.models.sparse_event import (
 )
 from rigidlcp.models.system import System
 
-from .loop import Limits, Outcome, blas_limit, run_events
+from .loop import Limits, Outcome, blas_limit, regime_left, run_events
 from .records import Run
 from .sparse_pivoting import StateSolution, lcp_residual, solve_states
 
@@ -69,6 +77,12 @@ class SparseBackend:
     method: str = METHOD
     info: dict = field(default_factory=lambda: {"seconds": [], "iterations": [], "fallbacks": 0,
                                                 **dict.fromkeys(COUNTERS, 0)})
+    check_tol: float = 1e-8  # the loop's acceptance, also of a closed solution followed
+    closed_search: bool = True
+    #: events (indices) where a solution keeping every contact closed was followed instead of
+    #: the pivoting's, which would have opened one; events where the search ran
+    closed_events: list = field(default_factory=list)
+    closed_searched: int = 0
 
     def __post_init__(self) -> None:
         self.asys = ActiveSystem(sparse_delassus(self.dyn), self.dyn.q, self.system.mu)
@@ -99,14 +113,49 @@ class SparseBackend:
         lam = np.concatenate([sol.R, sol.S])
         nu_dot = self.dyn.accelerations(lam)
         a = self.dyn.H @ nu_dot + self.dyn.u_obs_dot
+        residual, note = float(sol.residual), ""
+        p = self.system.p
+        if self.closed_search and residual <= self.check_tol * scale and regime_left(
+                self.system, a[:c], nu_dot[:2 * p], residual):
+            lam, nu_dot, a, residual, note = self._closed(state, sol, scale, lam, nu_dot, a,
+                                                          residual)
         elapsed = _time.perf_counter() - t0
         self.info["seconds"].append(elapsed)
         self.info["iterations"].append(int(sol.iterations))
         if self.event_hook is not None:
             self.event_hook(len(self.info["seconds"]) - 1, elapsed, sol, asys)
-        return Outcome("solved", METHOD, R=sol.R, S=sol.S, omega_dot=nu_dot[2 * self.system.p:],
-                       a_n=a[:c], a_t=a[c:], residual=float(sol.residual), scale=scale,
-                       iterations=int(sol.iterations), n_lcp=n_lcp, fallback=fell_back)
+        return Outcome("solved", METHOD, R=lam[:c], S=lam[c:], omega_dot=nu_dot[2 * p:],
+                       a_n=a[:c], a_t=a[c:], residual=residual, scale=scale,
+                       iterations=int(sol.iterations), n_lcp=n_lcp, fallback=fell_back,
+                       note=note)
+
+    def _closed(self, state: State, sol: StateSolution, scale: float, lam, nu_dot, a,
+                residual):
+        """The closed-solution search at this event (module doc): the closed solution's
+        (lambda, nu', a, residual, verdict) when one is found and passes the engine's own
+        acceptance, else the pivoting's with the verdict."""
+        from .sparse_closed import closed_event, states_of
+
+        self.closed_searched += 1
+        c, p = self.system.c, self.system.p
+        found, sc = closed_event(self.system, state, self.dyn, scale, self.check_tol)
+        if found.status != "found":
+            return lam, nu_dot, a, residual, found.message
+        z = found.z
+        r = float(lcp.complementarity_residual(z, sc.problem.M @ z + sc.problem.q))
+        lam2 = sc.G @ z
+        nu2 = self.dyn.accelerations(lam2)
+        a2 = self.dyn.H @ nu2 + self.dyn.u_obs_dot
+        if r > self.check_tol * scale or regime_left(self.system, a2[:c], nu2[:2 * p], r):
+            return lam, nu_dot, a, residual, (
+                f"undecided: the closed solution found fails the engine's check (residual "
+                f"{r:.3g}, max a_n {a2[:c].max(initial=0):.3g})")
+        self.closed_events.append(len(self.info["seconds"]))
+        try:  # the next event starts from the closed solution's states when it can
+            self.factor.set_states(*states_of(sc, z, sol.tang, c))
+        except SingularSystem:
+            pass
+        return lam2, nu2, a2, r, found.message
 
     def _start(self, s_in: np.ndarray, cand: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The states the pivoting starts from: `cold_start` at the first event (where the
@@ -155,18 +204,24 @@ def simulate_sparse(
     fallback_max_n: int = 3000,
     blas_threads: int | None = 1,
     event_hook: Callable[[int, float, StateSolution, ActiveSystem], None] | None = None,
+    closed_search: bool = True,
 ) -> Run:
     """Evolve `system` event by event on the sparse path (see the module doc and
     `SparseBackend` for the options; the others as models.simulate). The run's `sparse_info`
-    holds the seconds of every event and the pivoting's counters."""
+    holds the seconds of every event and the pivoting's counters; run.closed the
+    closed-solution search's events (as models.simulate's)."""
     if state is None:
         state = initial_state(system, omega=omega, seed=seed)
     backend = SparseBackend(system, Dynamics(system), warm_start=warm_start, tol=tol,
                             max_updates=max_updates, fallback=fallback,
-                            fallback_max_n=fallback_max_n, event_hook=event_hook)
+                            fallback_max_n=fallback_max_n, event_hook=event_hook,
+                            check_tol=check_tol, closed_search=bool(closed_search))
     limits = Limits(t_max, max_events, check_tol, zeno_events, zeno_time)
     with blas_limit(blas_threads):
-        return run_events(system, state, backend, limits, progress, records)
+        run = run_events(system, state, backend, limits, progress, records)
+    from .dense import closed_note
+
+    return closed_note(backend, run)
 
 
 def cold_start(asys: ActiveSystem, s_in: np.ndarray, cand: np.ndarray

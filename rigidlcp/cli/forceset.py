@@ -53,7 +53,11 @@ def register(sub) -> None:
                    "or \"unknown\": its check failed, see unknown_ends)")
     p.add_argument("--out", metavar="DIR", help="write forceset.json and forceset.png here")
     p.add_argument("--force", action="store_true", help="overwrite files in --out")
-    p.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
+    p.add_argument("--resume", action="store_true", help="continue an interrupted --out DIR "
+                   "run: the range ends it settled (DIR/forceset.ends, written as they are) "
+                   "are read back, only the others are computed")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars on stderr "
+                   "(the phases, from 1000 disks; the range ends, from 200 contacts)")
     p.set_defaults(func=cmd_forceset)
 
 
@@ -75,13 +79,58 @@ def cmd_forceset(args: argparse.Namespace) -> int:
         raise ValueError("--samples writes samples.npz and pf.png: give --out DIR")
     names = ["forceset.json", "forceset.png"] + (["samples.npz", "pf.png"] if args.samples
                                                   else [])
-    made = _first_missing(args.out) if args.out else None  # removed again if refused below
-    out = output_dir(args.out, force=args.force, names=names) if args.out else None
+    known, out = _resumed(args, system, names)
+    made = _first_missing(args.out) if args.out and out is None else None
+    if args.out and out is None:  # removed again if refused below
+        out = output_dir(args.out, force=args.force, names=names)
+    journal = None
+    if out is not None and not args.no_ranges:
+        from rigidlcp.cli.forceset_resume import Journal
+
+        journal = Journal(out, system, resume=args.resume)
     try:
-        return _forceset(args, lat, disks, left, right, system, out)
-    except BaseException:
+        code = _forceset(args, lat, disks, left, right, system, out, known, journal)
+    except BaseException as exc:
+        if journal is not None:  # kept for a resume after Ctrl-C, and a resumed run's;
+            journal.close()     # else a refusal (e.g. of --samples) leaves nothing
+            stopped = isinstance(exc, KeyboardInterrupt)
+            if stopped and journal.count + len(known):
+                import sys
+
+                print(f"\n{journal.count + len(known)} range ends saved in {journal.path}: "
+                      "the same command with --resume continues", file=sys.stderr)
+            if not known and not (stopped and journal.count):
+                journal.remove()
         _remove_empty(made, out)
         raise
+    if journal is not None:
+        journal.remove()  # forceset.json holds every end now
+    return code
+
+
+def _resumed(args, system, names) -> tuple[dict, object]:
+    """(ends of an interrupted run, its --out folder) for --resume; ({}, None) otherwise, after
+    refusing a folder that holds an interrupted run's journal (without --force)."""
+    from pathlib import Path
+
+    from rigidlcp.cli.forceset_resume import JOURNAL, read_journal
+    from rigidlcp.lcp.errors import InvalidInput
+    from rigidlcp.lcp.io.files import OutputExists, output_dir
+
+    if not args.resume:
+        if args.out and (Path(args.out) / JOURNAL).is_file() and not args.force:
+            raise OutputExists(f"{args.out} holds an interrupted run ({JOURNAL}): --resume "
+                               "continues it, --force starts again")
+        return {}, None
+    if not args.out or args.no_ranges:
+        raise InvalidInput("--resume continues the range ends of an --out DIR run: give --out "
+                           "(and not --no-ranges)")
+    if args.force:
+        raise InvalidInput("--resume continues a run, --force starts again: give one")
+    if not Path(args.out).is_dir():
+        raise InvalidInput(f"--resume: {args.out} is not a folder (nothing to resume)")
+    known = read_journal(Path(args.out), system)
+    return known, output_dir(args.out, force=True, names=names)
 
 
 class EndsBar:
@@ -92,13 +141,15 @@ class EndsBar:
 
     LABEL = "force range ends (by LP, kept basis or bound)"
 
-    def __init__(self) -> None:
-        self.bar = None
+    def __init__(self, before=None) -> None:
+        self.bar, self.before = None, before  # before(): called as the bar opens
 
     def __call__(self, done: int, total: int, stage: str) -> None:
         if self.bar is None:
             from rigidlcp.models.progress import new_bar
 
+            if self.before is not None:
+                self.before()
             self.bar = new_bar(total=total, desc=self.LABEL, unit="end")
         self.bar.total = total
         self.bar.update(done - self.bar.n)  # drawn at most every mininterval, not per end
@@ -108,23 +159,41 @@ class EndsBar:
             self.bar.close()
 
 
-def _forceset(args, lat, disks, left, right, system, out) -> int:
+#: The phases before the ranges (existence, dimension), the samples and the figure are shown
+#: from this many disks (about 1 CPU s in all at 1000 disks, minutes at 10^4; a smaller pile's
+#: phases end before a bar means anything); the range ends' bar from 200 contacts.
+PHASES_FROM = 1000
+
+
+def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int:
     import sys
 
+    from rigidlcp.cli.forceset_resume import PhaseBar
     from rigidlcp.lcp.io.files import atomic_write_text
     from rigidlcp.models.packing import report
     from rigidlcp.verify.statics.forceset import analyse
 
-    show = not args.no_progress and not args.no_ranges and lat.c >= 200
-    bar = EndsBar()
-    fs = analyse(system, ranges=not args.no_ranges, progress=bar if show else None,
-                 jobs=args.jobs)
-    bar.close()
+    show = not args.no_progress and lat.c >= 200
+    phased = not args.no_progress and lat.p >= PHASES_FROM
+    phases = PhaseBar()
+    bar = EndsBar(before=phases.close)
+    try:
+        fs = analyse(system, ranges=not args.no_ranges, progress=bar if show else None,
+                     jobs=args.jobs, stage=phases if phased else None, known=known,
+                     record=journal)
+    finally:
+        bar.close()
+        phases.close()
     ens = None
     if args.samples and fs.exists:  # before any file is written: a refusal leaves nothing
         from rigidlcp.verify.statics.ensemble import sample
 
-        ens = sample(fs, n=args.samples, seed=args.seed, cap=args.cap)
+        if phased:
+            phases(f"{args.samples} uniform samples of the admissible forces")
+        try:
+            ens = sample(fs, n=args.samples, seed=args.seed, cap=args.cap)
+        finally:
+            phases.close()
     result = fs.to_dict() if not args.no_ranges or not fs.exists else {
         k: v for k, v in fs.to_dict().items() if k in ("exists", "dimension", "box", "p", "c")}
     result["packing"] = report(lat).to_dict()
@@ -134,7 +203,10 @@ def _forceset(args, lat, disks, left, right, system, out) -> int:
         if fs.exists and not args.no_ranges:
             from rigidlcp.verify.statics.plot import plot_forceset
 
+            if phased:
+                phases("figure forceset.png")
             plot_forceset(fs, out / "forceset.png")
+            phases.close()
     if ens is not None:
         result["ensemble"] = _write_ensemble(ens, args, out)
         text = json.dumps(result, allow_nan=False)

@@ -301,23 +301,26 @@ def same_state(status: str, what: str) -> str:
 def closed_summary(run) -> dict:
     """The closed-solution search of the run (models/engine/closed.py) for the JSON: on or off,
     at how many events it ran, the events where a closed solution was followed, and its
-    verdict at the stop ("proved", "undecided") when the run ends in a detachment."""
+    verdict at the stop ("proved", "undecided") when the run ends in a detachment (an event's
+    or, for `rigidlcp timestep`, a step's: models/step_closed.py)."""
     out = dict(run.closed)
     verdict = None
     if run.status == "detachment" and run.closed.get("search"):
-        verdict = ("proved" if "proved: no solution of the event" in run.message
+        verdict = ("proved" if ("proved: no solution of the event" in run.message
+                               or "proved: no solution of the step" in run.message)
                    else "undecided" if "undecided" in run.message else None)
     out["at_stop"] = verdict
     return out
 
 
-def closed_text(c: dict) -> str:
-    """One line of the summary for `closed_summary`."""
+def closed_text(c: dict, unit: str = "event") -> str:
+    """One line of the summary for `closed_summary` (unit: "event", or "step" for a
+    time-stepper's run)."""
     if not c["search"]:
         return "off (--no-closed-search)"
-    text = f"on: ran at {c['searched']} event(s); a closed solution followed at " + (
-        "event(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
-        else "no event")
+    text = f"on: ran at {c['searched']} {unit}(s); a closed solution followed at " + (
+        f"{unit}(s) " + ", ".join(str(e) for e in c["followed"][:10]) if c["followed"]
+        else f"no {unit}")
     if c["at_stop"]:
         text += f"; at the stop: {c['at_stop']} (message)"
     return text

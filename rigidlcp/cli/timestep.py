@@ -28,6 +28,10 @@ def register(sub) -> None:
     g.add_argument("--selection", type=selection_rule, default="none", metavar="RULE",
                    help="the point followed where a step's solution is not unique: none "
                    "(default: the solver's), face-min-norm, max-sum-R[:CAP], random:SEED")
+    g.add_argument("--no-closed-search", dest="closed_search", action="store_false",
+                   help="stop at a step whose solution opens a contact without looking for "
+                   "one of the same step that keeps every contact closed (default: look, "
+                   "and follow it or prove there is none)")
     g.add_argument("--t-max", type=float, default=np.inf, help="stop at this time (> 0; default: "
                    "no limit)")
     g.add_argument("--max-steps", type=int, default=2_000_000,
@@ -73,11 +77,16 @@ def cmd_timestep(args) -> int:
         run = moreau_jean(system, seed=args.seed, h=args.h, theta=args.theta,
                           method=args.method, t_max=args.t_max, max_steps=args.max_steps,
                           record_every=args.record_every, selection=args.selection,
+                          closed_search=args.closed_search,
                           progress=progress if bar is not None else None)
     finally:
         if bar is not None:
             bar.close()
     summary = run.summary()
+    if run.closed is not None:
+        from .simulate import closed_summary
+
+        summary["closed_search"] = closed_summary(run)
     if args.out:
         summary["saved"] = str(save_run(run, args.out))
     if args.json:
@@ -92,7 +101,11 @@ def cmd_timestep(args) -> int:
               f"gamma = {system.gamma} g, V0 = {system.V0}")
         width = max(len(k) for k in summary)
         for k, v in summary.items():
-            if isinstance(v, float):
+            if k == "closed_search":
+                from .simulate import closed_text
+
+                v = closed_text(v, "step")
+            elif isinstance(v, float):
                 v = f"{v:.6g}"
             elif isinstance(v, (list, tuple)) and all(isinstance(x, float) for x in v):
                 v = "[" + ", ".join(f"{x:.6g}" for x in v) + "]"

@@ -217,7 +217,8 @@ def test_forceset_progress_is_not_redrawn_at_every_lp(tmp_path, capsys, monkeypa
     from rigidlcp.models.packing_io import write_packing
 
     real = progress.new_bar
-    monkeypatch.setattr(progress, "new_bar", lambda **kw: real(mininterval=3600, **kw))
+    # (the phase bar passes its own mininterval=0: every phase shown; this one wins here)
+    monkeypatch.setattr(progress, "new_bar", lambda **kw: real(**{**kw, "mininterval": 3600}))
 
     pile = write_packing(tmp_path / "p.csv", deposit(100, seed=2, radii=(0.8, 1.2),
                                                      width=20.0))

@@ -148,3 +148,26 @@ def test_dense_memory_check_counts_the_packings_contacts(pile_run, tmp_path, mon
     assert main(args) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "(24 contacts)" in err and not out.exists()
+
+
+def test_timestep_and_the_sparse_backend_say_the_detachment_is_forced(tmp_path, capsys):
+    """The same spun pile on the time-stepper and on the sparse backend: each proves that no
+    solution of its first step / event keeps every contact closed (models/step_closed.py,
+    models/engine/sparse_closed.py), and says so as simulate does; --no-closed-search is the
+    old stop."""
+    pile = write_packing(tmp_path / "pile.csv", deposit(20, seed=1, radii=(0.8, 1.2),
+                                                         width=8.0))
+    for cmd in (["timestep", "--h", "0.01"],
+                ["simulate", "--method", "sparse-pivoting", "--select", "none"]):
+        assert main([*cmd, "--packing", str(pile), "--no-progress", "--json"]) == 1
+        summary = json.loads(capsys.readouterr().out)
+        assert summary["status"] == "detachment"
+        assert summary["closed_search"] == {"search": True, "searched": 1, "followed": [],
+                                            "at_stop": "proved"}
+        assert main([*cmd, "--packing", str(pile), "--no-progress", "--json",
+                     "--no-closed-search"]) == 1
+        off = json.loads(capsys.readouterr().out)
+        assert off["closed_search"]["search"] is False and off["closed_search"]["at_stop"] is None
+    assert main(["timestep", "--h", "0.01", "--packing", str(pile), "--no-progress"]) == 1
+    assert "on: ran at 1 step(s); a closed solution followed at no step" in (
+        capsys.readouterr().out)

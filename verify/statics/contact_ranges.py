@@ -125,10 +125,14 @@ def sliding_of(prob: StaticProblem, lp: ForceLP, implicit: list[str], hi_R: np.n
 def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
                    witness: np.ndarray,
                    progress: Callable[[int, int, str], None] | None = None,
-                   jobs: int = 1) -> Ranges:
+                   jobs: int = 1, known: dict | None = None,
+                   record: Callable[[int, str, float], None] | None = None) -> Ranges:
     """The ranges of every R and S and the sliding contacts (module docstring). witness: a
     checked point of P; lp: a ForceLP of P (built here if None; unused when jobs > 1);
-    progress(done, total, "ranges") as the ends are settled (by any means: `end_count`)."""
+    progress(done, total, "ranges") as the ends are settled (by any means: `end_count`).
+    known: {(k, "min" | "max"): value} ends of [R; S] settled by an earlier run on the same P
+    (each a checked end then), taken as they are (a resumed `rigidlcp forceset --out`);
+    record(k, side, value): called for every end settled here but an unknown one."""
     check_jobs(jobs)
     c = prob.c
     total, done = end_count(prob, implicit), 0
@@ -141,14 +145,14 @@ def contact_ranges(prob: StaticProblem, lp: ForceLP | None, implicit: list[str],
 
     wit = Witnesses.of(prob, witness)
     if jobs > 1 and c > 1:
-        return _in_workers(prob, implicit, wit, step, jobs)
+        return _in_workers(prob, implicit, wit, step, jobs, known or {}, record)
     lp = lp or ForceLP(prob)
     every = np.arange(c)
     unknown: list[Unknown] = []
     unsure: list[int] = []
     retried = [0]
     lo, hi, lps, unchecked = ranges_of(prob, DualForceLP(prob, lp), implicit, every, wit, step,
-                                       unknown, retried)
+                                       unknown, retried, known=known, record=record)
     sliding, more, bad = sliding_of(prob, lp, implicit, hi[:c], wit.seen, every, unsure,
                                     retried)
     return Ranges(lo, hi, sliding, lps + more, unchecked + bad, unknown,
@@ -181,11 +185,12 @@ def _start(system: models.System) -> None:
 
 
 def _range_chunk(task):
-    implicit, contacts, wit = task
+    implicit, contacts, wit, known = task
     unknown: list[Unknown] = []
     retried = [0]
     lo, hi, lps, unchecked = ranges_of(_WORKER["prob"], _WORKER["dual"], implicit, contacts,
-                                       wit, None, unknown, retried, _WORKER["vertices"])
+                                       wit, None, unknown, retried, _WORKER["vertices"],
+                                       known=known)
     return contacts, lo, hi, lps, unchecked, wit, unknown, retried[0]
 
 
@@ -199,7 +204,7 @@ def _sliding_chunk(task):
 
 
 def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
-                jobs: int) -> Ranges:
+                jobs: int, known: dict, record) -> Ranges:
     c = prob.c
     lo, hi = np.zeros(prob.n), np.zeros(prob.n)
     sliding = np.zeros(c, dtype=bool)
@@ -231,6 +236,8 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
             out.unknown.extend(unknown)
             out.retried += retried
             wit.merge(w)
+            if record is not None:
+                _record_chunk(record, c, contacts, lo_x, hi_x)
             step(int(sum(2 + 2 * (prob.mu[a] > 0 and not implicit[a])
                          for a in contacts if implicit[a] != "R=0")))
 
@@ -242,7 +249,26 @@ def _in_workers(prob: StaticProblem, implicit: list[str], wit: Witnesses, step,
             out.unchecked += unchecked
             out.retried += retried
 
-        run(_range_chunk, lambda ch: (implicit, ch, wit), merge_ranges)
+        run(_range_chunk, lambda ch: (implicit, ch, wit, _known_of(known, c, ch)),
+            merge_ranges)
         run(_sliding_chunk, lambda ch: (implicit, ch, hi[:c], wit.seen), merge_sliding)
     out.unknown.sort(key=lambda u: (u.k, u.side))
     return out
+
+
+def _known_of(known: dict, c: int, contacts: np.ndarray) -> dict:
+    """The known ends of a chunk's contacts (R: k = a, S: k = c + a)."""
+    ks = set(int(a) for a in contacts) | set(c + int(a) for a in contacts)
+    return {key: v for key, v in known.items() if key[0] in ks}
+
+
+def _record_chunk(record, c: int, contacts: np.ndarray, lo_x: np.ndarray,
+                  hi_x: np.ndarray) -> None:
+    """record(k, side, value) for a chunk's ends (lo_x, hi_x: R then S), unknown ones left
+    out."""
+    m = len(contacts)
+    for x, a in enumerate(contacts):
+        for k, pos in ((int(a), x), (c + int(a), m + x)):
+            for side, v in (("min", lo_x[pos]), ("max", hi_x[pos])):
+                if not np.isnan(v):
+                    record(k, side, float(v))

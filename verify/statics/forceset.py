@@ -160,34 +160,43 @@ class ForceSet:
 
 def analyse(system: models.System, ranges: bool = True,
             progress: Callable[[int, int, str], None] | None = None,
-            jobs: int = 1) -> ForceSet:
+            jobs: int = 1, stage: Callable[[str, str], None] | None = None,
+            known: dict | None = None,
+            record: Callable[[int, str, float], None] | None = None) -> ForceSet:
     """Existence, dimension, ranges and sliding contacts of P (module docstring).
     progress(done, total, stage): called as the range ends are settled (by an LP, a kept basis
     or a bound: verify.statics.contact_ranges.end_count, the total); jobs: worker
-    processes for the range LPs (verify.statics.contact_ranges; 1: in this process)."""
+    processes for the range LPs (verify.statics.contact_ranges; 1: in this process).
+    stage(name, detail): called as each phase before the ranges starts (name: the phase, e.g.
+    "existence: interior point"; detail: "" or how far it is, e.g. windows solved), for
+    progress on large packings. known, record: range ends settled by an earlier run of the
+    same P, and a callback for each end settled now (contact_ranges; resuming)."""
     check_jobs(jobs)  # before any LP
+    say = stage or _silent
     prob = StaticProblem(system)
     weight = float(np.sum(system.masses)) * system.g
     # deposited piles lose their equilibrium locally: small windows first (a few LPs per
     # disk, each exactly checked; 0.3 CPU s on the 10^4-disk pile, docs/packings.md, Scale)
-    local = scan(prob, levels=1)
+    say(WINDOWS, "")
+    local = scan(prob, levels=1, progress=lambda n, side: say(WINDOWS, f"{n} windows"))
     if local is not None:
         return _falls(system, local.y, local.disks, local.windows)
     # the IPM is fast, and its point a relative-interior witness; when it finds no point in
     # its box, a Farkas certificate (wider windows, then one LP, IPM) usually settles
     # existence before any simplex (27 CPU s for the equilibrium LP of a 3000-disk pile
     # without equilibrium)
-    status, lam = _interior(prob, weight)
+    status, lam = _interior(prob, weight, say)
     interior = status == "optimal" and prob.admissible(lam)
     lp = cert = None
     if not interior:
         if status != "optimal":  # HiGHS's IPM says "infeasible" or stops undecided
-            cert = _certificate(prob)
+            cert = _certificate(prob, say)
         if cert is None or not cert.proves:
+            say("existence: equilibrium LP (simplex)", "")
             lp = ForceLP(prob)
             status, lam = lp.solve(np.zeros(prob.n))
         if cert is not None and cert.proves or status != "optimal" or not prob.admissible(lam):
-            cert = cert if cert is not None else _certificate(prob)
+            cert = cert if cert is not None else _certificate(prob, say)
             if not cert.proves:  # neither a checked solution nor a checked certificate
                 return ForceSet(system, None, radius=cert.radius, lps=3,
                                 undecided=f"equilibrium LP {status}; Farkas certificate "
@@ -202,16 +211,19 @@ def analyse(system: models.System, ranges: bool = True,
         # reported network is a simplex vertex when that is closer (checked the same way);
         # not on large packings: that simplex had not ended after 14 minutes wall (load
         # 6-14) on a 100 x 100 array written as a packing (docs/packings.md, Scale)
+        say("a vertex of the admissible set (simplex)", "")
         lp = ForceLP(prob)
         status, vertex = lp.solve(np.zeros(prob.n))
         if (status == "optimal" and prob.admissible(vertex)
                 and max(prob.residuals(vertex)) < max(prob.residuals(lam))):
             witness = vertex
     fs = ForceSet(system, True, solution=witness, lps=1, residuals=prob.residuals(witness))
+    say("implicit equalities", "")
     fs.implicit = implicit_equalities(prob, lam if interior else None)
+    say("dimension (rank of the balance)", "")
     fs.dimension, fs.rank_gap = dimension(prob, fs.implicit)
     if ranges:
-        r = contact_ranges(prob, lp, fs.implicit, witness, progress, jobs)
+        r = contact_ranges(prob, lp, fs.implicit, witness, progress, jobs, known, record)
         fs.lo, fs.hi, fs.sliding = r.lo, r.hi, r.sliding
         fs.sliding_unknown, fs.unknown, fs.retried = r.sliding_unknown, r.unknown, r.retried
         fs.lps += r.lps
@@ -219,14 +231,25 @@ def analyse(system: models.System, ranges: bool = True,
     return fs
 
 
-def _interior(prob: StaticProblem, weight: float) -> tuple[str, np.ndarray | None]:
+def _silent(name: str, detail: str) -> None:
+    """analyse's stage callback when none is given."""
+
+
+#: The first phase's name (stage callback).
+WINDOWS = "existence: local certificates in windows"
+
+
+def _interior(prob: StaticProblem, weight: float, say=_silent
+              ) -> tuple[str, np.ndarray | None]:
     """A point deep in P: the analytic centre (verify.statics.centre: 1.5-4.2 CPU s at 10^4
     disks; where P has implicit equalities, the centre of the face where the coordinates that
     vanished are 0) when it passes the check against P, else HiGHS's IPM in a box
     (`interior_point`: 67-111 CPU s there)."""
+    say("existence: interior point (analytic centre)", "")
     lam = analytic_centre(prob)
     if lam is not None and prob.admissible(lam):
         return "optimal", lam
+    say("existence: interior point (HiGHS IPM)", "")
     return interior_point(prob, 1e3 * weight)
 
 
@@ -246,11 +269,15 @@ class _Local(Certificate):
         self.disks, self.windows = disks, windows
 
 
-def _certificate(prob: StaticProblem) -> Certificate:
+def _certificate(prob: StaticProblem, say=_silent) -> Certificate:
     """Wider windows (verify.statics.local), then the global Farkas LP."""
-    local = scan(prob, start=2 * START_DIAMETERS)
+    name = "existence: Farkas certificate in wider windows"
+    say(name, "")
+    local = scan(prob, start=2 * START_DIAMETERS,
+                 progress=lambda n, side: say(name, f"{n} windows, side {side:.3g}"))
     if local is not None:
         return _Local(local.y, local.disks, local.gap, local.windows)
+    say("existence: global Farkas certificate (IPM)", "")
     return farkas(prob)
 
 

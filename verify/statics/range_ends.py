@@ -131,13 +131,17 @@ class Vertices:
 def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str],
               contacts: np.ndarray, wit: Witnesses, step: Callable[[int], None] | None = None,
               unknown: list[Unknown] | None = None, retried: list[int] | None = None,
-              vertices: Vertices | None = None) -> tuple[np.ndarray, np.ndarray, int, int]:
+              vertices: Vertices | None = None, known: dict | None = None,
+              record: Callable[[int, str, float], None] | None = None
+              ) -> tuple[np.ndarray, np.ndarray, int, int]:
     """(lo, hi) of [R; S] at `contacts` (each (2 len(contacts),): R then S; NaN: unknown),
     LPs solved, ends reported unknown (their check failed after the retries; appended to
     `unknown` with their evidence, indices in P's [R; S]); wit is updated with every checked
     optimum; retried[0] counts the answers settled by a retry; vertices: the optimal bases
     kept (module docstring; a new store when None). step(n): called with the number of ends
-    settled (by LP, kept basis or bound) as they are."""
+    settled (by LP, kept basis or bound) as they are. known: {(k, "min" | "max"): value}
+    ends settled before (a resumed run), settled first as they are; record(k, side, value):
+    called for each end settled here (not the unknown ones)."""
     c, mu = prob.c, prob.mu
     contacts = np.asarray(contacts, dtype=int)
     m = contacts.size
@@ -172,6 +176,16 @@ def ranges_of(prob: StaticProblem, lp: DualForceLP | ForceLP, implicit: list[str
         todo[e] = False
         if step:
             step(1)
+        if record is not None and not np.isnan(value):
+            record(int(k_of[e]), "max" if q[e] % 2 == 0 else "min", float(value))
+
+    for e in np.flatnonzero(todo) if known else ():
+        key = (int(k_of[e]), "max" if q[e] % 2 == 0 else "min")
+        if key in known:
+            out[e] = known[key]
+            todo[e] = False
+            if step:
+                step(1)
 
     while True:
         # 1. bounds attained at checked points
