@@ -41,7 +41,12 @@ C(U)^-1 C(L)^-1 P g, and reports that larger bound instead when it is at most 1e
 (_bound_core.h's CHEAP_FERR; no verdict at FERR_TOL or at bench's accuracies depends on it;
 tests/lcp/test_comparison_bound.py); without the C extension |K_PP^-1| is always formed. A
 singular K_PP (a continuum of solutions) uses its pseudo-inverse at the numerical rank (y's
-distance to the refined point added), and an inconsistent one has ferr = inf.
+distance to the refined point added), and an inconsistent one has ferr = inf. Consistency is
+decided exactly (ranks in rationals, up to 200 unknowns; beyond, at the least-norm point),
+never only at the answer's own size: a z inflated along a null direction of K_PP keeps its
+residual while the rows' terms grow, which had made an inconsistent pattern look consistent
+(verify.certify accepted z = 1e13 d on an infeasible LCP with M d = 0;
+tests/lcp/test_inflated_null_direction.py).
 
 **Accepted** iff berr <= TOL (lcp.residual.TOL = 1e-8) and ferr <= FERR_TOL. lcp.solve (and its
 fast paths, solve_many, the friction and unreduced-MLCP branches) and verify.certify use
@@ -224,9 +229,48 @@ def refine(Kp: np.ndarray, kp: np.ndarray, y0: np.ndarray) -> tuple[np.ndarray, 
             scale = np.maximum(absK @ np.abs(y) + np.abs(kp), data_scale(Kp, kp))
             if np.any(np.abs(r) > 1e3 * m * _EPS * np.maximum(scale, 1e-300)):
                 return y, np.inf
+            # ... and not only at y, whose size the answer can inflate: with K_PP d = 0,
+            # y + t d keeps y's residual while |K| |y + t d| grows with t, so an inconsistent
+            # system looked consistent at a large enough y. Decided exactly where small
+            # (rank of K_PP against rank of [K_PP, k_P] in rationals: a K_PP singular only to
+            # working precision, with a huge exact solution, stays consistent), else at the
+            # least-norm point, whose size the answer cannot change.
+            consistent = _exactly_consistent(Kp, kp)
+            if consistent is None:
+                y_mn = -solve(kp)
+                r_mn = _residual_ld(Kp, kp, y_mn)
+                scale_mn = np.maximum(absK @ np.abs(y_mn) + np.abs(kp), data_scale(Kp, kp))
+                consistent = not np.any(
+                    np.abs(r_mn) > 1e3 * m * _EPS * np.maximum(scale_mn, 1e-300))
+            if not consistent:
+                return y, np.inf
         ynorm = max(float(np.max(np.abs(y))), 1e-300)
         ferr = float(np.max(np.abs(inv) @ g)) / ynorm + _EPS
     return y, (ferr if np.isfinite(ferr) else np.inf)
+
+
+#: Largest pattern decided exactly by `_exactly_consistent` (rational row reduction).
+EXACT_CONSISTENCY_MAX_M = 200
+
+
+def _exactly_consistent(Kp: np.ndarray, kp: np.ndarray) -> bool | None:
+    """Whether K_PP y = -k_P has an exact solution, each double read as a rational: rank of
+    K_PP equal to the rank of [K_PP, k_P] (python-flint's exact row reduction). None beyond
+    EXACT_CONSISTENCY_MAX_M unknowns or on non-finite data."""
+    m = kp.size
+    if m > EXACT_CONSISTENCY_MAX_M or not (np.all(np.isfinite(Kp)) and np.all(np.isfinite(kp))):
+        return None
+    from fractions import Fraction
+
+    from flint import fmpq, fmpq_mat
+
+    def q(v: float):
+        f = Fraction(float(v))
+        return fmpq(f.numerator, f.denominator)
+
+    A = fmpq_mat(m, m, [q(v) for v in Kp.ravel()])
+    Ak = fmpq_mat(m, m + 1, [q(v) for row in np.c_[Kp, kp] for v in row])
+    return A.rref()[1] == Ak.rref()[1]
 
 
 def assess(K: np.ndarray, k: np.ndarray, x: np.ndarray, nu: int = 0,
