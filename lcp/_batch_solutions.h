@@ -79,6 +79,11 @@ static PyObject *py_batch_solutions(PyObject *self, PyObject *args)
         Py_CLEAR(list);
         goto done;
     }
+    /* The collector off while the k Solutions are made (as it was): each one (and its info
+     * dict) is a tracked container, and every 700 of them would start a collection that walks
+     * the young ones again -- 0.08 us per problem at n = 10. The objects are the same; the
+     * collector runs as usual at the next allocation after the loop. */
+    int gc_was = PyGC_Disable();
     for (idx p = 0; p < k; p++) {
         const double *a = acc + 4 * p;
         double raw = mea[4 * p], scaled = mea[4 * p + 1];
@@ -104,6 +109,7 @@ static PyObject *py_batch_solutions(PyObject *self, PyObject *args)
         }
         PyList_SET_ITEM(list, p, sol);
     }
+    if (gc_was) PyGC_Enable();
     if (basis != bbuf) free(basis);
 done:
     release(&vB);

@@ -4,14 +4,25 @@ refused with a typed error."""
 
 from __future__ import annotations
 
+import dataclasses
+import gc
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
 
+from .test_fast_lemke import same
 from .test_lemke import degenerate_integer_lcps, murty_matrix, murty_q
+
+
+def same_outcome(a, b) -> bool:
+    """Two Solutions equal field for field, bit for bit."""
+    return type(a) is type(b) and all(same(getattr(a, f.name), getattr(b, f.name))
+                                      for f in dataclasses.fields(a))
 
 
 def random_lcps(k: int, n: int, seed: int) -> list[lcp.LCP]:
@@ -134,3 +145,50 @@ def test_each_answer_is_judged_once(monkeypatch):
                       "iterations"):
             assert repr(getattr(got, field)) == repr(getattr(one, field))
         assert got.info == one.info
+
+
+@st.composite
+def batches(draw):
+    """A list of LCPs of mixed sizes (1..12) and kinds -- A A^T + 0.1 I, nonsymmetric, integer
+    degenerate (rays, infeasible, q >= 0, ties) -- some of them repeated, as a study's list is."""
+    out = []
+    for _ in range(draw(st.integers(1, 8))):
+        n = draw(st.integers(1, 12))
+        seed = draw(st.integers(0, 2**16))
+        rng = np.random.default_rng(seed)
+        kind = draw(st.sampled_from(["psd", "nonsymmetric", "degenerate"]))
+        if kind == "psd":
+            A = rng.standard_normal((n, n))
+            M, q = A @ A.T + 0.1 * np.eye(n), rng.standard_normal(n)
+        elif kind == "nonsymmetric":
+            M, q = rng.standard_normal((n, n)) + n * np.eye(n), rng.standard_normal(n)
+        else:
+            M = rng.integers(-2, 3, (n, n)).astype(float)
+            q = rng.integers(-2, 3, n).astype(float)
+        out += [lcp.LCP(M, q)] * draw(st.integers(1, 3))
+    return out
+
+
+@given(batches())
+def test_solve_many_is_a_loop_of_solve_field_by_field(problems):
+    """Every field of every Solution -- z, w, status, method, pivots, residuals, backward and
+    forward error, basis, u, message, info -- bit for bit that of `lcp.solve(p)`, whichever
+    route each answer took (the C loop and batch_solutions, numpy's judge, `lcp.solve`)."""
+    many = lcp.solve_many(problems)
+    assert type(many) is list and len(many) == len(problems)
+    for p, got in zip(problems, many):
+        assert same_outcome(got, lcp.solve(p))
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_solve_many_leaves_the_collector_as_it_found_it(enabled):
+    """batch_solutions turns the collector off while it builds the Solutions (lcp/
+    _batch_solutions.h) and back on only if it was on."""
+    was = gc.isenabled()
+    try:
+        gc.enable() if enabled else gc.disable()
+        sols = lcp.solve_many(random_lcps(30, 4, 6))
+        assert gc.isenabled() is enabled
+        assert all(s.status == "solved" for s in sols)
+    finally:
+        gc.enable() if was else gc.disable()
