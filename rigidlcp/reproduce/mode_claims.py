@@ -49,6 +49,8 @@ from rigidlcp.verify.ranges.steady import (
 from rigidlcp.verify.ranges.valid_steady import seed_states
 from rigidlcp.verify.ranges.witness import SteadyWitness, make_witness
 
+from .valid_steady import SEARCH_CLOCK
+
 #: Seconds per question (a pattern, or its negation): full run, --quick.
 PATTERN_TIME_LIMIT = {False: 60.0, True: 5.0}
 PAPER_FIG9 = (4, 3, 2)
@@ -202,9 +204,11 @@ def _all_terms(clauses: list[list[list[Lit]]]) -> Pattern:
     return P
 
 
-def judge_patterns(name: str, run: models.Run, time_limit: float) -> dict[str, dict]:
+def judge_patterns(name: str, run: models.Run, time_limit: float,
+                   clock: str = SEARCH_CLOCK) -> dict[str, dict]:
     """{claim id: {"P": PatternResult, "not": PatternResult | None}} for the system of `run`
-    (a report job: one per experiment); a string value when the MILP cannot be formed."""
+    (a report job: one per experiment; time_limit seconds per question, on `clock`:
+    verify.ranges.patterns.find_state); a string value when the MILP cannot be formed."""
     system = run.system
     try:
         form = formulate(system)
@@ -213,10 +217,10 @@ def judge_patterns(name: str, run: models.Run, time_limit: float) -> dict[str, d
     known, labels = known_states(form, run)
     out: dict[str, dict] = {}
     for cid, (P, notP, check) in questions(name, system).items():
-        out[cid] = {"P": _ask(form, P, time_limit, check, known, labels),
+        out[cid] = {"P": _ask(form, P, time_limit, check, known, labels, clock),
                     "not": None if notP is None else _ask(form, notP, time_limit,
                                                           lambda w, c=check: not c(w), known,
-                                                          labels)}
+                                                          labels, clock)}
     return out
 
 
@@ -256,10 +260,11 @@ def known_states(form: Formulation, run: models.Run | None
     return [out[k] for k in keep], [labels[k] for k in keep]
 
 
-def _ask(form, P: Pattern, time_limit: float, check, known: list, labels: list
-         ) -> PatternResult:
+def _ask(form, P: Pattern, time_limit: float, check, known: list, labels: list,
+         clock: str = SEARCH_CLOCK) -> PatternResult:
     try:
-        res = find_state(form, P, time_limit=time_limit, check=check, known=known)
+        res = find_state(form, P, time_limit=time_limit, check=check, known=known,
+                         clock=clock)
     except Exception as exc:  # a failed question is "unknown", never a verdict
         return PatternResult("failed", note=f"{type(exc).__name__}: {exc}")
     w = res.witness

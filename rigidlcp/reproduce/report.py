@@ -22,6 +22,10 @@ from rigidlcp.models.plot import (
 from .crosscheck import TS_DEFINITION
 from .experiments import SELECT, SWEEP_POINTS, Claim, Results, provenance
 from .quick import claim_sizes, quick_section, size_differences
+from .valid_steady import SEARCH_CLOCK
+
+#: How the report names the clock of its searches' time limits.
+CLOCK_WORDS = {"cpu": "CPU seconds of the process", "wall": "wall-clock seconds"}
 
 
 def _plt():
@@ -255,7 +259,10 @@ def write_report(res: Results, claims: list[Claim], out: Path, files: dict[str, 
         "valid steady state of its system: holds for all, for some (which), for none, or "
         "unknown (why), with the range of mu_g (verify.ranges.steady_ranges; each end a "
         "checked witness, an end not decided in its time limit is \"unknown (time limit)\" "
-        "with the best value met, never a bound). The column \"this toolkit's selection "
+        "with the best value met, never a bound). The range and pattern searches count their "
+        f"time limits in {CLOCK_WORDS[SEARCH_CLOCK]} (rigidlcp/reproduce/valid_steady.py, "
+        "SEARCH_CLOCK), so where a search stops does not depend on the machine's load. "
+        "The column \"this toolkit's selection "
         f"(face-min-norm)\" is the verdict on the one state the select='{SELECT}' rule "
         "reaches.",
         "",

@@ -34,6 +34,11 @@ from rigidlcp.verify.ranges.result import OPTIMAL, TIME_LIMIT
 #: the lower end: "time limit" with the best value met, e.g. the rolling checkerboard's).
 BAND_TIME_LIMIT = 20.0
 SET_TIME_LIMIT = {False: 30.0, True: 2.0}
+#: The clock of the report's range and pattern searches (verify.ranges.milp.clock): CPU
+#: seconds, so that where a search stops, hence a verdict, does not depend on the machine's
+#: load. HiGHS checks the limit only between some of its steps, so a search may overrun its
+#: CPU limit (measured: a 1 s limit stopped after 1.9 s; docs/benchmarks.md).
+SEARCH_CLOCK = "cpu"
 
 
 @dataclass
@@ -47,9 +52,10 @@ class BandPoint:
     selected: float | None
 
 
-def mu_g_band(params: dict, gammas, *, seed: int = 1, time_limit: float = 10.0
-              ) -> list[BandPoint]:
-    """params: a sweep's system parameters (lattice, lx, ly, mu_pp, mu_plane, mu_wall, ...)."""
+def mu_g_band(params: dict, gammas, *, seed: int = 1, time_limit: float = 10.0,
+              clock: str = SEARCH_CLOCK) -> list[BandPoint]:
+    """params: a sweep's system parameters (lattice, lx, ly, mu_pp, mu_plane, mu_wall, ...);
+    time_limit: seconds per end, on `clock` (verify.ranges.steady_ranges)."""
     p = {k: v for k, v in params.items() if k in ("mu_pp", "mu_plane", "mu_wall", "V0",
                                                    "mass", "inertia", "g")}
     out = []
@@ -58,7 +64,7 @@ def mu_g_band(params: dict, gammas, *, seed: int = 1, time_limit: float = 10.0
                                     gamma=float(gamma), **p)
         run = models.simulate(system, seed=seed)
         target = run if run.status == "steady" else system
-        r = steady_ranges(target, time_limit=time_limit)
+        r = steady_ranges(target, time_limit=time_limit, clock=clock)
         out.append(BandPoint(float(gamma), r.mu_g, r.own.get("mu_g"),
                              r.run_values.get("mu_g")))
     return out
@@ -109,11 +115,13 @@ def linear_through_zero(points: list[BandPoint], rel: float = 1e-9,
                        "lies on one line (intermediate values not checked)")
 
 
-def steady_set(run: models.Run, time_limit: float) -> SteadyRanges | str:
+def steady_set(run: models.Run, time_limit: float, clock: str = SEARCH_CLOCK
+               ) -> SteadyRanges | str:
     """The range of mu_g over every valid steady state of a run's system, with the run's own
-    contact states; a string (the reason) when there is none to compute."""
+    contact states (time_limit seconds per end, on `clock`); a string (the reason) when there
+    is none to compute."""
     try:
-        return steady_ranges(run, time_limit=time_limit)
+        return steady_ranges(run, time_limit=time_limit, clock=clock)
     except Exception as exc:  # NotSteady, a solver failure: the column says why
         return f"{type(exc).__name__}: {exc}"
 

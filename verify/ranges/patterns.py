@@ -48,6 +48,7 @@ from scipy.optimize import Bounds, LinearConstraint, milp
 from rigidlcp.models.system import System
 
 from .milp import MilpModel
+from .milp import clock as milp_clock
 from .proportional import exact as proportional_exact
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT
 from .steady import Formulation, formulate, state_velocities, states_of
@@ -328,15 +329,20 @@ def _accepts(system: System, pattern: Pattern, wit: SteadyWitness, check) -> str
 
 def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: float = 60.0,
                check: Callable[[SteadyWitness], bool] | None = None,
-               known: list[SteadyWitness] = (), kinematics: str = "auto") -> PatternResult:
+               known: list[SteadyWitness] = (), kinematics: str = "auto",
+               clock: str = "wall") -> PatternResult:
     """A valid steady state of `target` (a System, or its Formulation) satisfying `pattern`, or
     a proof that none does (module docstring). check(witness) -> bool: the caller's own test
     of the property on the witness (e.g. the classifier of models.modes); a witness must pass
     it, steady_check and Pattern.holds. known: valid steady states met before (a run's own, the
     seeds', earlier witnesses), tried first: one that passes is the answer, no MILP.
     kinematics: MilpModel's; "auto" is "lazy-a_t" (states checked on the contacts with a_t =
-    0 only) where that is exact (gamma != 0, V = gamma t admitted), else "lazy"."""
-    t0 = time.perf_counter()
+    0 only) where that is exact (gamma != 0, V = gamma t admitted), else "lazy". clock:
+    time_limit counted on the wall clock ("wall") or as this process's CPU seconds ("cpu":
+    the same work whatever the machine's load; verify.ranges.milp.MilpModel); the result's
+    `seconds` are wall seconds either way."""
+    now = milp_clock(clock)  # a wrong clock refused before any work (ValueError)
+    t0, c0 = time.perf_counter(), now()
     form = target if isinstance(target, Formulation) else formulate(target)
     for k, wit in enumerate(known):
         if not _accepts(form.system, pattern, wit, check):
@@ -354,8 +360,8 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
         if tighten and not any(lit.strict and lit.margin > 0 for lit in pattern.literals()):
             break
         ext, proved = _extend(form, pattern, tighten)
-        model = MilpModel(ext, kinematics)
-        left = time_limit - (time.perf_counter() - t0)
+        model = MilpModel(ext, kinematics, clock)
+        left = time_limit - (now() - c0)
         st, x = model.solve(np.zeros(model.n), left) if left > 0 else (TIME_LIMIT, None)
         took = time.perf_counter() - t0
         if st == INFEASIBLE and not tighten:
