@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -16,7 +17,9 @@ from rigidlcp.bench.harness import (
     LocalRunner,
     Result,
     SiconosRunner,
+    exact_farkas,
     farkas_certificate,
+    judge,
     read_csv,
     run_bench,
     write_csv,
@@ -27,6 +30,7 @@ from rigidlcp.cli.main import main as cli_main
 from rigidlcp.lcp.api import _REGISTRY
 
 SMALL = dict(sizes=(3, 6), per_size=2)
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 # Test doubles: module-level functions, so that the bench's worker (started by forkserver or
@@ -148,6 +152,26 @@ def test_farkas_certificate_only_for_infeasible_problems():
         assert y is not None and np.all(y >= 0) and p.q @ y < 0
     for p in get_set("random-psd", **SMALL):
         assert farkas_certificate(p.M, p.q) is None
+
+
+def test_a_ray_claim_needs_an_exact_certificate():
+    """A peer's "no solution" (Lemke's ray) is judged by the proof `lcp.solve` needs: on
+    tests/data/float_certificate_p_matrix_n16.npz, a P-matrix LCP (so it has a solution, at
+    |z| ~ 1e16) singular to working precision, the float LP certificate passes its 1e-9 margin
+    but no certificate holds in exact arithmetic: the claim is unproved. On the integer-built
+    infeasible set the exact certificate exists and the claim is certified."""
+    data = np.load(DATA / "float_certificate_p_matrix_n16.npz")
+    p_matrix = lcp.LCP(data["M"], data["q"], name="p16")
+    assert farkas_certificate(p_matrix.M, p_matrix.q) is not None  # the float check is fooled
+    assert exact_farkas(p_matrix) is None
+    ray = {"kind": "answer", "z": np.full(16, np.nan), "status": "ray", "time": 1e-3,
+           "iterations": 5, "message": "secondary ray"}
+    assert judge(p_matrix, "peer", "s", ray, 10.0, 1e-8).outcome == "unproved_infeasible"
+    for p in get_set("infeasible", **SMALL):
+        y = exact_farkas(p)
+        assert y is not None and np.all(y >= 0) and p.q @ y < 0
+        ray["z"] = np.full(p.n, np.nan)
+        assert judge(p, "peer", "s", ray, 10.0, 1e-8).outcome == "infeasible"
 
 
 def test_siconos_absent_is_reported_not_fatal():
