@@ -3,7 +3,8 @@
     python docs/make_comparison.py                    # the stated collection (a few minutes)
     python docs/make_comparison.py --quick --out DIR  # a small subset, into DIR (a look only)
     python docs/make_comparison.py --run DIR          # keep the bench run in DIR; run again,
-                                                      # it resumes (only what is missing runs)
+                                                      # it reuses a finished run (the page is
+                                                      # written again) or resumes a broken one
 
 The collection (stated in the page it writes):
 
@@ -144,13 +145,61 @@ def good_for(results, method: str, summaries_by_set: dict) -> str:
         parts.append(f"solves all of {', '.join(full)}")
     if fastest:
         parts.append(f"fastest of those that do on {', '.join(fastest)}")
+    if partial:
+        parts.append(f"solves part of {'; '.join(partial)}")
     if none:
         parts.append(f"solves none of {'; '.join(none)}")
-    if partial:
-        parts.append(f"fails some of {'; '.join(partial)}")
+    mine = [r for r in results if r.method == method]
+    false = sum(r.outcome == "uncertified" for r in mine)
+    if false:
+        parts.append(f"**{false} false success{'es' if false > 1 else ''}** (answers it called "
+                     "solutions that are not: check its 'solved' before use)")
+    unproved = sum(r.outcome == "unproved_infeasible" for r in mine)
+    if unproved:
+        parts.append(f"{unproved} claim{'s' if unproved > 1 else ''} of no solution without "
+                     "a proof (no exact Farkas certificate: a failure, not an answer)")
     if refused:
         parts.append(f"does not take {', '.join(refused)}")
     return "; ".join(parts) or "-"
+
+
+def in_short(results, summaries_by_set: dict) -> list[str]:
+    """Markdown lines answering "which method for which problems": per set, the methods that
+    certified every problem and the fastest of them by SGM time (else the most certified),
+    then the methods with false successes and the broken ones."""
+    lines = ["| set | certified every problem | fastest of those (SGM time) |",
+             "|---|---|---|"]
+    for set_name, by in summaries_by_set.items():
+        ran = {m: x for m, x in by.items() if x.refused < x.problems}
+        full = [m for m, x in ran.items() if x.successes == x.problems]
+        if full:
+            best = min(full, key=lambda m: ran[m].sgm_time)
+            lines.append(f"| {set_name} | {', '.join(full)} | {best} "
+                         f"({_time(ran[best].sgm_time)}) |")
+        elif ran:
+            top = max(x.successes for x in ran.values())
+            most = [m for m, x in ran.items() if x.successes == top]
+            lines.append(f"| {set_name} | none; most: {', '.join(most)} "
+                         f"({top}/{ran[most[0]].problems}) | - |")
+    methods = list(dict.fromkeys(r.method for r in results if r.method != "-"))
+    false = {m: sum(r.method == m and r.outcome == "uncertified" for r in results)
+             for m in methods}
+    false = {m: k for m, k in false.items() if k}
+    if false:
+        lines += ["", "Called solutions that are not (their 'solved' must be checked): "
+                  + ", ".join(f"{m} {k}" for m, k in false.items()) + "."]
+    broken = []
+    for m in methods:
+        errors, calls, message = raised(results, m)
+        if calls and 2 * errors >= calls:
+            broken.append(f"{m} ({errors} of {calls} calls raised `{message}`)")
+    if broken:
+        lines += ["", "Broken here: " + "; ".join(broken) + "."]
+    return lines
+
+
+def _time(t: float) -> str:
+    return "-" if math.isnan(t) else f"{1e3 * t:.3g} ms" if t < 1 else f"{t:.3g} s"
 
 
 def write_page(path: Path, results, rows, notes, command: str, time_limit: float) -> None:
@@ -186,7 +235,11 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
         "accepts ('-': the method accepts fewer than half, and is left out of that "
         "comparison rather than shrinking it to the few problems it takes); *refused* "
         "problems (outside the method's class or size limit) are neither timed nor "
-        "failures.", "", "## The collection", "", "| set | what |", "|---|---|"]
+        "failures.", ""]
+    lines += ["## In short", "",
+              "Per set, the methods whose every answer was certified, and the fastest of "
+              "them; the details follow.", "", *in_short(results, by_set), ""]
+    lines += ["## The collection", "", "| set | what |", "|---|---|"]
     lines += [f"| {s} | {w} |" for s, w in rows]
     lines += ["", *(f"- {n}" for n in notes)] if notes else []
     lines += ["", "## Successes per set", "",
@@ -249,9 +302,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--cache", default=None, metavar="DIR", help="where Fig. 9 is harvested")
     p.add_argument("--run", default=None, metavar="DIR",
                    help="keep the bench run (results.csv, report.md) in DIR instead of a "
-                        "temporary folder; when DIR already holds a run of the same command, "
-                        "it is resumed (the pairs done are not run again), so a change to "
-                        "the page's layout, or an interrupted run, costs only what is missing")
+                        "temporary folder; a finished run there is reused as it is (only the "
+                        "page is written again), an interrupted one is resumed (the pairs "
+                        "done are not run again)")
     args = p.parse_args(argv)
     from rigidlcp.bench.harness import read_csv
     from rigidlcp.cli.main import main as rigidlcp
@@ -272,11 +325,15 @@ def main(argv: list[str] | None = None) -> int:
         argv_bench = ["bench", "--set", ",".join(specs), "--out", str(run), "--quiet",
                       "--no-batch", "--time-limit", f"{args.time_limit:g}", "--sizes",
                       "4" if args.quick else SIZES]
-        if (run / "results.csv").is_file():
-            argv_bench.append("--resume")
-        print("rigidlcp " + " ".join(argv_bench), flush=True)
-        if rigidlcp(argv_bench) != 0:
-            sys.exit("rigidlcp bench failed")
+        if (run / "report.md").is_file():  # a finished run (bench writes it last): reused
+            print(f"reusing the finished bench run in {run} (remove it to run again)",
+                  flush=True)
+        else:
+            if (run / "results.csv").is_file():
+                argv_bench.append("--resume")  # an interrupted run: only what is missing runs
+            print("rigidlcp " + " ".join(argv_bench), flush=True)
+            if rigidlcp(argv_bench) != 0:
+                sys.exit("rigidlcp bench failed")
         results = read_csv(run / "results.csv")
         if figures.exists():
             shutil.rmtree(figures)

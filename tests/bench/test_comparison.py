@@ -69,18 +69,25 @@ def test_the_page_says_a_peer_that_raises_is_broken_and_the_common_subset_is_mea
             _row("fig9-events", p, "lemke", "solved"),
             _row("fig9-events", p, "pgs", "solved" if k == 0 else "not_applicable"),
             _row("fig9-events", p, "slow-fail", "max_iter"),
+            _row("fig9-events", p, "liar", "solved" if k < 2 else "uncertified"),
             _row("fig9-events", p, "lemkelcp", "solved" if k == 0 else "error",
                  message="" if k == 0 else TYPE_ERROR)]
     page_path = tmp_path / "comparison.md"
     module.write_page(page_path, results, [("fig9-events", "events")], [], "cmd", 10.0)
     page = page_path.read_text()
-    lemkelcp = next(line for line in page.splitlines() if line.startswith("- **lemkelcp**"))
+    lemkelcp = next(line for line in page.splitlines() if line.startswith("- **lemkelcp** ("))
     assert f"broken here: 3 of its 4 calls raised an exception** (`{TYPE_ERROR}`)" in lemkelcp
     assert "broken on Python 3" in lemkelcp  # the peer's own note
     assert "| lemkelcp | 1/4 (3 raised) |" in page
-    slow = next(line for line in page.splitlines() if line.startswith("- **slow-fail**"))
+    slow = next(line for line in page.splitlines() if line.startswith("- **slow-fail** ("))
     assert "solves none of fig9-events 0/4" in slow and "fails some" not in slow
     assert "broken" not in slow
+    liar = next(line for line in page.splitlines() if line.startswith("- **liar** ("))
+    assert "solves part of fig9-events 2/4" in liar and "**2 false successes**" in liar
+    # in short: lemke alone certified all four (pgs refused three)
+    assert "| fig9-events | lemke | lemke (1 ms) |" in page
+    assert "Called solutions that are not (their 'solved' must be checked): liar 2." in page
+    assert f"Broken here: lemkelcp (3 of 4 calls raised `{TYPE_ERROR}`)." in page
     assert "SGM time, common LCP (4)" in page and "SGM time, common LCP (1)" not in page
     pgs = next(line for line in page.splitlines() if line.startswith("| pgs | 1/4 (25%)"))
     assert pgs.split("|")[5].strip() == "-"  # left out of the common comparison
