@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.bench.harness import (
@@ -172,6 +174,24 @@ def test_a_ray_claim_needs_an_exact_certificate():
         assert y is not None and np.all(y >= 0) and p.q @ y < 0
         ray["z"] = np.full(p.n, np.nan)
         assert judge(p, "peer", "s", ray, 10.0, 1e-8).outcome == "infeasible"
+
+
+@given(n=st.integers(2, 12), seed=st.integers(0, 2**32 - 1), pd=st.booleans())
+def test_judged_rays_are_certified_exactly_when_there_is_no_feasible_point(n, seed, pd):
+    """A "ray" (no solution) claim: on the integer-built infeasible LCPs it is certified (an
+    exact Farkas certificate exists); on a positive definite LCP (always solvable: a P-matrix)
+    it never is, whatever q."""
+    from rigidlcp.bench.problem_sets import infeasible_lcp
+
+    rng = np.random.default_rng(seed)
+    if pd:
+        A = rng.standard_normal((n, n))
+        problem = lcp.LCP(A @ A.T + 1e-3 * np.eye(n), rng.standard_normal(n) * 10.0)
+    else:
+        problem = infeasible_lcp(n, rng)
+    ray = {"kind": "answer", "z": np.full(n, np.nan), "status": "ray", "time": 1e-3}
+    outcome = judge(problem, "peer", "s", ray, 10.0, 1e-8).outcome
+    assert outcome == ("unproved_infeasible" if pd else "infeasible")
 
 
 def test_siconos_absent_is_reported_not_fatal():
