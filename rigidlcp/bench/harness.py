@@ -4,7 +4,10 @@ Every method is run on every problem of the chosen sets, one solve at a time, wi
 per solve, and every answer is checked here, never taken from the solver:
 
 * a claimed solution ("solved") is certified by `verify.certify` (uniqueness "none": the
-  residual certificate only, scaled residual <= tol); uncertified counts as a failure;
+  residual certificate only, scaled residual <= tol); uncertified counts as a failure; so
+  does a point the check accepts on an LCP with an exact Farkas certificate (no feasible
+  point exists: Drake's Moby returns z ~ 1e14 with w negative by O(1) on the infeasible set,
+  which the scaled measures accept);
 * a claim that no solution exists ("infeasible", or Lemke's "ray") is accepted only with the
   project's own proof, the one `lcp.solve` needs for its "infeasible": a Farkas certificate
   y >= 0, M'y <= 0, q'y < 0 (so no z >= 0 has M z + q >= 0) found by HiGHS and checked in
@@ -150,6 +153,20 @@ def exact_farkas(problem: LCP) -> np.ndarray | None:
     return cert.y if cert is not None and cert.exact else None
 
 
+_FARKAS_SEEN: dict[int, tuple] = {}  # id(problem) -> (problem, its exact certificate or None)
+
+
+def _no_feasible_point(problem: LCP) -> bool:
+    """Whether `problem` has an exact Farkas certificate (so no z >= 0 has M z + q >= 0 and no
+    claimed solution can be one); one LP per problem object in a run (cached)."""
+    seen = _FARKAS_SEEN.get(id(problem))
+    if seen is None or seen[0] is not problem:
+        if len(_FARKAS_SEEN) > 4096:
+            _FARKAS_SEEN.clear()
+        seen = _FARKAS_SEEN[id(problem)] = (problem, exact_farkas(problem))
+    return seen[1] is not None
+
+
 # --------------------------------------------------------------------------------------------
 # the run
 # --------------------------------------------------------------------------------------------
@@ -187,6 +204,12 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         outcome = "timeout"
     elif status == "solved":
         outcome = "solved" if accepted else "uncertified"
+        if accepted and isinstance(problem, LCP) and _no_feasible_point(problem):
+            # the check accepted a point of an LCP that provably has none (a z inflated to
+            # ~1e14 with w negative by O(1) passes its scaled measures): not a solution
+            outcome = "uncertified"
+            base["message"] = (base["message"] + "; " if base["message"] else "") + (
+                "the LCP has no feasible point (an exact Farkas certificate): not a solution")
     elif status in NO_SOLUTION:
         proved = isinstance(problem, LCP) and exact_farkas(problem) is not None
         outcome = "infeasible" if proved else "unproved_infeasible"

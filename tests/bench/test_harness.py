@@ -176,6 +176,28 @@ def test_a_ray_claim_needs_an_exact_certificate():
         assert judge(p, "peer", "s", ray, 10.0, 1e-8).outcome == "infeasible"
 
 
+def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
+    """The infeasible set's n4-0 has y = (0, 1, 2, 0)/3 with M'y = 0 and q'y = -1 exactly, so no
+    z >= 0 has M z + q >= 0. Drake's Moby answered it "solved" with z ~ 1e14 along the null
+    direction (0, 1, 2, 0) (w = M z + q negative by O(1)), which verify.certify's scaled
+    measures accept; the judge must not count it a success."""
+    M = np.array([[5.0, 2, -1, 2], [2, 8, -4, -16], [-1, -4, 2, 8], [2, 8, -4, 5]])
+    q = np.array([3.0, -7, 2, 0])
+    y = np.array([0.0, 1, 2, 0])
+    assert np.array_equal(M.T @ y, np.zeros(4)) and q @ y < 0  # exact in floats (integers)
+    problem = lcp.LCP(M, q, name="n4-0")
+    z = 5.8236202078067453e13 * np.array([0.0, 1, 2, 0])
+    assert np.min(M @ z + q) < -0.5  # not feasible, by far
+    claim = {"kind": "answer", "z": z, "status": "solved", "time": 1e-3, "iterations": 0}
+    r = judge(problem, "peer", "s", claim, 10.0, 1e-8)
+    assert r.outcome == "uncertified" and not r.success
+    assert "no feasible point" in r.message
+    # a true solution of a feasible LCP is still a success
+    ok = lcp.LCP(np.eye(2), np.array([-1.0, 2.0]))
+    claim = {"kind": "answer", "z": np.array([1.0, 0.0]), "status": "solved", "time": 1e-3}
+    assert judge(ok, "peer", "s", claim, 10.0, 1e-8).outcome == "solved"
+
+
 @given(n=st.integers(2, 12), seed=st.integers(0, 2**32 - 1), pd=st.booleans())
 def test_judged_rays_are_certified_exactly_when_there_is_no_feasible_point(n, seed, pd):
     """A "ray" (no solution) claim: on the integer-built infeasible LCPs it is certified (an
