@@ -133,9 +133,11 @@ def good_for(results, method: str, summaries_by_set: dict) -> str:
             if s.sgm_time <= best:
                 fastest.append(set_name)
         elif s.successes == 0:
-            none.append(f"{set_name} 0/{s.problems}")
+            none.append(f"{set_name} 0/{s.problems}"
+                        + (f" ({s.refused} refused)" if s.refused else ""))
         else:
-            partial.append(f"{set_name} {s.successes}/{s.problems}")
+            partial.append(f"{set_name} {s.successes}/{s.problems}"
+                           + (f" ({s.refused} refused)" if s.refused else ""))
     parts = []
     errors, calls, message = raised(results, method)
     if calls and 2 * errors >= calls:
@@ -245,15 +247,18 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
     lines += ["", "## Successes per set", "",
               "Certified answers / problems given; '-': the method takes none of the set; "
               "'k false': k answers the method called solutions that are not (the check "
-              "rejected them; see below); 'k raised': k calls ended in an exception.", "",
+              "rejected them; see below); 'k raised': k calls ended in an exception; 'k "
+              "refused': k problems outside the method's class or size limit.", "",
               "| method | " + " | ".join(sets) + " |", "|---|" + "---:|" * len(sets)]
     for m in methods:
         cells = []
         for s in sets:
             x = by_set[s].get(m)
             marks = [f"{x.failures[k]} {word}" for k, word in
-                      (("uncertified", "false"), ("error", "raised"))
-                      if x is not None and x.failures.get(k, 0)]
+                     (("uncertified", "false"), ("error", "raised"))
+                     if x is not None and x.failures.get(k, 0)]
+            if x is not None and 0 < x.refused < x.problems:
+                marks.append(f"{x.refused} refused")
             cells.append("-" if x is None or x.refused == x.problems
                          else f"{x.successes}/{x.problems}"
                          + (f" ({', '.join(marks)})" if marks else ""))

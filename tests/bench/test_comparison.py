@@ -89,6 +89,9 @@ def test_the_page_says_a_peer_that_raises_is_broken_and_the_common_subset_is_mea
     assert "Called solutions that are not (their 'solved' must be checked): liar 2." in page
     assert f"Broken here: lemkelcp (3 of 4 calls raised `{TYPE_ERROR}`)." in page
     assert "SGM time, common LCP (4)" in page and "SGM time, common LCP (1)" not in page
+    assert "| pgs | 1/4 (3 refused) |" in page  # pgs certified 1 of 4 and refused 3
+    pgs_line = next(line for line in page.splitlines() if line.startswith("- **pgs** ("))
+    assert "solves part of fig9-events 1/4 (3 refused)" in pgs_line
     pgs = next(line for line in page.splitlines() if line.startswith("| pgs | 1/4 (25%)"))
     assert pgs.split("|")[5].strip() == "-"  # left out of the common comparison
 
