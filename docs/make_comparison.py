@@ -2,6 +2,9 @@
 
     python docs/make_comparison.py                    # the stated collection (a few minutes)
     python docs/make_comparison.py --quick --out DIR  # a small subset, into DIR (a look only)
+    python docs/make_comparison.py --run DIR          # keep the bench run in DIR; run again,
+                                                      # it reuses a finished run (the page is
+                                                      # written again) or resumes a broken one
 
 The collection (stated in the page it writes):
 
@@ -101,10 +104,21 @@ def build_collection(root: Path, siconos_data: Path, quick: bool, cache: Path
     return specs, rows, notes
 
 
+def raised(results, method: str) -> tuple[int, int, str]:
+    """(calls that raised an exception, calls made, the most common message) of `method`
+    over `results` (refusals are no calls)."""
+    ran = [r for r in results if r.method == method and r.outcome != "not_applicable"]
+    errors = [r.message for r in ran if r.outcome == "error"]
+    common = max(set(errors), key=errors.count) if errors else ""
+    return len(errors), len(ran), common
+
+
 def good_for(results, method: str, summaries_by_set: dict) -> str:
-    """One line from the results: the sets the method solved entirely (and where it was the
-    fastest such method by SGM time), the sets where it failed some, the sets it refused."""
-    full, fastest, partial, refused = [], [], [], []
+    """One line from the results: first, when at least half of the method's calls raised an
+    exception, that it is broken here (how many, the message); then the sets the method
+    solved entirely (and where it was the fastest such method by SGM time), the sets where it
+    solved none, those where it failed some, the sets it refused."""
+    full, fastest, none, partial, refused = [], [], [], [], []
     for set_name, by in summaries_by_set.items():
         s = by.get(method)
         if s is None:
@@ -118,18 +132,76 @@ def good_for(results, method: str, summaries_by_set: dict) -> str:
                         and x.problems), default=math.nan)
             if s.sgm_time <= best:
                 fastest.append(set_name)
+        elif s.successes == 0:
+            none.append(f"{set_name} 0/{s.problems}"
+                        + (f" ({s.refused} refused)" if s.refused else ""))
         else:
-            partial.append(f"{set_name} {s.successes}/{s.problems}")
+            partial.append(f"{set_name} {s.successes}/{s.problems}"
+                           + (f" ({s.refused} refused)" if s.refused else ""))
     parts = []
+    errors, calls, message = raised(results, method)
+    if calls and 2 * errors >= calls:
+        parts.append(f"**broken here: {errors} of its {calls} calls raised an exception** "
+                     f"(`{message}`)")
     if full:
         parts.append(f"solves all of {', '.join(full)}")
     if fastest:
         parts.append(f"fastest of those that do on {', '.join(fastest)}")
     if partial:
-        parts.append(f"fails some of {'; '.join(partial)}")
+        parts.append(f"solves part of {'; '.join(partial)}")
+    if none:
+        parts.append(f"solves none of {'; '.join(none)}")
+    mine = [r for r in results if r.method == method]
+    false = sum(r.outcome == "uncertified" for r in mine)
+    if false:
+        parts.append(f"**{false} false success{'es' if false > 1 else ''}** (answers it called "
+                     "solutions that are not: check its 'solved' before use)")
+    unproved = sum(r.outcome == "unproved_infeasible" for r in mine)
+    if unproved:
+        parts.append(f"{unproved} claim{'s' if unproved > 1 else ''} of no solution without "
+                     "a proof (no exact Farkas certificate: a failure, not an answer)")
     if refused:
         parts.append(f"does not take {', '.join(refused)}")
     return "; ".join(parts) or "-"
+
+
+def in_short(results, summaries_by_set: dict) -> list[str]:
+    """Markdown lines answering "which method for which problems": per set, the methods that
+    certified every problem and the fastest of them by SGM time (else the most certified),
+    then the methods with false successes and the broken ones."""
+    lines = ["| set | certified every problem | fastest of those (SGM time) |",
+             "|---|---|---|"]
+    for set_name, by in summaries_by_set.items():
+        ran = {m: x for m, x in by.items() if x.refused < x.problems}
+        full = [m for m, x in ran.items() if x.successes == x.problems]
+        if full:
+            best = min(full, key=lambda m: ran[m].sgm_time)
+            lines.append(f"| {set_name} | {', '.join(full)} | {best} "
+                         f"({_time(ran[best].sgm_time)}) |")
+        elif ran:
+            top = max(x.successes for x in ran.values())
+            most = [m for m, x in ran.items() if x.successes == top]
+            lines.append(f"| {set_name} | none; most: {', '.join(most)} "
+                         f"({top}/{ran[most[0]].problems}) | - |")
+    methods = list(dict.fromkeys(r.method for r in results if r.method != "-"))
+    false = {m: sum(r.method == m and r.outcome == "uncertified" for r in results)
+             for m in methods}
+    false = {m: k for m, k in false.items() if k}
+    if false:
+        lines += ["", "Called solutions that are not (their 'solved' must be checked): "
+                  + ", ".join(f"{m} {k}" for m, k in false.items()) + "."]
+    broken = []
+    for m in methods:
+        errors, calls, message = raised(results, m)
+        if calls and 2 * errors >= calls:
+            broken.append(f"{m} ({errors} of {calls} calls raised `{message}`)")
+    if broken:
+        lines += ["", "Broken here: " + "; ".join(broken) + "."]
+    return lines
+
+
+def _time(t: float) -> str:
+    return "-" if math.isnan(t) else f"{1e3 * t:.3g} ms" if t < 1 else f"{t:.3g} s"
 
 
 def write_page(path: Path, results, rows, notes, command: str, time_limit: float) -> None:
@@ -152,23 +224,44 @@ def write_page(path: Path, results, rows, notes, command: str, time_limit: float
         "in [bench.md](bench.md). Every answer, rigidlcp's and every peer's, is judged by the "
         "same check; every method is timed as the whole call from Python on M and q "
         "(rigidlcp: `lcp.solve(lcp.LCP(M, q), method)`, one call per problem, no batches) "
-        "after an untimed warm-up; times are indicative (a shared "
-        "2-core machine).", "", "## The collection", "", "| set | what |", "|---|---|"]
+        "after an untimed warm-up (with its own limit, so that an import or numba's "
+        "compilation is not counted as a timeout; its times are in the report); times are "
+        "indicative (a shared 2-core machine).", "",
+        "How to read the tables: *success* counts certified answers (a solution that passes "
+        "`verify.certify`, or a claim of no solution backed by a Farkas certificate that "
+        "holds in exact rational arithmetic); *SGM time* is the shifted geometric mean "
+        "(shift 10 ms) of the time over the problems the method accepted, each failure "
+        f"counted at the time limit ({time_limit:g} s), so a method that fails fast does "
+        "not look fast; *SGM time, common KIND (k)* is the same mean over the k problems "
+        "of that kind that every method accepting at least half of the kind's problems "
+        "accepts ('-': the method accepts fewer than half, and is left out of that "
+        "comparison rather than shrinking it to the few problems it takes); *refused* "
+        "problems (outside the method's class or size limit) are neither timed nor "
+        "failures.", ""]
+    lines += ["## In short", "",
+              "Per set, the methods whose every answer was certified, and the fastest of "
+              "them; the details follow.", "", *in_short(results, by_set), ""]
+    lines += ["## The collection", "", "| set | what |", "|---|---|"]
     lines += [f"| {s} | {w} |" for s, w in rows]
     lines += ["", *(f"- {n}" for n in notes)] if notes else []
     lines += ["", "## Successes per set", "",
               "Certified answers / problems given; '-': the method takes none of the set; "
               "'k false': k answers the method called solutions that are not (the check "
-              "rejected them; see below).", "",
+              "rejected them; see below); 'k raised': k calls ended in an exception; 'k "
+              "refused': k problems outside the method's class or size limit.", "",
               "| method | " + " | ".join(sets) + " |", "|---|" + "---:|" * len(sets)]
     for m in methods:
         cells = []
         for s in sets:
             x = by_set[s].get(m)
-            false = x.failures.get("uncertified", 0) if x is not None else 0
+            marks = [f"{x.failures[k]} {word}" for k, word in
+                     (("uncertified", "false"), ("error", "raised"))
+                     if x is not None and x.failures.get(k, 0)]
+            if x is not None and 0 < x.refused < x.problems:
+                marks.append(f"{x.refused} refused")
             cells.append("-" if x is None or x.refused == x.problems
-                         else f"{x.successes}/{x.problems}" + (f" ({false} false)" if false
-                                                               else ""))
+                         else f"{x.successes}/{x.problems}"
+                         + (f" ({', '.join(marks)})" if marks else ""))
         lines.append(f"| {m} | " + " | ".join(cells) + " |")
     fig9 = by_set.get("fig9-events", {})
     if fig9:
@@ -212,6 +305,11 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--time-limit", type=float, default=2.0, help="seconds per solve")
     p.add_argument("--siconos-data", default=str(SICONOS_DATA), metavar="DIR")
     p.add_argument("--cache", default=None, metavar="DIR", help="where Fig. 9 is harvested")
+    p.add_argument("--run", default=None, metavar="DIR",
+                   help="keep the bench run (results.csv, report.md) in DIR instead of a "
+                        "temporary folder; a finished run there is reused as it is (only the "
+                        "page is written again), an interrupted one is resumed (the pairs "
+                        "done are not run again)")
     args = p.parse_args(argv)
     from rigidlcp.bench.harness import read_csv
     from rigidlcp.cli.main import main as rigidlcp
@@ -228,13 +326,19 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory(prefix="comparison_") as tmp:
         specs, rows, notes = build_collection(root, Path(args.siconos_data), args.quick,
                                               cache)
-        run = Path(tmp) / "run"
+        run = Path(args.run) if args.run else Path(tmp) / "run"
         argv_bench = ["bench", "--set", ",".join(specs), "--out", str(run), "--quiet",
                       "--no-batch", "--time-limit", f"{args.time_limit:g}", "--sizes",
                       "4" if args.quick else SIZES]
-        print("rigidlcp " + " ".join(argv_bench), flush=True)
-        if rigidlcp(argv_bench) != 0:
-            sys.exit("rigidlcp bench failed")
+        if (run / "report.md").is_file():  # a finished run (bench writes it last): reused
+            print(f"reusing the finished bench run in {run} (remove it to run again)",
+                  flush=True)
+        else:
+            if (run / "results.csv").is_file():
+                argv_bench.append("--resume")  # an interrupted run: only what is missing runs
+            print("rigidlcp " + " ".join(argv_bench), flush=True)
+            if rigidlcp(argv_bench) != 0:
+                sys.exit("rigidlcp bench failed")
         results = read_csv(run / "results.csv")
         if figures.exists():
             shutil.rmtree(figures)

@@ -4,11 +4,18 @@ Every method is run on every problem of the chosen sets, one solve at a time, wi
 per solve, and every answer is checked here, never taken from the solver:
 
 * a claimed solution ("solved") is certified by `verify.certify` (uniqueness "none": the
-  residual certificate only, scaled residual <= tol); uncertified counts as a failure;
-* a claim that no solution exists ("infeasible", or Lemke's "ray") is accepted only when an LP
-  (HiGHS) finds a Farkas certificate y >= 0, M'y <= 0, q'y < 0, i.e. proves that no z >= 0
-  has M z + q >= 0. (An LCP can be feasible and still have no solution when M is not
-  copositive-plus; such a claim cannot be certified this way and counts as a failure.)
+  residual certificate only, scaled residual <= tol); uncertified counts as a failure; so
+  does a point the check accepts on an LCP with an exact Farkas certificate (no feasible
+  point exists: Drake's Moby returns z ~ 1e14 with w negative by O(1) on the infeasible set,
+  which the scaled measures accept);
+* a claim that no solution exists ("infeasible", or Lemke's "ray") is accepted only with the
+  project's own proof, the one `lcp.solve` needs for its "infeasible": a Farkas certificate
+  y >= 0, M'y <= 0, q'y < 0 (so no z >= 0 has M z + q >= 0) found by HiGHS and checked in
+  exact rational arithmetic on the data as stored (lcp.acceptance.farkas); a certificate that
+  holds only in floating point proves nothing (a P-matrix singular to working precision has
+  one, and a solution beyond it) and the claim counts as "unproved_infeasible". (An LCP can
+  be feasible and still have no solution when M is not copositive-plus; such a claim cannot
+  be certified this way either and counts as a failure.)
 * a solve longer than the time limit, a refusal (NotApplicable), an exception, or any other
   status (max_iter, not_converged, failed) is a failure.
 
@@ -46,6 +53,8 @@ from scipy.optimize import linprog
 
 from rigidlcp import lcp
 from rigidlcp.lcp import LCP, MLCP, Solution
+from rigidlcp.lcp.acceptance.farkas import find_certificate
+from rigidlcp.lcp.acceptance.scaling import ruiz
 from rigidlcp.verify.certificates.certify import certify
 
 from .peers import PEERS, peer_available
@@ -53,9 +62,9 @@ from .problem_sets import Unreadable
 from .runners import GRACE, LocalRunner
 from .siconos_runner import SICONOS_METHODS, SiconosRunner
 
-__all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate", "write_csv",
-           "append_csv", "read_csv", "available_methods", "check_methods", "LocalRunner",
-           "PEERS", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
+__all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate", "exact_farkas",
+           "write_csv", "append_csv", "read_csv", "available_methods", "check_methods",
+           "LocalRunner", "PEERS", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
 
 #: Claims that no solution exists.
 NO_SOLUTION = ("infeasible", "ray")
@@ -110,7 +119,8 @@ CSV_FIELDS = [f.name for f in fields(Result)]
 # --------------------------------------------------------------------------------------------
 
 def farkas_certificate(M: np.ndarray, q: np.ndarray) -> np.ndarray | None:
-    """y >= 0 with M'y <= 0 and q'y <= -1 (scaled), found by an LP, or None.
+    """y >= 0 with M'y <= 0 and q'y <= -1 (scaled), found by an LP, or None (checked in floating
+    point only: evidence, not the judge's proof, which is `exact_farkas`).
 
     Such a y proves that {z >= 0 : M z + q >= 0} is empty: y'(M z + q) = (M'y)'z + q'y < 0.
     The LP is solved on M, q scaled to max|entry| = 1; the certificate is re-checked with a
@@ -129,6 +139,32 @@ def farkas_certificate(M: np.ndarray, q: np.ndarray) -> np.ndarray | None:
     if qs @ y >= -0.5 or np.any(Ms.T @ y > 1e-9 * max(ynorm, 1.0)):
         return None
     return y
+
+
+def exact_farkas(problem: LCP) -> np.ndarray | None:
+    """y >= 0 (the problem's units) with M'y <= 0 and q'y < 0 holding in exact rational
+    arithmetic on the stored data (lcp.acceptance.farkas.find_certificate on the equilibrated
+    problem, as `lcp.solve` checks its own "infeasible"), or None: no certificate, or only one
+    that holds in floating point. The bench's proof of a claim that no solution exists."""
+    M = problem.M.toarray() if hasattr(problem.M, "toarray") else np.asarray(problem.M)
+    eq = ruiz(np.asarray(M, dtype=float), np.asarray(problem.q, dtype=float))
+    with np.errstate(all="ignore"):
+        cert = find_certificate(eq)
+    return cert.y if cert is not None and cert.exact else None
+
+
+_FARKAS_SEEN: dict[int, tuple] = {}  # id(problem) -> (problem, its exact certificate or None)
+
+
+def _no_feasible_point(problem: LCP) -> bool:
+    """Whether `problem` has an exact Farkas certificate (so no z >= 0 has M z + q >= 0 and no
+    claimed solution can be one); one LP per problem object in a run (cached)."""
+    seen = _FARKAS_SEEN.get(id(problem))
+    if seen is None or seen[0] is not problem:
+        if len(_FARKAS_SEEN) > 4096:
+            _FARKAS_SEEN.clear()
+        seen = _FARKAS_SEEN[id(problem)] = (problem, exact_farkas(problem))
+    return seen[1] is not None
 
 
 # --------------------------------------------------------------------------------------------
@@ -168,8 +204,14 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
         outcome = "timeout"
     elif status == "solved":
         outcome = "solved" if accepted else "uncertified"
+        if accepted and isinstance(problem, LCP) and _no_feasible_point(problem):
+            # the check accepted a point of an LCP that provably has none (a z inflated to
+            # ~1e14 with w negative by O(1) passes its scaled measures): not a solution
+            outcome = "uncertified"
+            base["message"] = (base["message"] + "; " if base["message"] else "") + (
+                "the LCP has no feasible point (an exact Farkas certificate): not a solution")
     elif status in NO_SOLUTION:
-        proved = isinstance(problem, LCP) and farkas_certificate(problem.M, problem.q) is not None
+        proved = isinstance(problem, LCP) and exact_farkas(problem) is not None
         outcome = "infeasible" if proved else "unproved_infeasible"
     else:
         outcome = status

@@ -6,7 +6,7 @@ package imports (`pip install -e ".[peers]"`), and is skipped with a note otherw
 | quantecon-lemke | quantecon (numba) | `quantecon.optimize.lcp_lemke(M, q)` |
 | drake-moby | drake | `MobyLcpSolver().Solve(prog)`, prog a MathematicalProgram with M, q |
 | drake-unrevised-lemke | drake | `UnrevisedLemkeSolver().Solve(prog)` |
-| lemkelcp | lemkelcp | `lemkelcp.lemkelcp(M, q, maxIter)` |
+| lemkelcp | lemkelcp | `lemkelcp.lemkelcp(M, q, maxIter)` (0.1: broken on Python 3) |
 
 Every peer is timed the way rigidlcp's methods are (rigidlcp.bench.runners): the whole call
 from Python, in the bench's worker process, after one untimed warm-up solve per fresh worker
@@ -64,6 +64,11 @@ def _drake(solver_name: str, M: np.ndarray, q: np.ndarray) -> tuple:
 
 
 def _lemkelcp(M: np.ndarray, q: np.ndarray) -> tuple:
+    """lemkelcp 0.1 (2016, its only release) is broken on Python 3: its tableau keeps
+    `range(n)` for the basis positions and assigns into it at the first pivot, so every call
+    on a q with a negative entry raises TypeError ('range' object does not support item
+    assignment); q >= 0 returns z = 0 before any pivot. The exception is reported as the
+    peer's error on each problem, not hidden: the comparison says the peer is broken."""
     from lemkelcp.lemkelcp import lemkelcp
 
     z, code, text = lemkelcp(M, q, 1000 + 100 * q.size)
@@ -79,7 +84,10 @@ PEERS: dict[str, Peer] = {
     "drake-unrevised-lemke": Peer(
         "drake", "pydrake.solvers", partial(_drake, "UnrevisedLemkeSolver"),
         "Drake's UnrevisedLemkeSolver via Solve"),
-    "lemkelcp": Peer("lemkelcp", "lemkelcp", _lemkelcp, "PyPI's lemkelcp (pure Python)"),
+    "lemkelcp": Peer("lemkelcp", "lemkelcp", _lemkelcp,
+                     "PyPI's lemkelcp (pure Python); version 0.1 is broken on Python 3: "
+                     "every call with some q_i < 0 raises TypeError ('range' object does not "
+                     "support item assignment), only q >= 0 is answered (z = 0)"),
 }
 
 

@@ -23,10 +23,12 @@ Metrics per set and method (qpbenchmark's conventions, stated in the report):
 * refused: problems the method declined (NotApplicable: outside its class or size limit),
   reported apart from its failures and outside the SGMs;
 * SGM over the common problems, per kind of problem (LCP, MLCP, FC2D): for each kind, the
-  methods compared on it are those that accept at least one problem of that kind, and the
-  common problems are the problems of that kind that every one of them accepts (none refused
-  it); the same mean over only those, a fair comparison of methods with different domains
-  ("-" for a method that refuses every problem of the kind).
+  methods compared on it are those that accept at least half of its problems (COMMON_SHARE),
+  and the common problems are the problems of that kind that every one of them accepts (none
+  refused it); the same mean over only those, a fair comparison of methods with different
+  domains ("-" for a method outside the comparison: one that accepts fewer than half of the
+  kind's problems, e.g. pgs, which needs a positive diagonal, on Fig. 9's event LCPs, would
+  otherwise shrink the common problems to the few it takes).
 Unreadable files (method "-") are listed with their reason, outside every method's numbers.
 
 Performance profile (Dolan & More, Math. Program. 91, 201, 2002): with t_ps the time of method
@@ -49,6 +51,9 @@ from .harness import Result
 SHIFT = 0.010  # seconds
 RESIDUAL_SHIFT = 1e-16  # the SGM of residuals: rounding level
 ACCURACIES = (1e-8, 1e-12)  # success rates at these backward / forward errors
+#: A method is compared on the common problems of a kind when it accepts at least this share
+#: of the kind's problems; the common problems are those all such methods accept.
+COMMON_SHARE = 0.5
 
 
 def at_accuracy(r: Result, accuracy: float, forward: bool = False) -> bool:
@@ -138,18 +143,22 @@ def summarize(results: Sequence[Result], time_limit: float, set_name: str | None
     return out
 
 
-def common_problems(rows: Sequence[Result]) -> dict[str, tuple[set, set]]:
+def common_problems(rows: Sequence[Result], share: float = COMMON_SHARE
+                    ) -> dict[str, tuple[set, set]]:
     """{kind: (compared methods, common problems)} over `rows` (one set's or all results):
-    the methods compared on a kind accept (do not refuse) at least one of its problems; its
-    common problems, (set, problem) pairs, are those that none of these methods refused."""
+    the methods compared on a kind accept (do not refuse) at least `share` of its problems
+    (and at least one); its common problems, (set, problem) pairs, are those that none of
+    these methods refused."""
     out = {}
     order = {"LCP": 0, "MLCP": 1, "FC2D": 2}
     for kind in sorted(dict.fromkeys(r.kind for r in rows), key=lambda k: order.get(k, 3)):
         mine = [r for r in rows if r.kind == kind]
-        compared = {r.method for r in mine if r.outcome != "not_applicable"}
+        problems = {(r.set, r.problem) for r in mine}
+        accepted = Counter(r.method for r in mine if r.outcome != "not_applicable")
+        compared = {m for m, k in accepted.items() if k >= share * len(problems)}
         refused = {(r.set, r.problem) for r in mine
                    if r.method in compared and r.outcome == "not_applicable"}
-        out[kind] = (compared, {(r.set, r.problem) for r in mine} - refused)
+        out[kind] = (compared, problems - refused)
     return out
 
 

@@ -7,16 +7,21 @@ from __future__ import annotations
 import csv
 import math
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from rigidlcp import lcp
 from rigidlcp.bench.harness import (
     LocalRunner,
     Result,
     SiconosRunner,
+    exact_farkas,
     farkas_certificate,
+    judge,
     read_csv,
     run_bench,
     write_csv,
@@ -27,6 +32,7 @@ from rigidlcp.cli.main import main as cli_main
 from rigidlcp.lcp.api import _REGISTRY
 
 SMALL = dict(sizes=(3, 6), per_size=2)
+DATA = Path(__file__).resolve().parents[1] / "data"
 
 
 # Test doubles: module-level functions, so that the bench's worker (started by forkserver or
@@ -148,6 +154,66 @@ def test_farkas_certificate_only_for_infeasible_problems():
         assert y is not None and np.all(y >= 0) and p.q @ y < 0
     for p in get_set("random-psd", **SMALL):
         assert farkas_certificate(p.M, p.q) is None
+
+
+def test_a_ray_claim_needs_an_exact_certificate():
+    """A peer's "no solution" (Lemke's ray) is judged by the proof `lcp.solve` needs: on
+    tests/data/float_certificate_p_matrix_n16.npz, a P-matrix LCP (so it has a solution, at
+    |z| ~ 1e16) singular to working precision, the float LP certificate passes its 1e-9 margin
+    but no certificate holds in exact arithmetic: the claim is unproved. On the integer-built
+    infeasible set the exact certificate exists and the claim is certified."""
+    data = np.load(DATA / "float_certificate_p_matrix_n16.npz")
+    p_matrix = lcp.LCP(data["M"], data["q"], name="p16")
+    assert farkas_certificate(p_matrix.M, p_matrix.q) is not None  # the float check is fooled
+    assert exact_farkas(p_matrix) is None
+    ray = {"kind": "answer", "z": np.full(16, np.nan), "status": "ray", "time": 1e-3,
+           "iterations": 5, "message": "secondary ray"}
+    assert judge(p_matrix, "peer", "s", ray, 10.0, 1e-8).outcome == "unproved_infeasible"
+    for p in get_set("infeasible", **SMALL):
+        y = exact_farkas(p)
+        assert y is not None and np.all(y >= 0) and p.q @ y < 0
+        ray["z"] = np.full(p.n, np.nan)
+        assert judge(p, "peer", "s", ray, 10.0, 1e-8).outcome == "infeasible"
+
+
+def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
+    """The infeasible set's n4-0 has y = (0, 1, 2, 0)/3 with M'y = 0 and q'y = -1 exactly, so no
+    z >= 0 has M z + q >= 0. Drake's Moby answered it "solved" with z ~ 1e14 along the null
+    direction (0, 1, 2, 0) (w = M z + q negative by O(1)), which verify.certify's scaled
+    measures accept; the judge must not count it a success."""
+    M = np.array([[5.0, 2, -1, 2], [2, 8, -4, -16], [-1, -4, 2, 8], [2, 8, -4, 5]])
+    q = np.array([3.0, -7, 2, 0])
+    y = np.array([0.0, 1, 2, 0])
+    assert np.array_equal(M.T @ y, np.zeros(4)) and q @ y < 0  # exact in floats (integers)
+    problem = lcp.LCP(M, q, name="n4-0")
+    z = 5.8236202078067453e13 * np.array([0.0, 1, 2, 0])
+    assert np.min(M @ z + q) < -0.5  # not feasible, by far
+    claim = {"kind": "answer", "z": z, "status": "solved", "time": 1e-3, "iterations": 0}
+    r = judge(problem, "peer", "s", claim, 10.0, 1e-8)
+    assert r.outcome == "uncertified" and not r.success
+    assert "no feasible point" in r.message
+    # a true solution of a feasible LCP is still a success
+    ok = lcp.LCP(np.eye(2), np.array([-1.0, 2.0]))
+    claim = {"kind": "answer", "z": np.array([1.0, 0.0]), "status": "solved", "time": 1e-3}
+    assert judge(ok, "peer", "s", claim, 10.0, 1e-8).outcome == "solved"
+
+
+@given(n=st.integers(2, 12), seed=st.integers(0, 2**32 - 1), pd=st.booleans())
+def test_judged_rays_are_certified_exactly_when_there_is_no_feasible_point(n, seed, pd):
+    """A "ray" (no solution) claim: on the integer-built infeasible LCPs it is certified (an
+    exact Farkas certificate exists); on a positive definite LCP (always solvable: a P-matrix)
+    it never is, whatever q."""
+    from rigidlcp.bench.problem_sets import infeasible_lcp
+
+    rng = np.random.default_rng(seed)
+    if pd:
+        A = rng.standard_normal((n, n))
+        problem = lcp.LCP(A @ A.T + 1e-3 * np.eye(n), rng.standard_normal(n) * 10.0)
+    else:
+        problem = infeasible_lcp(n, rng)
+    ray = {"kind": "answer", "z": np.full(n, np.nan), "status": "ray", "time": 1e-3}
+    outcome = judge(problem, "peer", "s", ray, 10.0, 1e-8).outcome
+    assert outcome == ("unproved_infeasible" if pd else "infeasible")
 
 
 def test_siconos_absent_is_reported_not_fatal():

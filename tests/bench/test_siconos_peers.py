@@ -277,6 +277,36 @@ def test_the_common_sgm_is_taken_per_kind_over_the_problems_all_its_methods_acce
     assert by["a"].sgm_common["LCP"] == pytest.approx(sgm([0.001, 5.0]))
 
 
+def test_a_method_taking_few_problems_of_a_kind_does_not_decide_the_common_subset():
+    """Fig. 9's event LCPs: pgs takes 1 of the 74 and the common subset was that one problem.
+    A method that accepts fewer than half of a kind's problems is left out of the comparison
+    ('-' in the column) instead; a method that accepts exactly half is compared."""
+    NA = "not_applicable"
+    results = []
+    for k in range(4):
+        results += [_r(f"p{k}", "a", "LCP", 0.001 * (k + 1)),
+                    _r(f"p{k}", "b", "LCP", 0.002 * (k + 1)),
+                    _r(f"p{k}", "narrow", "LCP", 0.5 if k == 0 else 0.0,
+                       "solved" if k == 0 else NA),
+                    _r(f"p{k}", "half", "LCP", 0.003 if k < 2 else 0.0,
+                       "solved" if k < 2 else NA)]
+    by = {s.method: s for s in summarize(results, time_limit=5.0)}
+    # narrow (1 of 4) is out; half (2 of 4) is in, so the common problems are p0 and p1
+    assert by["a"].common == {"LCP": 2}
+    assert "LCP" not in by["narrow"].sgm_common
+    sgm = shifted_geometric_mean
+    assert by["a"].sgm_common["LCP"] == pytest.approx(sgm([0.001, 0.002]))
+    assert by["half"].sgm_common["LCP"] == pytest.approx(sgm([0.003, 0.003]))
+    table = summary_table(list(by.values()))
+    assert "SGM time, common LCP (2)" in table[0]
+    row = next(line for line in table if line.startswith("| narrow |"))
+    assert row.split("|")[5].strip() == "-" and row.split("|")[4].strip() == "500 ms"
+    # without "half", the common subset is every problem a and b take
+    by = {s.method: s for s in summarize([r for r in results if r.method != "half"], 5.0)}
+    assert by["b"].common == {"LCP": 4}
+    assert by["b"].sgm_common["LCP"] == pytest.approx(sgm([0.002, 0.004, 0.006, 0.008]))
+
+
 def test_the_kind_survives_the_csv(tmp_path):
     rows = [_r("p1", "a", "MLCP", 0.001), _r("g1", "a", "FC2D", 0.002)]
     back = read_csv(write_csv(rows, tmp_path / "r.csv"))
