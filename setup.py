@@ -55,7 +55,7 @@ setup(
                            "lcp/_lemke_problem.h", "lcp/_lemke_measure.h",
                            "lcp/_lemke_solution.h", "lcp/_solve_entry.h",
                            "lcp/_batch_solutions.h", "lcp/_balanced.h", "lcp/_blas.h",
-                           "lcp/_buffer.h",
+                           "lcp/_buffer.h", "lcp/_numpy_abi.h",
                            "lcp/acceptance/_accuracy_core.h", "lcp/acceptance/_bound_core.h",
                            "lcp/acceptance/_lu_core.h", "lcp/acceptance/_inverse_core.h"]),
         Extension("rigidlcp.lcp.solvers._pivot_c", sources=["lcp/solvers/_pivot_c.c"],

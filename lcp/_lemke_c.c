@@ -27,6 +27,8 @@
  *   acceptance/_accuracy_core.h  the acceptance steps of assess_lcp (shared with _accuracy_c.c)
  *   _lemke_run.h      the Lemke state and the pivoting run on one dictionary (its updates,
  *                     eager or lazy, in _lemke_update.h)
+ *   _numpy_abi.h      new arrays by numpy's PyArray_NewFromDescr, found at run time
+ *                     (array_setup, array_probe, new_array_of)
  *   _lemke_py.h       the buffer checks and the entry points run, setup, check, plain
  *   _blas.h           numpy's cblas_dgemv, called directly for M z (gemv_setup, gemv)
  *   _lemke_problem.h  one whole problem without the GIL: equilibration (_balanced.h), the
@@ -51,6 +53,7 @@ typedef Py_ssize_t idx;
 
 #include "acceptance/_accuracy_core.h" /* assess_one: the acceptance of solve_accept */
 #include "_lemke_run.h"
+#include "_numpy_abi.h" /* new_array_of: numpy's PyArray_NewFromDescr, found at run time */
 #include "_lemke_py.h"
 #include "_blas.h" /* gemv_setup, gemv: numpy's own cblas_dgemv for M z */
 #include "_lemke_problem.h"
@@ -152,7 +155,8 @@ static PyObject *py_solve_accept(PyObject *self, PyObject *args)
     int code, acode = 1;
     Py_BEGIN_ALLOW_THREADS
     code = solve_and_accept(n, (const double *)vM.buf, (const double *)vq.buf, tol, max_iter,
-                            (double *)vz.buf, (int64_t *)vb.buf, &pivots, &nb, &acode, res);
+                            (double *)vz.buf, (int64_t *)vb.buf, &pivots, &nb, &acode, res,
+                            NULL);
     Py_END_ALLOW_THREADS
     if (code < 0)
         PyErr_NoMemory();
@@ -313,13 +317,14 @@ static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t
     idx nb = 0;
     int code, acode = 1;
     int direct = blas_ok(n), measured = 0;
+    double mmax = -1.0; /* max|M| from the solve (measure_known) */
     Py_BEGIN_ALLOW_THREADS
     code = solve_and_accept(n, M, q, tol, max_iter, z, (int64_t *)vb.buf, &pivots, &nb, &acode,
-                            res);
+                            res, &mmax);
     if (code == 0 && acode == 0 && direct) { /* numpy's own gemv (_blas.h), then the measure */
         blas_mz(n, M, z, w);
         measured = 1;
-        if (n <= upto && measure_one(n, M, q, z, w, got) < 0) got[0] = got[1] = NAN;
+        if (n <= upto && measure_known(n, M, q, z, w, got, mmax) < 0) got[0] = got[1] = NAN;
     }
     Py_END_ALLOW_THREADS
     if (code < 0) {
@@ -331,7 +336,7 @@ static PyObject *py_solve_fast(PyObject *self, PyObject *const *args, Py_ssize_t
         PyObject *out = PyObject_Vectorcall(args[7], call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;
         Py_DECREF(out);
-        if (n <= upto && measure_one(n, M, q, z, w, got) < 0) got[0] = got[1] = NAN;
+        if (n <= upto && measure_known(n, M, q, z, w, got, mmax) < 0) got[0] = got[1] = NAN;
     }
     result = Py_BuildValue("iLniddidd", code, pivots, nb, acode, res[0], res[1], (int)res[2],
                            got[0], got[1]);
@@ -368,6 +373,11 @@ static PyMethodDef methods[] = {
     {"entry_setup", py_entry_setup, METH_VARARGS,
      "entry_setup(registry, kernel_dict, lemke, finish, ndarray, tol, upto): solve_default's "
      "objects."},
+    {"array_setup", py_array_setup, METH_VARARGS,
+     "array_setup(capsule, float64, intp, ndarray) -> bool: new arrays by numpy's "
+     "PyArray_NewFromDescr (see lcp/_numpy_abi.h)."},
+    {"array_probe", py_array_probe, METH_VARARGS,
+     "array_probe(shape, integer) -> an array made by that route, entries 0, 1, 2, ..."},
     {"gemv_setup", py_gemv_setup, METH_VARARGS,
      "gemv_setup(address, ilp64): numpy's cblas_dgemv for M z (0: none; see lcp/_blas.h)."},
     {"gemv", py_gemv, METH_VARARGS,

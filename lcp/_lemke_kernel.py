@@ -263,3 +263,56 @@ def numpy_gemv() -> bool:
                 _lemke_c.gemv_setup(0, False)
             _gemv_found = ok
     return _gemv_found
+
+
+_arrays_found: bool | None = None
+
+
+def _array_capsule():
+    """numpy's table of C functions for extensions (the capsule `_ARRAY_API`), or None."""
+    import importlib
+
+    for name in ("numpy._core._multiarray_umath", "numpy.core._multiarray_umath"):
+        try:
+            return importlib.import_module(name)._ARRAY_API
+        except (ImportError, AttributeError):
+            continue
+    return None
+
+
+def _flags(a: np.ndarray) -> tuple[bool, ...]:
+    return tuple(a.flags[f] for f in ("C_CONTIGUOUS", "F_CONTIGUOUS", "OWNDATA", "WRITEABLE",
+                                      "ALIGNED", "WRITEBACKIFCOPY"))
+
+
+def numpy_arrays() -> bool:
+    """Do the C calls make their new arrays (lcp.LCP's copies of M and q, a Solution's z, w and
+    basis) by numpy's own PyArray_NewFromDescr (lcp/_numpy_abi.h) rather than by calling
+    numpy.empty? Found once: the function is taken from numpy's C-API table when its ABI
+    version and ndarray type are the known ones, then arrays made by it (1-D and 2-D, float64
+    and intp, empty included) are checked against numpy.empty's -- type, dtype, shape,
+    strides, flags, no base -- and their entries, written through the data pointer read in C,
+    against 0, 1, 2, ...; any difference and numpy.empty is called as before."""
+    global _arrays_found
+    if _arrays_found is None:
+        _arrays_found = False
+        if COMPILED and hasattr(_lemke_c, "array_setup"):  # (an older build has not)
+            intp = np.dtype(np.intp)
+            ok = intp.itemsize == 8 and bool(_lemke_c.array_setup(
+                _array_capsule(), np.dtype(np.float64), intp, np.ndarray))
+            for shape in ((0,), (1,), (10,), (3, 3), (30, 30), (0, 0)) if ok else ():
+                for integer in (False, True):
+                    got = _lemke_c.array_probe(shape, integer)
+                    ref = np.empty(shape, np.intp if integer else np.float64)
+                    ok = ok and (type(got) is np.ndarray and got.dtype is ref.dtype
+                                 and got.shape == ref.shape and got.strides == ref.strides
+                                 and _flags(got) == _flags(ref) and got.base is None
+                                 and np.array_equal(got.ravel(), np.arange(got.size)))
+            if not ok:
+                _lemke_c.array_setup(None, np.dtype(np.float64), np.dtype(np.intp),
+                                     np.ndarray)
+            _arrays_found = ok
+    return _arrays_found
+
+
+numpy_arrays()

@@ -68,14 +68,15 @@ __attribute__((target("avx2"))) static double pairwise_abs_avx2(const double *a,
 }
 
 /* measure_one's pass over M (finiteness, max|M|, the row sums of |M| in numpy's order), with
- * pairwise_abs_avx2 and _accuracy_core.h's abs_max_finite_avx2. */
+ * pairwise_abs_avx2 and _accuracy_core.h's abs_max_finite_avx2; `known`: M is finite and
+ * *mmax already max|M| (measure_known), so only the row sums are taken. */
 __attribute__((target("avx2"))) static int m_pass_avx2(idx n, const double *M, double *mmax,
-                                                       double *norm)
+                                                       double *norm, int known)
 {
     int finite = 1;
     for (idx i = 0; i < n; i++) {
         const double *Mi = M + i * n;
-        finite &= abs_max_finite_avx2(Mi, n, mmax);
+        if (!known) finite &= abs_max_finite_avx2(Mi, n, mmax);
         double row = 0.0 + pairwise_abs_avx2(Mi, n);
         finite &= row <= DBL_MAX;
         *norm = row > *norm ? row : *norm;
@@ -112,22 +113,25 @@ static PyObject *py_abs_row_sums(PyObject *self, PyObject *args)
 }
 
 /* One LCP's measure (see lcp_measure below): 0 and w = Mz + q written, or -1 (nothing written)
- * when a number is not finite. */
-static int measure_one(idx n, const double *M, const double *q, const double *z, double *w,
-                       double out[4])
+ * when a number is not finite. mmax_in >= 0: M is known finite and max|M| = mmax_in (the
+ * solve measured it: solve_and_accept's *mmax), so the pass over M takes only the row sums
+ * (max|M| is the same number in any order); negative: measured here. */
+static int measure_known(idx n, const double *M, const double *q, const double *z, double *w,
+                         double out[4], double mmax_in)
 {
-    double mmax = 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
+    const int known = mmax_in >= 0;
+    double mmax = known ? mmax_in : 0.0, qmax = 0.0, zmax = 0.0, norm = 0.0;
     int finite = 1; /* branch-free maxima and finiteness test, as in balanced_units */
 #if HAVE_AVX2_CLONE
     int wide = cpu_avx2(); /* M's pass four lanes wide: the same numbers (see m_pass_avx2) */
-    if (wide) finite = m_pass_avx2(n, M, &mmax, &norm);
+    if (wide) finite = m_pass_avx2(n, M, &mmax, &norm, known);
 #else
     const int wide = 0;
 #endif
     for (idx i = 0; i < n; i++) {
         if (!wide) {
             const double *Mi = M + i * n;
-            for (idx j = 0; j < n; j++) {
+            for (idx j = 0; !known && j < n; j++) {
                 double a = fabs(Mi[j]);
                 finite &= a <= DBL_MAX;
                 mmax = a > mmax ? a : mmax;
@@ -164,6 +168,13 @@ static int measure_one(idx n, const double *M, const double *q, const double *z,
     out[2] = zs;
     out[3] = ws;
     return 0;
+}
+
+/* measure_known with max|M| measured here. */
+static int measure_one(idx n, const double *M, const double *q, const double *z, double *w,
+                       double out[4])
+{
+    return measure_known(n, M, q, z, w, out, -1.0);
 }
 
 /* float64 C-contiguous buffers of the given sizes (objs[i], writable where asked), all or none:

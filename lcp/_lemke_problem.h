@@ -310,10 +310,11 @@ static int accept_one(idx n, const double *M, const double *q, const double *zs,
 
 /* The work of solve_accept on C-contiguous data (M n x n, q, z: n doubles, basis: n int64),
  * without the GIL: the code of solve_problem (-1: out of memory), *acode that of accept_one
- * (1 when not solved). */
+ * (1 when not solved); *mmax (unless NULL) = max|M| when the code is 0 (M then finite: the
+ * solve refuses other data with NOT_FINITE), else -1. */
 static int solve_and_accept(idx n, const double *M, const double *q, double tol,
                             long long max_iter, double *z, int64_t *basis, long long *pivots,
-                            idx *nb, int *acode, double res[3])
+                            idx *nb, int *acode, double res[3], double *mmax)
 {
     Work w;
     uint64_t stack[STACK_WORDS] STACK_ALIGNED;
@@ -331,6 +332,7 @@ static int solve_and_accept(idx n, const double *M, const double *q, double tol,
     int code = solve_problem(&w.L, w.T, M, q, NULL, NULL, NULL, 1, max_iter, zs, w.bz, pivots,
                              bound);
     if (code == 0) *acode = accept_one(n, M, q, zs, w.bz, bound, basis, nb, z, res);
+    if (mmax) *mmax = code == 0 ? bound[0] : -1.0;
     if (zs != zbuf) free(zs);
     work_free(&w);
     return code;

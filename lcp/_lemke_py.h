@@ -348,24 +348,12 @@ static PyObject *py_lcp_setup(PyObject *self, PyObject *args)
     return PyBool_FromLong(ok);
 }
 
-/* A new float64 array of `shape` (an int or a tuple) holding the `bytes` bytes at src. */
-static PyObject *copy_of(PyObject *shape, const void *src, idx bytes)
+/* A new float64 array of nd dimensions dims (_numpy_abi.h) holding the `bytes` bytes at src. */
+static PyObject *copy_of(int nd, const Py_ssize_t *dims, const void *src, idx bytes)
 {
-    PyObject *arr = PyObject_Vectorcall(s_lcp_empty, &shape, 1, NULL);
-    if (!arr) return NULL;
-    Py_buffer v;
-    if (PyObject_GetBuffer(arr, &v, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) {
-        Py_DECREF(arr);
-        return NULL;
-    }
-    if (v.len != bytes) {
-        PyErr_SetString(PyExc_ValueError, "lcp_init: numpy.empty gave an array of another size");
-        PyBuffer_Release(&v);
-        Py_DECREF(arr);
-        return NULL;
-    }
-    memcpy(v.buf, src, (size_t)bytes);
-    PyBuffer_Release(&v);
+    void *data;
+    PyObject *arr = new_array_of(nd, dims, 0, s_lcp_empty, NULL, &data);
+    if (arr) memcpy(data, src, (size_t)bytes);
     return arr;
 }
 
@@ -379,15 +367,11 @@ static int lcp_quick(PyObject *obj, PyObject *oM, PyObject *oq, PyObject *name, 
         Py_TYPE(oq) != (PyTypeObject *)s_lcp_ndarray || !(n = plain_buffers(oM, oq, &vM, &vq)))
         return 0;
     PyObject *v[4] = {NULL, NULL, name, meta};
-    PyObject *size = PyLong_FromSsize_t(n), *shape = size ? PyTuple_Pack(2, size, size) : NULL;
-    if (shape) {
-        v[0] = copy_of(shape, vM.buf, n * n * 8);
-        v[1] = v[0] ? copy_of(size, vq.buf, n * 8) : NULL;
-    }
+    const Py_ssize_t dims[2] = {n, n};
+    v[0] = copy_of(2, dims, vM.buf, n * n * 8);
+    v[1] = v[0] ? copy_of(1, dims, vq.buf, n * 8) : NULL;
     PyBuffer_Release(&vM);
     PyBuffer_Release(&vq);
-    Py_XDECREF(shape);
-    Py_XDECREF(size);
     if (v[1] && v[3] == Py_None && !(v[3] = PyDict_New())) Py_CLEAR(v[1]);
     else if (v[1] && v[3] != Py_None) Py_INCREF(v[3]);
     if (!v[1]) {

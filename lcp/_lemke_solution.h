@@ -159,8 +159,9 @@ static int own_buffer(PyObject *obj, Py_buffer *view, idx bytes)
  * data the C call does not take: the caller's general path). */
 static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long max_iter, idx upto)
 {
-    Py_buffer vq = {0}, vM = {0}, vz = {0}, vw = {0};
+    Py_buffer vq = {0}, vM = {0};
     PyObject *result = NULL, *z = NULL, *w = NULL, *basis = NULL;
+    void *zp, *wp, *bp;
     int64_t bbuf[64], *b = NULL;
     idx n = problem_data(oM, oq, &vM, &vq);
     if (n < 0) goto done;
@@ -169,26 +170,28 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
         goto done;
     }
     if (max_iter < 0) max_iter = 1000 + 100 * (long long)n;
-    if (!(z = new_array(n, 0)) || !(w = new_array(n, 0))) goto done;
-    if (own_buffer(z, &vz, n * 8) < 0 || own_buffer(w, &vw, n * 8) < 0) goto done;
+    if (!(z = new_array_of(1, &n, 0, s_empty, s_intp, &zp)) ||
+        !(w = new_array_of(1, &n, 0, s_empty, s_intp, &wp)))
+        goto done;
     b = n <= 64 ? bbuf : (int64_t *)malloc((size_t)n * sizeof(int64_t));
     if (!b) {
         PyErr_NoMemory();
         goto done;
     }
     const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
-    double *zd = (double *)vz.buf, *wd = (double *)vw.buf;
+    double *zd = (double *)zp, *wd = (double *)wp;
     long long pivots = 0;
     double res[3], got[4] = {NAN, NAN, 0.0, 0.0};
     idx nb = 0;
     int code, acode = 1;
     int direct = blas_ok(n), measured = 0;
+    double mmax = -1.0; /* max|M|, which the solve measured: the measure does not again */
     Py_BEGIN_ALLOW_THREADS
-    code = solve_and_accept(n, M, q, tol, max_iter, zd, b, &pivots, &nb, &acode, res);
+    code = solve_and_accept(n, M, q, tol, max_iter, zd, b, &pivots, &nb, &acode, res, &mmax);
     if (code == 0 && acode == 0 && direct) { /* numpy's own gemv (_blas.h), then the measure */
         blas_mz(n, M, zd, wd);
         measured = 1;
-        if (n <= upto && measure_one(n, M, q, zd, wd, got) < 0) got[0] = got[1] = NAN;
+        if (n <= upto && measure_known(n, M, q, zd, wd, got, mmax) < 0) got[0] = got[1] = NAN;
     }
     Py_END_ALLOW_THREADS
     if (code < 0) {
@@ -200,15 +203,10 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
         PyObject *out = PyObject_Vectorcall(s_dot, call, 3, NULL); /* dot(M, z, w) */
         if (!out) goto done;
         Py_DECREF(out);
-        if (n <= upto && measure_one(n, M, q, zd, wd, got) < 0) got[0] = got[1] = NAN;
+        if (n <= upto && measure_known(n, M, q, zd, wd, got, mmax) < 0) got[0] = got[1] = NAN;
     }
-    if (!(basis = new_array(nb, 1))) goto done;
-    if (nb) {
-        Py_buffer vb = {0};
-        if (own_buffer(basis, &vb, nb * (idx)sizeof(int64_t)) < 0) goto done;
-        memcpy(vb.buf, b, (size_t)nb * sizeof(int64_t));
-        PyBuffer_Release(&vb);
-    }
+    if (!(basis = new_array_of(1, &nb, 1, s_empty, s_intp, &bp))) goto done;
+    if (nb) memcpy(bp, b, (size_t)nb * sizeof(int64_t)); /* intp: 8 bytes (numpy_arrays) */
     int refined = (int)res[2];
     /* solve_lemke's verdict (NaN fails every test: then the Python measures or refuses) */
     if (code == 0 && acode == 0 && got[1] <= s_tol && res[0] <= s_tol && res[1] <= s_ferr_tol)
@@ -219,8 +217,6 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
                                got[0], got[1], z, w, basis);
 done:
     if (b && b != bbuf) free(b);
-    release(&vw);
-    release(&vz);
     release(&vM);
     release(&vq);
     Py_XDECREF(z);

@@ -1,0 +1,131 @@
+"""The arrays the C calls make by numpy's own PyArray_NewFromDescr (lcp/_numpy_abi.h, issue 23's
+ninth pass) are the arrays numpy.empty made before, and no answer changes with the route.
+
+* `_lemke_kernel.numpy_arrays` finds the route on the numpy installed (its C-API table) and
+  checks arrays made by it -- type, dtype, shape, strides, flags, no base, the entries written
+  through the data pointer read in C -- against numpy.empty's.
+* `lcp.LCP`'s copies of M and q and a Solution's z, w and basis are such arrays; with the route
+  off (numpy.empty called from C, as before) the Solutions are the same, field for field, bit
+  for bit, and so are the arrays' properties.
+* array_setup refuses what is not numpy's table for this ndarray type (then numpy.empty runs).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rigidlcp import lcp
+from rigidlcp.lcp import _lemke_kernel as kernel
+from rigidlcp.lcp.solvers import fast_lemke
+
+from .test_entry_glue import same_outcome
+from .test_fast_lemke import assert_same_answer
+from .test_speed_paths import SIZES, _problem
+
+compiled = pytest.mark.skipif(not (kernel.enabled() and fast_lemke._solve_lcp is not None),
+                              reason="the C extensions are not built or are off")
+
+
+def route(on: bool) -> None:
+    """Switch the route on (found and checked again) or off (numpy.empty from C)."""
+    if on:
+        kernel._arrays_found = None
+        assert kernel.numpy_arrays()
+    else:
+        kernel._lemke_c.array_setup(None, np.dtype(np.float64), np.dtype(np.intp), np.ndarray)
+
+
+@pytest.fixture
+def restore():
+    yield
+    route(True)
+
+
+def looks(a: np.ndarray) -> tuple:
+    """What a user can see of an array besides its values."""
+    return (type(a), a.dtype, a.shape, a.strides, kernel._flags(a), a.base is None)
+
+
+def natural(M, q):
+    """The natural call, and what its arrays look like."""
+    P = lcp.LCP(M, q)
+    sol = lcp.solve(P)
+    return sol, [looks(a) for a in (P.M, P.q, sol.z, sol.w, sol.basis)]
+
+
+@compiled
+def test_the_route_is_found_and_checked():
+    assert kernel.numpy_arrays()
+    for shape in ((0,), (7,), (4, 5), (0, 3)):
+        for integer in (False, True):
+            a = kernel._lemke_c.array_probe(shape, integer)
+            ref = np.empty(shape, np.intp if integer else np.float64)
+            assert looks(a) == looks(ref)
+            assert np.array_equal(a.ravel(), np.arange(a.size))  # written through the pointer
+
+
+@compiled
+@pytest.mark.parametrize("kind", ["psd", "general", "scaled", "degenerate", "ties"])
+@pytest.mark.parametrize("n", (1, 2, *SIZES))
+def test_the_same_answers_and_arrays_with_the_route_off(n, kind, restore):
+    M, q = _problem(n, kind, 0)
+    on, on_looks = natural(M, q)
+    route(False)
+    off, off_looks = natural(M, q)
+    assert same_outcome(on, off)
+    assert on_looks == off_looks
+    assert on_looks[0] == looks(np.empty((n, n))) and on_looks[2] == looks(np.empty(n))
+    assert on_looks[4][1] == np.dtype(np.intp)
+    route(True)
+    assert_same_answer(lcp.LCP(M, q))  # the C path against the general (numpy) path
+
+
+@compiled
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 40), st.integers(0, 2**32 - 1), st.sampled_from(["psd", "general", "q>=0"]))
+def test_random_problems_with_the_route_on_and_off(n, seed, kind):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    M = A @ A.T + 0.1 * np.eye(n) if kind == "psd" else A
+    q = np.abs(rng.standard_normal(n)) if kind == "q>=0" else rng.standard_normal(n)
+    try:
+        on, on_looks = natural(M, q)
+        route(False)
+        off, off_looks = natural(M, q)
+    finally:
+        route(True)
+    assert same_outcome(on, off)
+    assert on_looks == off_looks
+
+
+@compiled
+def test_the_copies_are_the_problems_own():
+    M, q = np.eye(3) + 0.5, -np.ones(3)
+    P = lcp.LCP(M, q)
+    M[0, 0], q[0] = 99.0, 99.0
+    assert P.M[0, 0] == 1.5 and P.q[0] == -1.0
+    assert not np.shares_memory(P.M, M) and not np.shares_memory(P.q, q)
+    P.M[1, 1] = 7.0  # the problem's arrays are writable, as M.copy()'s
+    assert M[1, 1] == 1.5
+
+
+@compiled
+def test_array_setup_refuses_what_is_not_numpys_table(restore):
+    f64, intp = np.dtype(np.float64), np.dtype(np.intp)
+    capsule = kernel._array_capsule()
+    assert capsule is not None
+    assert not kernel._lemke_c.array_setup(None, f64, intp, np.ndarray)
+    assert not kernel._lemke_c.array_setup(object(), f64, intp, np.ndarray)
+
+    class Sub(np.ndarray):
+        pass
+
+    assert not kernel._lemke_c.array_setup(capsule, f64, intp, Sub)  # not the table's type
+    with pytest.raises(RuntimeError):  # the route is off: nothing made by it
+        kernel._lemke_c.array_probe((3,), False)
+    sol, _ = natural(np.eye(2), -np.ones(2))  # numpy.empty from C: the same Solution
+    route(True)
+    assert same_outcome(sol, natural(np.eye(2), -np.ones(2))[0])
