@@ -30,6 +30,7 @@ from rigidlcp.bench.problem_sets import get_set
 from rigidlcp.bench.report import profile_data, shifted_geometric_mean, summarize
 from rigidlcp.cli.main import main as cli_main
 from rigidlcp.lcp.api import _REGISTRY
+from rigidlcp.verify import certify
 
 SMALL = dict(sizes=(3, 6), per_size=2)
 DATA = Path(__file__).resolve().parents[1] / "data"
@@ -179,8 +180,11 @@ def test_a_ray_claim_needs_an_exact_certificate():
 def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
     """The infeasible set's n4-0 has y = (0, 1, 2, 0)/3 with M'y = 0 and q'y = -1 exactly, so no
     z >= 0 has M z + q >= 0. Drake's Moby answered it "solved" with z ~ 1e14 along the null
-    direction (0, 1, 2, 0) (w = M z + q negative by O(1)), which verify.certify's scaled
-    measures accept; the judge must not count it a success."""
+    direction (0, 1, 2, 0) (w = M z + q negative by O(1)), which verify.certify's measures
+    accepted until its pattern system's consistency was decided exactly (lcp.accuracy;
+    tests/lcp/test_inflated_null_direction.py): certify now rejects it (forward bound inf),
+    and the judge's exact-Farkas guard stays behind it. The judge must not count it a
+    success."""
     M = np.array([[5.0, 2, -1, 2], [2, 8, -4, -16], [-1, -4, 2, 8], [2, 8, -4, 5]])
     q = np.array([3.0, -7, 2, 0])
     y = np.array([0.0, 1, 2, 0])
@@ -191,7 +195,9 @@ def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
     claim = {"kind": "answer", "z": z, "status": "solved", "time": 1e-3, "iterations": 0}
     r = judge(problem, "peer", "s", claim, 10.0, 1e-8)
     assert r.outcome == "uncertified" and not r.success
-    assert "no feasible point" in r.message
+    cert = certify(problem, lcp.Solution(z=z, w=M @ z + q, status="solved", method="peer"),
+                   uniqueness="none")
+    assert not cert.accepted and cert.forward_error == np.inf
     # a true solution of a feasible LCP is still a success
     ok = lcp.LCP(np.eye(2), np.array([-1.0, 2.0]))
     claim = {"kind": "answer", "z": np.array([1.0, 0.0]), "status": "solved", "time": 1e-3}

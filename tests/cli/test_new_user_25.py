@@ -36,11 +36,13 @@ def test_bench_takes_no_progress_like_the_other_commands():
 
 def test_ranges_announces_a_long_run_before_the_work(capsys):
     fig9 = models.System(models.rectangular(10, 4))
-    _warn_long(fig9, argparse.Namespace(observables="alpha", time_limit=10.0))
+    _warn_long(fig9, argparse.Namespace(observables="alpha", time_limit=10.0, clock="cpu"))
     err = capsys.readouterr().err
     # 2 ends of mu_g and of each of the 40 angular accelerations, 10 s each: 820 s
     assert "82 MILP ends" in err and "14 min" in err and "--observables mu_g" in err
-    _warn_long(fig9, argparse.Namespace(observables="mu_g", time_limit=10.0))  # 20 s: quiet
+    assert "10 CPU s" in err  # --clock cpu, the default
+    _warn_long(fig9, argparse.Namespace(observables="mu_g", time_limit=10.0,
+                                        clock="cpu"))  # 20 s: quiet
     assert capsys.readouterr().err == ""
     assert 2 * 10.0 < LONG_RUN_S
 
