@@ -254,8 +254,14 @@ def _node_lp(pb: ClosedProblem, cost, zero_z, zero_w, limit: float | None):
     A_eq, b_eq, A_ub, b_ub = _node_rows(pb, zero_w)
     bounds = [(0.0, 0.0) if f else (0.0, None) for f in zero_z]
     options = dict(LP_OPTIONS) if limit is None else {**LP_OPTIONS, "time_limit": limit}
-    return linprog(cost, A_ub=A_ub if b_ub.size else None, b_ub=b_ub if b_ub.size else None,
-                   A_eq=A_eq, b_eq=b_eq, bounds=bounds, method="highs", options=options)
+    res = None
+    for extra in ({}, {"presolve": False}):  # HiGHS may end "unknown" (status 15; highspy
+        res = linprog(cost, A_ub=A_ub if b_ub.size else None,  # 1.10): asked again without
+                      b_ub=b_ub if b_ub.size else None, A_eq=A_eq,  # its presolve
+                      b_eq=b_eq, bounds=bounds, method="highs", options={**options, **extra})
+        if res.status in (0, 2, 3):
+            break
+    return res
 
 
 def _farkas_radius(pb: ClosedProblem, zero_z, zero_w, limit: float | None = None) -> float:
