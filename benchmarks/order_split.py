@@ -54,10 +54,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigidlcp.verify.certificates.uniqueness import quiet_highs
 from rigidlcp.verify.ranges.bounds import rotation_cap
 from rigidlcp.verify.ranges.disk_split import DOWN, INSIDE, NOTDOWN, NOTUP, OPEN, UP, _Cases
-from rigidlcp.verify.ranges.milp import certified_result
 from rigidlcp.verify.ranges.steady import Formulation, velocity_box
 
 
@@ -234,29 +232,7 @@ def solve_case(cases: _Cases, disks: np.ndarray, fixed: dict[int, int], weak: di
             lo[cases.r_a + k] = max(lo[cases.r_a + k], -cases.q[k])
         else:
             hi[cases.r_a + k] = min(hi[cases.r_a + k], -cases.q[k])
-    h, hs = cases.h, cases.hs
-    row = cases.power_row(disks)
-    changed = np.flatnonzero(row != cases.Ad[cases.r_pw])
-    for j in changed:
-        h.changeCoeff(cases.r_pw, int(j), float(row[j]))
-    if changed.size:
-        import scipy.sparse as sp
-
-        cases.Ad = cases.Ad.copy()
-        cases.Ad[cases.r_pw] = row
-        cases.A = sp.csr_matrix(cases.Ad)
-    for i in np.flatnonzero((lo != cases.cur_lo) | (hi != cases.cur_hi)):
-        h.changeRowBounds(int(i), float(lo[i]), float(hi[i]))
-    cases.cur_lo, cases.cur_hi = lo, hi
-    with quiet_highs():
-        h.run()
-    if h.getModelStatus() not in (hs.HighsModelStatus.kOptimal,
-                                  hs.HighsModelStatus.kInfeasible):
-        h.clearSolver()
-        with quiet_highs():
-            h.run()
-    b, x = certified_result(h, hs, cases.cost, cases.A, lo, hi, cases.lb, cases.ub)
-    return b, (None if x is None else x[:2 * cases.c])
+    return cases.solve_with(disks, lo, hi)
 
 
 def order_split_bound(form: Formulation, cost: np.ndarray, target: float, time_limit: float,

@@ -228,6 +228,12 @@ class _Cases:
               ) -> tuple[float, np.ndarray | None]:
         """(certified lower bound, LP point) of the case."""
         lo, hi = self.bounds(disks, contacts)
+        return self.solve_with(disks, lo, hi)
+
+    def solve_with(self, disks: np.ndarray, lo: np.ndarray, hi: np.ndarray
+                   ) -> tuple[float, np.ndarray | None]:
+        """(certified lower bound, LP point) with the row bounds lo, hi and the power row of
+        `disks` loaded into the kept model (only the entries that changed)."""
         h = self.h
         row = self.power_row(disks)
         for j in np.flatnonzero(row != self.Ad[self.r_pw]):
