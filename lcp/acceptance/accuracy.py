@@ -260,16 +260,12 @@ def _exactly_consistent(Kp: np.ndarray, kp: np.ndarray) -> bool | None:
     m = kp.size
     if m > EXACT_CONSISTENCY_MAX_M or not (np.all(np.isfinite(Kp)) and np.all(np.isfinite(kp))):
         return None
-    from fractions import Fraction
+    from flint import fmpq_mat
 
-    from flint import fmpq, fmpq_mat
+    from .farkas import _q  # a double as the exact rational it is
 
-    def q(v: float):
-        f = Fraction(float(v))
-        return fmpq(f.numerator, f.denominator)
-
-    A = fmpq_mat(m, m, [q(v) for v in Kp.ravel()])
-    Ak = fmpq_mat(m, m + 1, [q(v) for row in np.c_[Kp, kp] for v in row])
+    A = fmpq_mat(m, m, [_q(v) for v in Kp.ravel()])
+    Ak = fmpq_mat(m, m + 1, [_q(v) for row in np.c_[Kp, kp] for v in row])
     return A.rref()[1] == Ak.rref()[1]
 
 
