@@ -39,7 +39,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -50,20 +52,8 @@ from rigidlcp.verify.statics.forceset import analyse
 from rigidlcp.verify.statics.model import DualForceLP, ForceLP, StaticProblem
 from rigidlcp.verify.statics.range_ends import Vertices, Witnesses, ranges_of, spatial_order
 
-
-def _picks(prob: StaticProblem, k: int, blocks: int) -> np.ndarray:
-    """As benchmarks/packings.py's --sample: k contacts spread evenly (blocks = k) or in
-    `blocks` clusters of neighbours around contacts at evenly spread heights."""
-    if blocks >= k:
-        return np.unique(np.linspace(0, prob.c - 1, k).round().astype(int))
-    lat = prob.system.lattice
-    where = np.asarray(lat.x, dtype=float)[np.asarray(lat.i)]
-    by_height = np.argsort(where[:, 1], kind="stable")
-    centres = by_height[np.linspace(0, prob.c - 1, blocks).round().astype(int)]
-    size = max(1, k // blocks)
-    near = [np.argsort(np.sum((where - where[a]) ** 2, axis=1), kind="stable")[:size]
-            for a in centres]
-    return np.unique(np.concatenate(near))
+sys.path.insert(0, str(Path(__file__).parent))
+from packings import _picks  # noqa: E402  (the contacts of packings.py's --sample)
 
 
 class Rings:

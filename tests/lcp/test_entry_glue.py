@@ -46,6 +46,15 @@ def same_outcome(a, b) -> bool:
     return type(a) is type(b) and all(same(getattr(a, k), getattr(b, k)) for k in fields(a))
 
 
+def seeded_problem(n: int, seed: int, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """(M, q) of size n from a seed: "psd" (A A^T + 0.1 I), "general" (A) or "q>=0" (A, |q|)."""
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    M = A @ A.T + 0.1 * np.eye(n) if kind == "psd" else A
+    q = np.abs(rng.standard_normal(n)) if kind == "q>=0" else rng.standard_normal(n)
+    return M, q
+
+
 @compiled
 @pytest.mark.parametrize("kind", ["psd", "general", "scaled", "degenerate", "ties"])
 @pytest.mark.parametrize("n", (1, 2, *SIZES))
@@ -61,11 +70,7 @@ def test_the_c_entry_is_solve_lemke(n, kind):
 @settings(max_examples=60, deadline=None)
 @given(st.integers(1, 12), st.integers(0, 2**32 - 1), st.sampled_from(["psd", "general", "q>=0"]))
 def test_the_c_entry_is_solve_lemke_on_random_problems(n, seed, kind):
-    rng = np.random.default_rng(seed)
-    A = rng.standard_normal((n, n))
-    M = A @ A.T + 0.1 * np.eye(n) if kind == "psd" else A
-    q = np.abs(rng.standard_normal(n)) if kind == "q>=0" else rng.standard_normal(n)
-    P = lcp.LCP(M, q)
+    P = lcp.LCP(*seeded_problem(n, seed, kind))
     assert same_outcome(fast_lemke.entry(P), fast_lemke.solve_lemke(P))
 
 

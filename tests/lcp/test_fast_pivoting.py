@@ -6,8 +6,6 @@ singular start, a single or exchange pivot, bad data, options, Fortran order, no
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -19,7 +17,7 @@ from rigidlcp.lcp import api
 from rigidlcp.lcp.problems.solution import Solution
 from rigidlcp.lcp.solvers import fast_pivoting
 
-from .test_fast_lemke import outcome, random_lcps, same
+from .test_fast_lemke import fields, outcome, random_lcps, same
 from .test_lemke import degenerate_integer_lcps
 
 compiled = pytest.mark.skipif(not fast_pivoting.applies(),
@@ -27,10 +25,6 @@ compiled = pytest.mark.skipif(not fast_pivoting.applies(),
                               "does not round as numpy's")
 
 
-
-def fields(sol) -> list[str]:
-    """The Solution's field names (its slots: a Solution has no __dict__)."""
-    return [f.name for f in dataclasses.fields(sol)]
 
 def general(problem, **kw):
     """lcp.solve(problem, "pivoting") without the fast path (lcp.trust.solve_checked)."""

@@ -21,7 +21,7 @@ from rigidlcp import lcp
 from rigidlcp.lcp import _lemke_kernel as kernel
 from rigidlcp.lcp.solvers import fast_lemke
 
-from .test_entry_glue import same_outcome
+from .test_entry_glue import same_outcome, seeded_problem
 from .test_fast_lemke import assert_same_answer
 from .test_speed_paths import SIZES, _problem
 
@@ -87,10 +87,7 @@ def test_the_same_answers_and_arrays_with_the_route_off(n, kind, restore):
 @settings(max_examples=60, deadline=None)
 @given(st.integers(1, 40), st.integers(0, 2**32 - 1), st.sampled_from(["psd", "general", "q>=0"]))
 def test_random_problems_with_the_route_on_and_off(n, seed, kind):
-    rng = np.random.default_rng(seed)
-    A = rng.standard_normal((n, n))
-    M = A @ A.T + 0.1 * np.eye(n) if kind == "psd" else A
-    q = np.abs(rng.standard_normal(n)) if kind == "q>=0" else rng.standard_normal(n)
+    M, q = seeded_problem(n, seed, kind)
     try:
         on, on_looks = natural(M, q)
         route(False)

@@ -22,7 +22,9 @@ from rigidlcp.models.deposition import deposit, with_vacancies
 from rigidlcp.models.packing import report
 
 
-def _check_invariants(lat: models.Lattice) -> None:
+def assert_inside_without_overlap(lat: models.Lattice) -> None:
+    """No two disks overlap beyond the gap tolerance (all pairs), every disk above the plane
+    and between the walls."""
     x, r = lat.x, lat.radii
     d = np.hypot(*(x[:, None, :] - x[None, :, :]).transpose(2, 0, 1))
     gap = d - r[:, None] - r[None, :]
@@ -30,6 +32,10 @@ def _check_invariants(lat: models.Lattice) -> None:
     assert gap.min() >= -1e-9 * r.min()
     assert np.all(x[:, 1] - r >= -1e-9 * r) and np.all(x[:, 0] - r >= lat.left - 1e-9 * r)
     assert np.all(x[:, 0] + r <= lat.right + 1e-9 * r)
+
+
+def _check_invariants(lat: models.Lattice) -> None:
+    assert_inside_without_overlap(lat)
     for k in range(lat.p):
         normals = [-lat.n[a] for a in np.flatnonzero(lat.i == k)
                    if lat.j[a] < 0 or lat.j[a] < k]

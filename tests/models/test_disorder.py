@@ -15,20 +15,17 @@ from rigidlcp.models.disorder import with_size_disorder
 from rigidlcp.models.packing import report
 from rigidlcp.models.packing_io import read_packing
 
+from .test_deposition import assert_inside_without_overlap
+
 
 def _check(lat: models.Lattice, regular: models.Lattice, spread: float) -> None:
     """No overlap beyond the gap tolerance (all pairs), inside the box, radii in range, the
     bottom row against both walls, and every disk held by what was placed before it (row by
     row, left to right): (0, 1) = sum R_c n_c with R >= 0 over those contacts."""
-    x, r = lat.x, lat.radii
+    r = lat.radii
     r0 = regular.radius
     assert np.all(r >= r0 * (1 - spread) - 1e-15) and np.all(r <= r0 * (1 + spread) + 1e-15)
-    d = np.hypot(*(x[:, None, :] - x[None, :, :]).transpose(2, 0, 1))
-    gap = d - r[:, None] - r[None, :]
-    np.fill_diagonal(gap, np.inf)
-    assert gap.min() >= -1e-9 * r.min()
-    assert np.all(x[:, 1] - r >= -1e-9 * r) and np.all(x[:, 0] - r >= lat.left - 1e-9 * r)
-    assert np.all(x[:, 0] + r <= lat.right + 1e-9 * r)
+    assert_inside_without_overlap(lat)
     walls = {int(j) for j in lat.j[lat.j < 0]}
     assert {models.LEFT_WALL, models.RIGHT_WALL} <= walls
     rank = np.empty(lat.p, dtype=int)

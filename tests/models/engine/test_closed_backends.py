@@ -24,7 +24,7 @@ from rigidlcp.models.step_lcp import StepProblem, coulomb_residual
 from rigidlcp.models.timestepping import moreau_jean
 
 from ...verify.statics.test_groove import _closed_by_hand, _groove
-from .test_closed import laws_residual, scale_of
+from .test_closed import _small_case, laws_residual, scale_of
 
 EXAMPLES = (settings.get_profile("deep").max_examples
             if os.environ.get("HYPOTHESIS_PROFILE") == "deep" else 10)
@@ -34,14 +34,6 @@ PROVED = "proved: no solution of the {} keeps every contact closed"
 def _spinning_groove(mu: float):
     system = _groove(mu)
     return system, models.initial_state(system, omega=np.array([0.0, 0.0, 1.0]))
-
-
-def _small_case(n: int, seed: int, mu: float, spins: bool):
-    pile = deposit(n, seed=seed, radii=(0.8, 1.2), width=2.2 * n ** 0.5 + 1.0)
-    system = models.System(pile, mu_pp=mu, mu_plane=mu, mu_wall=mu, gamma=0.1)
-    state = (models.initial_state(system, seed=seed) if spins
-             else models.initial_state(system, omega=np.zeros(system.p)))
-    return system, state
 
 
 def _same_verdict(system, state):
