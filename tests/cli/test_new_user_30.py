@@ -1,0 +1,65 @@
+"""What a new user tripped on with a packing made by numpy or a spreadsheet (session 30):
+numpy.savetxt's `header=` is written as a comment ("# x,y,r"), and the refusal named the first
+data line without saying why the header was not seen; a CSV saved as "UTF-8" by a spreadsheet
+starts with a byte-order mark, and its header was refused as "missing x"."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from rigidlcp.cli import main
+
+#: Three unit disks, the top one on the two others (docs/packings.md's three.csv).
+THREE = np.array([[1.0, 1.0, 1.0], [3.0, 1.0, 1.0], [2.0, 1.0 + math.sqrt(3.0), 1.0]])
+
+
+def _one_line_error(capsys, command: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"rigidlcp {command}: error: ") and "\n" not in err
+    return err
+
+
+def _forceset_json(path, capsys) -> dict:
+    assert main(["forceset", str(path), "--no-ranges", "--json", "--no-progress"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_numpy_savetxt_header_is_named_as_a_comment(tmp_path, capsys):
+    """np.savetxt(..., header="x,y,r") writes "# x,y,r": refused (a comment is not the header:
+    the CSV format is unchanged), with one line saying that line 1 names the columns but is a
+    comment, and how numpy writes it without the '#'."""
+    path = tmp_path / "np.csv"
+    np.savetxt(path, THREE, delimiter=",", header="x,y,r")
+    assert path.read_text().startswith("# x,y,r")
+    assert main(["forceset", str(path), "--no-ranges"]) == 2
+    err = _one_line_error(capsys, "forceset")
+    assert "line 1 names them but is a comment" in err and "comments=''" in err
+    # as the message says: the same data with comments="" is read
+    good = tmp_path / "np_ok.csv"
+    np.savetxt(good, THREE, delimiter=",", header="x,y,r", comments="")
+    out = _forceset_json(good, capsys)
+    assert out["exists"] is True and out["c"] == 7  # 2 plane, 2 walls (tight box), 3 pairs
+
+
+def test_a_byte_order_mark_is_not_part_of_the_header(tmp_path, capsys):
+    """A spreadsheet's "CSV UTF-8" starts with U+FEFF: the file reads as the same file
+    without it (same disks, contacts and answer)."""
+    text = "x,y,r\n" + "".join(f"{x!r},{y!r},{r!r}\n" for x, y, r in THREE.tolist())
+    plain, marked = tmp_path / "plain.csv", tmp_path / "bom.csv"
+    plain.write_text(text, encoding="utf-8")
+    marked.write_text(text, encoding="utf-8-sig")
+    assert marked.read_bytes()[:3] == b"\xef\xbb\xbf"
+    assert _forceset_json(marked, capsys) == _forceset_json(plain, capsys)
+
+
+def test_pandas_to_csv_with_its_index_column_is_read(tmp_path, capsys):
+    """pandas' `df.to_csv(path)` writes an unnamed index column first (",x,y,r"): other
+    columns are ignored, so the file is the packing (written here as pandas writes it)."""
+    path = tmp_path / "pd.csv"
+    path.write_text(",x,y,r\n" + "".join(f"{k},{x!r},{y!r},{r!r}\n"
+                                          for k, (x, y, r) in enumerate(THREE.tolist())))
+    out = _forceset_json(path, capsys)
+    assert out["p"] == 3 and out["c"] == 7 and out["exists"] is True
