@@ -63,3 +63,22 @@ def test_pandas_to_csv_with_its_index_column_is_read(tmp_path, capsys):
                                           for k, (x, y, r) in enumerate(THREE.tolist())))
     out = _forceset_json(path, capsys)
     assert out["p"] == 3 and out["c"] == 7 and out["exists"] is True
+
+
+def test_bench_problems_names_what_a_folder_problem_is_called(tmp_path, capsys):
+    """A folder's problems are named FOLDER/FILE: `--problems p0` (the file's stem, as a user
+    types it after `ls`) was refused without a name to use; now the message offers it, and
+    nothing is written."""
+    from rigidlcp import lcp
+
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    for k in range(2):
+        lcp.LCP(np.eye(2) * (k + 1), np.array([-1.0, 1.0])).save(folder / f"p{k}.npz")
+    out = tmp_path / "out"
+    argv = ["bench", "--set", str(folder), "--methods", "lemke", "--out", str(out)]
+    assert main(argv + ["--problems", "p0.npz"]) == 2
+    assert _one_line_error(capsys, "bench").endswith("(did you mean mine/p0?)")
+    assert main(argv + ["--problems", "zzz"]) == 2
+    assert "problems are named like mine/p0, mine/p1" in _one_line_error(capsys, "bench")
+    assert not out.exists()
