@@ -82,3 +82,20 @@ def test_bench_problems_names_what_a_folder_problem_is_called(tmp_path, capsys):
     assert main(argv + ["--problems", "zzz"]) == 2
     assert "problems are named like mine/p0, mine/p1" in _one_line_error(capsys, "bench")
     assert not out.exists()
+
+
+def test_a_contact_lost_to_rounding_is_named_as_a_near_miss(tmp_path, capsys):
+    """Coordinates written with 6 decimals (numpy's fmt="%.6f"): the top disk's height
+    2.732051 for 1 + sqrt(3) leaves it 1.7e-7 above its supports, a rattler, and forceset proves
+    that such a pile has no equilibrium, which read like physics; the packing line now names
+    the near miss and the --gap-tol that makes it a contact, and that tolerance does."""
+    path = tmp_path / "rounded.csv"
+    np.savetxt(path, THREE, delimiter=",", header="x,y,r", comments="", fmt="%.6f")
+    assert main(["forceset", str(path), "--no-ranges", "--no-progress"]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "1 rattler(s)" in first and "near miss(es) of these: disk 2 is 1.7e-07 x radius" in first
+    tol = first.split("--gap-tol ")[1].split()[0]
+    assert main(["forceset", str(path), "--no-ranges", "--json", "--no-progress",
+                 "--gap-tol", tol]) == 0
+    fixed = json.loads(capsys.readouterr().out)
+    assert fixed["c"] == 7 and fixed["exists"] is True and fixed["packing"]["rattlers"] == []
