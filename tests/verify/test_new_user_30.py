@@ -70,3 +70,14 @@ def test_event_ranges_takes_the_event_problem_not_its_lcp(one_disk):
         verify.event_ranges(ep, sol, time_limit=-1)
     r = verify.event_ranges(ep, sol, time_limit=10)
     assert r is not None
+
+
+def test_certify_without_a_solution_says_so():
+    """`verify.certify(problem, None)` (a forgotten solve) said "the solution has 1 entries,
+    the problem 2 pairs"."""
+    import numpy as np
+
+    problem = lcp.LCP(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]))
+    with pytest.raises(InvalidInput, match="certify needs a solution.*got None"):
+        verify.certify(problem, None)
+    assert verify.certify(problem, lcp.solve(problem)).accepted
