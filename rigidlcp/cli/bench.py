@@ -40,7 +40,7 @@ def register(sub) -> None:
                    help="seconds per solve; a longer solve is killed and fails (default 10)")
     p.add_argument("--tol", type=float, default=1e-8,
                    help="certification tolerance on the scaled residual (default 1e-8)")
-    p.add_argument("--seed", type=seed, default=0, help="seed of the generated sets")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the generated sets (default 0)")
     p.add_argument("--sizes", default=None, metavar="N[,N]",
                    help="sizes n for the generated sets (default: each set's own)")
     p.add_argument("--per-size", type=int, default=None, help="problems per size")

@@ -7,8 +7,10 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
+import pytest
 
 from rigidlcp.cli import main
 
@@ -99,3 +101,12 @@ def test_a_contact_lost_to_rounding_is_named_as_a_near_miss(tmp_path, capsys):
                  "--gap-tol", tol]) == 0
     fixed = json.loads(capsys.readouterr().out)
     assert fixed["c"] == 7 and fixed["exists"] is True and fixed["packing"]["rattlers"] == []
+
+
+@pytest.mark.parametrize("command", ["pack", "bench", "forces"])
+def test_seed_help_states_its_default(command, capsys):
+    """`rigidlcp pack --n 10 --out a.csv` silently used seed 0: --help now says so."""
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert re.search(r"--seed SEED [^-]*\(default 0\)", text)
