@@ -110,3 +110,19 @@ def test_seed_help_states_its_default(command, capsys):
         main([command, "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert re.search(r"--seed SEED [^-]*\(default 0\)", text)
+
+
+@pytest.mark.parametrize("command, given", [("simulate", ["--lattice", "rect"]),
+                                            ("timestep", ["--ly", "4"]),
+                                            ("nullspace", ["--lx", "4"])])
+def test_packing_refuses_array_options_given_at_their_default(command, given, tmp_path,
+                                                              capsys):
+    """`--packing FILE --lattice rect` was taken (rect being the default) and --lattice
+    ignored, while another value was refused: an option given is now refused whatever its
+    value (docs/usage.md: "given with them it is refused")."""
+    path = tmp_path / "three.csv"
+    np.savetxt(path, THREE, delimiter=",", header="x,y,r", comments="")
+    assert main([command, "--packing", str(path), *given, "--out" if command != "nullspace"
+                 else "--json", *([str(tmp_path / "run.npz")] if command != "nullspace"
+                                  else [])]) == 2
+    assert "give one or the other" in _one_line_error(capsys, command)
