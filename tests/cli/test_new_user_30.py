@@ -126,3 +126,14 @@ def test_packing_refuses_array_options_given_at_their_default(command, given, tm
                  else "--json", *([str(tmp_path / "run.npz")] if command != "nullspace"
                                   else [])]) == 2
     assert "give one or the other" in _one_line_error(capsys, command)
+
+
+@pytest.mark.parametrize("command", ["solve", "certify"])
+def test_a_packing_given_to_solve_is_named_as_one(command, tmp_path, capsys):
+    """`rigidlcp solve pile.csv` said only that no Siconos header fits."""
+    path = tmp_path / "pile.csv"
+    np.savetxt(path, THREE, delimiter=",", header="x,y,r", comments="")
+    assert main([command, str(path)]) == 2
+    err = _one_line_error(capsys, command)
+    assert "no Siconos header fits" in err and "looks like a packing of disks" in err
+    assert "rigidlcp forceset FILE" in err
