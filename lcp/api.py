@@ -20,14 +20,31 @@ import rigidlcp.lcp.registry as registry
 
 from .acceptance.residual import TOL
 from .acceptance.trust import Run, call_method, solve_checked
-from .errors import NotASolution
+from .errors import InvalidInput, NotASolution
 from .problems.problem import LCP, MLCP, InvalidProblem, NotApplicable
 from .problems.solution import Solution
-from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup, register
+from .registry import ACCEPTS, MethodInfo, check_options, did_you_mean, lookup
 from .solvers import BUILTIN as _BUILTIN
 
 __all__ = ["solve", "get_method", "methods", "register", "MethodInfo", "ACCEPTS",
            "check_options"]
+
+
+def register(name: str, *, accepts: str, description: str, replace: bool = False, **kw):
+    """Decorator adding a method of one's own to the table (`lcp.registry.register`: `max_n`,
+    `native`, `equilibrate` as there). A built-in method's name is refused (InvalidInput)
+    unless `replace=True`: such a registration used to replace the built-in silently when it
+    was loaded, and to be replaced by it silently when it was not (the built-ins load on first
+    use), so that "my lemke" was either rigidlcp's or everyone's. With `replace=True` the
+    built-in is loaded first, so the replacement stays. Registering one's own name again
+    replaces the earlier registration (a notebook cell run twice)."""
+    if name in _BUILTIN:
+        if not replace:
+            raise InvalidInput(f"{name!r} is one of rigidlcp's methods: register yours under "
+                               f"another name (e.g. 'my-{name}'), or pass replace=True to "
+                               "replace rigidlcp's in this process")
+        get_method(name)
+    return registry.register(name, accepts=accepts, description=description, **kw)
 
 
 def methods() -> list[MethodInfo]:

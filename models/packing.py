@@ -14,12 +14,14 @@ Normals point from i to j; of two disks
 i is the lower one (the left one at equal heights), as in the arrays.
 
 `report(lattice)`: rattlers (disks with fewer than two contacts, obstacles counted) and the
-clusters of the contact graph of the disks, those touching no obstacle marked as floating.
+clusters of the contact graph of the disks, those touching no obstacle marked as floating, and
+the near misses of those disks (a gap beyond gap_tol but within NEAR_GAP of the radius).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.sparse import coo_matrix
@@ -34,6 +36,9 @@ GAP_TOL = 1e-9
 #: DEM packing's contacts, say) are read as contacts of rigid disks; beyond that two disks
 #: interpenetrate and the packing is not one of touching rigid disks (the paper's model).
 MAX_GAP_TOL = 0.05
+#: A rattler's or floating disk's gap up to this fraction of the radius is named by `report`
+#: as a near miss (a contact lost to rounded coordinates, most likely).
+NEAR_GAP = 1e-3
 
 
 class Overlap(InvalidSystem):
@@ -168,6 +173,8 @@ class PackingReport:
     rattlers: list[int]
     clusters: list[list[int]]
     floating: list[int]  # indices into clusters
+    #: (i, j, gap / smaller radius) of rattlers' and floating disks' near misses (_near_misses)
+    near: list[tuple[int, int, float]] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"rattlers": self.rattlers, "clusters": len(self.clusters),
@@ -179,6 +186,14 @@ class PackingReport:
                f"{len(self.clusters)} cluster(s)")
         if self.floating:
             out += f", {len(self.floating)} touching no wall or plane"
+        if self.near:
+            i, j, g = self.near[0]
+            other = {PLANE: "the plane", LEFT_WALL: "the left wall",
+                     RIGHT_WALL: "the right wall"}.get(j, f"disk {j}")
+            e = 10.0 ** (math.floor(math.log10(g)) - 1)  # g rounded up to 2 digits
+            out += (f"; {len(self.near)} near miss(es) of these: disk {i} is {g:.2g} x radius "
+                    f"from {other}, beyond the gap tolerance (rounded coordinates? --gap-tol "
+                    f"{math.ceil(g * (1 + 1e-9) / e) * e:.2g} makes it a contact)")
         return out
 
 
@@ -195,7 +210,35 @@ def report(lattice: Lattice) -> PackingReport:
     order = sorted(range(labels.max() + 1), key=lambda k: (-int(np.sum(labels == k)), k))
     clusters = [np.flatnonzero(labels == k).tolist() for k in order]
     floating = [n for n, k in enumerate(order) if not grounded[k]]
-    return PackingReport(np.flatnonzero(degree < 2).tolist(), clusters, floating)
+    rattlers = np.flatnonzero(degree < 2).tolist()
+    loose = sorted(set(rattlers).union(*(clusters[n] for n in floating)))
+    return PackingReport(rattlers, clusters, floating, _near_misses(lattice, loose))
+
+
+def _near_misses(lattice: Lattice, disks: list[int]) -> list[tuple[int, int, float]]:
+    """(i, j, g / s) of the near misses of `disks` (rattlers, floating clusters): gaps g > 0
+    beyond the contact tolerance but within NEAR_GAP s (s the smaller radius; j a disk or an
+    obstacle code), closest first. A coordinate rounded to a few digits turns a contact into
+    such a gap: the disk then looks like a rattler, and the pile may have no equilibrium."""
+    if not disks or lattice.radii is None:
+        return []
+    x, r, tol = lattice.x, lattice.radii, lattice.gap_tol
+    out = []
+    sides = [(PLANE, x[:, 1] - r)]
+    if lattice.left is not None:
+        sides.append((LEFT_WALL, x[:, 0] - r - lattice.left))
+    if lattice.right is not None:
+        sides.append((RIGHT_WALL, lattice.right - x[:, 0] - r))
+    for k in disks:
+        for code, gap in sides:
+            if tol * r[k] < gap[k] <= NEAR_GAP * r[k]:
+                out.append((k, code, float(gap[k] / r[k])))
+        d = np.hypot(*(x - x[k]).T) - r - r[k]
+        s = np.minimum(r, r[k])
+        for j in np.flatnonzero((d > tol * s) & (d <= NEAR_GAP * s)):
+            if j != k:
+                out.append((k, int(j), float(d[j] / s[j])))
+    return sorted(out, key=lambda m: m[2])
 
 
 #: The name under which `rigidlcp.models` exports `packing` (the submodule owns the bare name).

@@ -84,7 +84,7 @@ def read_disks(path: str | os.PathLike) -> Disks:
     if path.suffix == ".npz":
         return _read_npz(path)
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8-sig")  # a spreadsheet's byte-order mark dropped
     except UnicodeDecodeError:
         raise InvalidFile(f"{path} is not a packing file (not text, not .npz)") from None
     lines = text.splitlines()
@@ -144,7 +144,7 @@ def _read_csv(path: Path, lines: list[str]) -> Disks:
             if missing:
                 raise InvalidFile(f"{path} line {k}: the header must name the columns x, y, r "
                                   f"(missing {', '.join(missing)}; got {line[:60]!r})"
-                                  + _header_hint(line, header, missing))
+                                  + _header_hint(line, header, missing, lines[:k - 1]))
             dup = [c for c in set(header) if header.count(c) > 1 and c]
             if dup:
                 raise InvalidFile(f"{path} line {k}: column {dup[0]!r} named twice")
@@ -161,15 +161,22 @@ def _read_csv(path: Path, lines: list[str]) -> Disks:
     return _finish(path, cols, **box)
 
 
-def _header_hint(line: str, header: list[str], missing: list[str]) -> str:
-    """What is most likely wrong with a CSV header that lacks `missing`: whitespace instead of
-    commas, names in another case, or a radius column named otherwise."""
+def _header_hint(line: str, header: list[str], missing: list[str],
+                 before: list[str] = ()) -> str:
+    """What is most likely wrong with a CSV header that lacks `missing`: the header written as
+    a comment (numpy.savetxt's `header=` is written after '# ' unless `comments=''`), whitespace
+    instead of commas, names in another case, or a radius column named otherwise."""
+    for k, raw in enumerate(before, start=1):
+        names = [f.strip() for f in raw.strip().lstrip("#").split(",")]
+        if raw.strip().startswith("#") and all(c in names for c in REQUIRED):
+            return (f": line {k} names them but is a comment (it starts with '#'): remove the "
+                    "'#' (numpy.savetxt writes its header= so unless given comments='')")
     if len(header) == 1 and len(line.split()) > 1:
         return ": fields are separated by commas, this line by spaces or tabs"
     lower = {h.lower(): h for h in header}
     if all(c in lower for c in missing):
         return (": names are case-sensitive, got " + ", ".join(repr(lower[c]) for c in missing))
-    if "r" in missing and ("radius" in lower or "diameter" in lower):
+    if "r" in missing and ("radius" in lower or "diameter" in lower or "d" in lower):
         return (": name the radius column r" if "radius" in lower else
                 ": give the radius as a column r (half the diameter)")
     return ""

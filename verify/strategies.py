@@ -308,11 +308,25 @@ def systems(draw, lattice=None, mu: st.SearchStrategy[float] | None = None,
                          gamma=draw(gamma), V0=draw(_unit(-1.0, 1.0)))
 
 
+def _system(system, name: str):
+    """`system` when it is a models.System; InvalidInput otherwise, saying how to draw one
+    first when it is a strategy (``event_states(systems())`` is the natural first try)."""
+    from rigidlcp import models
+
+    if isinstance(system, st.SearchStrategy):
+        raise InvalidInput(f"{name} takes a models.System, not a strategy: draw the system "
+                           f"first, e.g. systems().flatmap(lambda s: {name}(s).map("
+                           "lambda x: (s, x)))")
+    if not isinstance(system, models.System):
+        raise InvalidInput(f"{name} takes a models.System, got {type(system).__name__}")
+    return system
+
+
 @st.composite
 def contact_states(draw, system):
     """(normal, tangential) for ``models.contact_matrix``: normal[alpha] True (T) / False (NT),
     tangential[alpha] in {0 (NS), +1, -1 (sliding)}."""
-    c = system.c
+    c = _system(system, "contact_states").c
     normal = draw(arrays(bool, c))
     tangential = draw(arrays(np.int64, c, elements=st.sampled_from([0, 1, -1])))
     return normal, tangential
@@ -325,7 +339,7 @@ def event_states(draw, system, candidates: st.SearchStrategy[float] | None = Non
     default in [0, 1]); frictionless contacts carry 0."""
     from rigidlcp import models
 
-    p, c = system.p, system.c
+    p, c = _system(system, "event_states").p, system.c
     omega = _vector(draw, p)
     frac = draw(_unit(0.0, 1.0) if candidates is None else _strategy(candidates, "candidates"))
     stick = draw(arrays(np.float64, c, elements=_unit(0.0, 1.0))) < frac

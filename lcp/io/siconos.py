@@ -117,17 +117,32 @@ def siconos_kind(tok: Tokens) -> str | None:
     return best
 
 
+def _packing_hint(text: str) -> str:
+    """A hint for a packing file of disks given where a problem is expected (a CSV whose
+    header names x, y, r, or a LAMMPS dump): `rigidlcp solve pile.csv` said only that no
+    Siconos header fits."""
+    lines = [s.strip() for s in text.lstrip("\ufeff").splitlines() if s.strip()]
+    first = next((s for s in lines if not s.startswith("#")), "")
+    names = {f.strip() for f in first.split(",")}
+    if {"x", "y", "r"} <= names or (lines and lines[0] == "ITEM: TIMESTEP"):
+        return ("; this looks like a packing of disks (docs/packings.md): `rigidlcp forceset FILE` "
+                "analyses it at rest, `rigidlcp simulate --packing FILE` runs it")
+    return ""
+
+
 def read_siconos(path: str | os.PathLike) -> LCP | MLCP:
     """Read any Siconos text problem file: LCP, MLCP or 2D friction contact (the kind is
     detected from the header; see `siconos_kind`). Returns an lcp.LCP, lcp.MLCP or
     lcp.FrictionContact2D."""
     path = Path(path)
-    tok = Tokens(path.read_text(errors="replace"), str(path))
+    text = path.read_text(errors="replace")
+    tok = Tokens(text, str(path))
     kind = siconos_kind(tok)
     if kind is None:
         raise FileFormatError(str(path), 1, "no Siconos header fits: expected an LCP "
                               "(n, storage, n, n), an MLCP (0|1, 0|1, n, m, ...) or a friction-"
-                              "contact problem (2, contacts, storage, 2 contacts, 2 contacts)")
+                              "contact problem (2, contacts, storage, 2 contacts, 2 contacts)"
+                              + _packing_hint(text))
     if kind == "fc3d":
         raise WrongKind(str(path), 1, "a 3D friction-contact problem: rigidlcp reads 2D ones")
     tok.pos = 0

@@ -312,7 +312,7 @@ def run_bench(
                     if progress is not None:
                         progress(r)
     finally:
-        local.close()
+        local.close(wait=5.0)
         if warmups is not None:
             for runner in (local, siconos):
                 for m, ts in getattr(runner, "warmups", {}).items():

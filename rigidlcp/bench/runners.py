@@ -234,8 +234,15 @@ class LocalRunner:
                 self._ask(list(problems), method, time_limit * len(problems) + self.grace))
         return raws if isinstance(raws, list) else None  # an error, a timeout, a dead worker
 
-    def close(self) -> None:
+    def close(self, wait: float = 0.0) -> None:
+        """Stop the worker: killed at once (a timeout), or, with `wait` > 0 (the end of a run),
+        asked to exit by closing its pipe and killed only after `wait` seconds, so that its
+        exit handlers run (a peer's semaphores, e.g. numba's under QuantEcon, were left to
+        the resource tracker, which warned of "leaked semaphore objects" at shutdown)."""
         if self.proc is not None:
+            if wait > 0 and self.proc.is_alive():
+                self.conn.close()
+                self.proc.join(timeout=wait)
             if self.proc.is_alive():
                 self.proc.kill()
             self.proc.join(timeout=10)

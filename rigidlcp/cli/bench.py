@@ -40,7 +40,7 @@ def register(sub) -> None:
                    help="seconds per solve; a longer solve is killed and fails (default 10)")
     p.add_argument("--tol", type=float, default=1e-8,
                    help="certification tolerance on the scaled residual (default 1e-8)")
-    p.add_argument("--seed", type=seed, default=0, help="seed of the generated sets")
+    p.add_argument("--seed", type=seed, default=0, help="seed of the generated sets (default 0)")
     p.add_argument("--sizes", default=None, metavar="N[,N]",
                    help="sizes n for the generated sets (default: each set's own)")
     p.add_argument("--per-size", type=int, default=None, help="problems per size")
@@ -170,7 +170,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
             notes.append("peers (rigidlcp.bench.peers) run in the same worker as rigidlcp's "
                          "methods, timed as the whole call from Python on M and q; "
                          "their 'solved' is a claim, judged by the same check")
-        sets, set_info, specs_by_name = {}, {}, {}
+        sets, set_info, specs_by_name, names = {}, {}, {}, []
         only = {p.strip() for p in (args.problems or "").split(",") if p.strip()}
         for spec in specs:
             kw = params if spec in SETS and not spec.startswith("events-") else {}
@@ -181,6 +181,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
                       f"{args.cache or default_cache_dir()} (about 30 s the first time)",
                       file=sys.stderr, flush=True)
             problems = get_set(spec, seed=args.seed, cache_dir=args.cache, **kw)
+            names += [p.name for p in problems]
             if only:
                 problems = [p for p in problems if p.name in only]
             name = spec if spec in SETS else os.path.basename(os.path.normpath(spec))
@@ -192,7 +193,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
             found = {p.name for ps in sets.values() for p in ps}
             if only - found:
                 raise ValueError(f"--problems: no problem named "
-                                 f"{', '.join(sorted(only - found))} in the sets")
+                                 f"{', '.join(sorted(only - found))} in the sets"
+                                 + _names_hint(sorted(only - found), names))
         csv_path = os.path.join(args.out, "results.csv")
         done: list = []
         if args.resume:
@@ -351,6 +353,17 @@ def _print_summary(results, time_limit: float) -> None:
     for r in results:
         if r.method == "-":  # an unreadable file: one row, no method ran on it
             print(f"unreadable: {r.problem}: {r.message}")
+
+
+def _names_hint(missing: list[str], names: list[str]) -> str:
+    """The problem names a --problems NAME most likely meant (a folder's problems are named
+    FOLDER/FILE, without the extension), else a few of the sets' names."""
+    near = [n for m in missing for n in names
+            if n.rsplit("/", 1)[-1] == m.rsplit("/", 1)[-1].rsplit(".", 1)[0]]
+    if near:
+        return f" (did you mean {', '.join(dict.fromkeys(near))}?)"
+    shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
+    return f"; the sets' problems are named like {shown}" if names else ""
 
 
 def _slug(name: str) -> str:

@@ -36,7 +36,8 @@ def register(sub) -> None:
 
     add_system_arguments(p)  # the system options of `rigidlcp simulate` (and its friction)
     p.set_defaults(lattice=FIG4[0], lx=FIG4[1], ly=FIG4[2], gamma=0.0)  # Fig. 4
-    p.add_argument("--seed", type=seed, default=0, help="seed of the angular velocities")
+    p.add_argument("--seed", type=seed, default=0,
+                   help="seed of the angular velocities (default 0)")
     p.add_argument("--omega-scale", type=float, default=1.0,
                    help="angular velocities uniform in [-s, s]")
     p.add_argument("--networks", type=int, default=4, help="how many networks (>= 1; "

@@ -29,6 +29,8 @@ NULLSPACE_MU = {"mu_pp": 0.3, "mu_plane": 0.3, "mu_wall": 0.3}
 
 
 def add_nullspace(sub) -> None:
+    from rigidlcp.cli.simulate import GivenArray
+
     p = sub.add_parser(
         "nullspace", help="null space of the contact matrix (Eqs. 2.15, 3.1, 3.2; Fig. 5)",
         description="SVD of the paper's contact matrix M (Eq. 2.15) for a vector of contact "
@@ -40,11 +42,12 @@ def add_nullspace(sub) -> None:
         "[\"NS\"|\"+\"|\"-\", ...]} (one entry per contact, in the lattice's order; also "
         "true/false and 0/+1/-1), or .npz with arrays 'normal' and 'tangential'. The --json "
         "output has this form. See docs/verification.md.")
-    p.add_argument("--lattice", choices=("rect", "tri"), default="rect",
+    p.add_argument("--lattice", choices=("rect", "tri"), default="rect", action=GivenArray,
                    help="rectangular or triangular array (default rect)")
-    p.add_argument("--lx", type=int, default=4,
+    p.add_argument("--lx", type=int, default=4, action=GivenArray,
                    help="disks in the rows touching both walls (default 4)")
-    p.add_argument("--ly", type=int, default=3, help="number of rows (default 3)")
+    p.add_argument("--ly", type=int, default=3, action=GivenArray,
+                   help="number of rows (default 3)")
     p.add_argument("--packing", metavar="FILE", default=None,
                    help="disks from a packing file (.csv/.npz/LAMMPS dump) or a saved run "
                    "(RUN.npz) instead of --lattice/--lx/--ly (docs/packings.md)")

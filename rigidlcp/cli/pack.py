@@ -34,7 +34,8 @@ def register(sub) -> None:
         "CSV (or .npz by suffix), the walls in a '# box:' comment.")
     p.add_argument("--n", type=int, default=None,
                    help="number of disks to deposit (required unless --array)")
-    p.add_argument("--seed", type=seed, default=0, help="seed of the radii and drop points")
+    p.add_argument("--seed", type=seed, default=0,
+                   help="seed of the radii and drop points (default 0)")
     p.add_argument("--radii", type=radii, default=(1.0, 1.0), metavar="MIN:MAX",
                    help="radii uniform in [MIN, MAX] (default 1:1, monodisperse; within "
                    "[1e-76, 1e76], where the inertia r^4 / 2 is a normal float)")

@@ -14,13 +14,13 @@ def register(sub) -> None:
         description="Runs the experiments of Sec. IV (Figs. 6-13) and Eqs. (3.3)-(3.4) at the "
         "parameters of the captions, and writes OUT/report.md: each claim of the paper, the "
         "measured number, the criterion and PASS/FAIL, with the figures as PNGs and the "
-        "claims as OUT/claims.json. About 15 min on 2 busy cores with the default executor "
-        "(docs/reproduction.md). Exit status 0 when every claim was evaluated (whatever its "
-        "verdict), 1 when an evaluation failed.")
+        "claims as OUT/claims.json. 5-27 min on 2 shared cores, by their load, with the "
+        "default executor (docs/reproduction.md). Exit status 0 when every claim was "
+        "evaluated (whatever its verdict), 1 when an evaluation failed.")
     p.add_argument("--out", required=True, help="directory of the report")
     p.add_argument("--quick", action="store_true",
-                   help="small sizes (2-5 min on 2 busy cores; for tests): every claim is "
-                   "evaluated, but the sizes are not the paper's")
+                   help="small sizes (2-6 min on 2 shared cores, by their load; for tests): "
+                   "every claim is evaluated, but the sizes are not the paper's")
     p.add_argument("--jobs", "-j", type=int, default=None,
                    help="worker processes (default: the CPUs available; 1: in this process)")
     p.add_argument("--dask", default=None, metavar="tcp://HOST:PORT|local",

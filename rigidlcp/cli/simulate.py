@@ -16,17 +16,28 @@ from rigidlcp.cli.main import seed
 ARRAY_DEFAULTS = ("rect", 10, 4)
 
 
+class GivenArray(argparse.Action):
+    """Stores --lattice / --lx / --ly and records that it was given (`args.array_given`), so
+    that --packing refuses it even at its default value (`--packing F --lattice rect` was
+    taken, as rect is the default, and --lattice ignored)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        namespace.array_given = [*getattr(namespace, "array_given", []), option_string]
+
+
 def add_system_arguments(p: argparse.ArgumentParser) -> None:
     """The options that define a system (shared with other commands)."""
     from rigidlcp.models.system import DEFAULT_MU
 
     g = p.add_argument_group("system")
     lattice, lx, ly = ARRAY_DEFAULTS
-    g.add_argument("--lattice", choices=("rect", "tri"), default=lattice,
+    g.add_argument("--lattice", choices=("rect", "tri"), default=lattice, action=GivenArray,
                    help=f"rectangular or triangular array (default {lattice})")
-    g.add_argument("--lx", type=int, default=lx,
+    g.add_argument("--lx", type=int, default=lx, action=GivenArray,
                    help=f"disks in the rows touching both walls (default {lx})")
-    g.add_argument("--ly", type=int, default=ly, help=f"number of rows (default {ly})")
+    g.add_argument("--ly", type=int, default=ly, action=GivenArray,
+                   help=f"number of rows (default {ly})")
     for name, text in (("mu_pp", "particle-particle"), ("mu_plane", "particle-plane"),
                        ("mu_wall", "particle-wall")):
         g.add_argument("--" + name.replace("_", "-"), type=float, default=DEFAULT_MU[name],
@@ -74,7 +85,7 @@ DENSE_ONLY = ("this command is dense only: use a smaller array (the event-driven
 def refuse_array_options(args, defaults: tuple = ARRAY_DEFAULTS) -> None:
     """--packing with --lattice/--lx/--ly changed from their `defaults`: refused (they would
     be silently ignored)."""
-    if (args.lattice, args.lx, args.ly) != defaults:
+    if getattr(args, "array_given", None) or (args.lattice, args.lx, args.ly) != defaults:
         raise ValueError("--packing takes its disks from the file: --lattice, --lx and "
                          "--ly describe an array, give one or the other")
 

@@ -111,7 +111,8 @@ def test_a_method_registered_as_lemke_is_seen_by_the_c_entry():
     P = lcp.LCP(np.eye(2), -np.ones(2))
     assert fast_lemke.entry(P) is not None
 
-    @api.register("lemke", accepts="any", description="test double", equilibrate=True)
+    @api.register("lemke", accepts="any", description="test double", equilibrate=True,
+                  replace=True)
     def double(M, q):
         return lcp.Solution(z=np.zeros(q.size), w=q.copy(), status="failed", method="lemke")
 

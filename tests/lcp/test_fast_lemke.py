@@ -169,7 +169,8 @@ def test_a_method_registered_as_lemke_replaces_the_fast_path():
     info = api._REGISTRY["lemke"]
     seen = []
 
-    @api.register("lemke", accepts="any", description="test double", equilibrate=True)
+    @api.register("lemke", accepts="any", description="test double", equilibrate=True,
+                  replace=True)
     def double(M, q):
         seen.append(1)
         return Solution(z=np.zeros(q.size), w=q.copy(), status="solved", method="lemke")

@@ -148,7 +148,8 @@ def test_options_fortran_order_and_no_kernel_take_the_general_path(monkeypatch):
 def test_a_method_registered_as_pivoting_replaces_the_fast_path():
     info = api._REGISTRY["pivoting"]
 
-    @api.register("pivoting", accepts="any", description="test double", equilibrate=True)
+    @api.register("pivoting", accepts="any", description="test double", equilibrate=True,
+                  replace=True)
     def double(M, q):
         return Solution(z=np.zeros(q.size), w=q.copy(), status="solved", method="pivoting")
 

@@ -142,6 +142,9 @@ def certify(
         if not (isinstance(value, (int, float, np.number)) and 0 < value <= most):
             raise InvalidInput(f"{name} must be a number > 0{' (finite)' if name == 'tol' else ''}"
                                f", got {value!r}")
+    if solution is None:  # np.asarray(None) has one entry: "the solution has 1 entries"
+        raise InvalidInput("certify needs a solution: an lcp.Solution or a vector z "
+                           "(lcp.solve(problem) gives one), got None")
     t0 = time.perf_counter()
     obs: dict[str, np.ndarray] = {}
     fc_residual, fc = None, None

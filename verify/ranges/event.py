@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.optimize import Bounds, LinearConstraint, linprog, milp
 
 from rigidlcp.lcp import Solution
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.models.event import EventProblem
 from rigidlcp.verify.certificates.bounds import no_solution_beyond
 from rigidlcp.verify.certificates.faces import FaceLP
@@ -41,6 +42,7 @@ from rigidlcp.verify.certificates.uniqueness import (
     sign_pattern,
 )
 
+from .milp import seconds
 from .observables import (
     BadObservable,
     alpha_rows,
@@ -135,6 +137,11 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
     time_limit: seconds per MILP; bound: the box U (default 1e3 z_s); prove_bound: try to
     prove that no solution lies outside the box (verify.certificates.bounds)."""
     t0 = time.perf_counter()
+    if not isinstance(ep, EventProblem):
+        raise InvalidInput(f"event_ranges takes a models.EventProblem (models.event_problem("
+                           f"system, state): its observables need the event's mechanics), got "
+                           f"{type(ep).__name__}")
+    time_limit = seconds(time_limit)
     M, q = np.asarray(ep.lcp.M, dtype=float), np.asarray(ep.lcp.q, dtype=float)
     obs = event_observables(ep, observables, over, vt)
     z_star = None
@@ -144,7 +151,7 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
             raise BadObservable(f"solution has {z_star.size} entries, the event's LCP {q.size}")
         res = independent_residual(M, q, z_star)
         if not res <= WITNESS_TOL:
-            raise ValueError(f"the given z is not a solution of the event's LCP (independent "
+            raise InvalidInput(f"the given z is not a solution of the event's LCP (independent "
                              f"residual {res:.2e})")
     zs, _ = scales(M, q, z_star if z_star is not None else np.zeros_like(q))
     U = float(bound) if bound is not None else BOUND_FACTOR * zs

@@ -23,6 +23,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.lcp.quiet import new_highs
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
@@ -50,7 +51,18 @@ def clock(name: str):
         return time.perf_counter
     if name == "cpu":
         return time.process_time
-    raise ValueError(f"clock must be 'wall' or 'cpu', got {name!r}")
+    raise InvalidInput(f"clock must be 'wall' or 'cpu', got {name!r}")
+
+
+def seconds(value, name: str = "time_limit") -> float:
+    """A time limit as a float > 0, else InvalidInput naming `name` (a NaN, 0 or negative
+    limit used to be taken and left every end at "time limit" without a search)."""
+    number = isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, bool)
+    v = float(value) if number else float("nan")
+    if not v > 0:
+        raise InvalidInput(f"{name} must be a number of seconds > 0, got {value!r}")
+    return v
 
 
 def lagrangian_bound(c: np.ndarray, A: sp.csr_matrix, lo: np.ndarray, hi: np.ndarray,

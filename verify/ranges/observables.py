@@ -53,7 +53,7 @@ def steady_observables(system: System, which: str = "all", dyn: Dynamics | None 
             e[c + a] = 1.0
             obs[f"S[{a}]"] = e
     elif which not in ("mu_g", "alpha"):
-        raise ValueError(f"which must be 'all', 'alpha' or 'mu_g', got {which!r}")
+        raise BadObservable(f"which must be 'all', 'alpha' or 'mu_g', got {which!r}")
     return obs
 
 

@@ -22,7 +22,7 @@ from rigidlcp.models.system import System
 
 from .cap_split import bound_open_ends
 from .kinematics import realizable
-from .milp import MilpModel
+from .milp import MilpModel, seconds
 from .milp import clock as milp_clock
 from .observables import steady_observables, user_observables
 from .proportional import exact as proportional_exact
@@ -178,7 +178,8 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     the disk split's seconds counted on the wall clock ("wall") or as this process's CPU
     time ("cpu": the same work whatever the machine's load; verify.ranges.milp.MilpModel).
     Raises NotSteady (none valid, run not steady)."""
-    milp_clock(clock)  # a wrong clock refused before any work (ValueError)
+    milp_clock(clock)  # a wrong clock refused before any work (InvalidInput)
+    time_limit = seconds(time_limit)
     t0 = time.perf_counter()
     system, last = _run_system(target)
     start = None
