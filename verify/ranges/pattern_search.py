@@ -36,7 +36,9 @@ though z = 0 is feasible and the LP unbounded; test_pattern_search):
 Every node ends pruned or split into two children that partition its patterns, so the pruned
 nodes partition {0, 1}^n: checked in code at the end (sum over pruned nodes of 2^free equals
 2^n, in integers). The verdicts are HiGHS's LP verdicts at each node (an LP not said optimal
-or unbounded is asked again without presolve); the values, witnesses and rays are checked.
+or unbounded is asked again without presolve, then at HiGHS's default, looser, tolerances:
+a relaxation whose verdict "infeasible" or bound holds for the tighter one); the values,
+witnesses and rays are checked.
 A search stopped by its time limit (CPU seconds) reports "time limit" with the best solution
 met (not a bound) and, when every open node's parent LP was bounded, the least of their
 bounds, which is a proved bound on the end.
@@ -82,8 +84,9 @@ class SearchStats:
 
 def _solve(c, M, q, fixz, fixw, extra_ub=None):
     """linprog of c . z over the node's relaxation {z >= 0, w >= 0, z_Z = 0, w_W = 0}
-    (extra_ub: one more row a . z <= b); status 4 ("unbounded or infeasible", numerical)
-    asked again without presolve."""
+    (extra_ub: one more row a . z <= b); an LP not said optimal or unbounded is asked again
+    without presolve, then at HiGHS's default tolerances (dual simplex, then interior
+    point)."""
     free_w = ~fixw
     A_ub, b_ub = -M[free_w], q[free_w]
     if extra_ub is not None:
@@ -95,6 +98,10 @@ def _solve(c, M, q, fixz, fixw, extra_ub=None):
     r = linprog(c, options=_LP, **kw)
     if r.status not in (0, 3):  # HiGHS's presolve has called a feasible LP infeasible
         r = linprog(c, options={**_LP, "presolve": False}, **kw)
+    for method in ("highs-ds", "highs-ipm"):  # HiGHS's status 15 "unknown" at 1e-10 (a node
+        if r.status in (0, 2, 3):  # of rect 4x2's event from rest): its default tolerances
+            break  # (1e-7), looser, so a verdict "infeasible" or a bound still holds
+        r = linprog(c, options={"presolve": False}, **{**kw, "method": method})
     return r
 
 

@@ -132,6 +132,24 @@ def test_a_presolve_infeasible_is_asked_again():
     assert hi.ray[1] == pytest.approx(hi.ray[2], abs=1e-12) and hi.ray[3] == 0.0
 
 
+def test_a_node_lp_highs_leaves_unknown_is_asked_at_its_default_tolerances():
+    """rect 4x2 from rest (gamma 0.1): the node of the min of mu_g with z = 0 on
+    {23, 30, 33, 34, 35, 43, 44, 45} and w = 0 on {0, 1, 2, 3, 9, 10, 11, 12, 22, 32} ended
+    HiGHS status 15 "unknown" at tolerances 1e-10, with and without presolve, and the search
+    said "unproved"; at HiGHS's default tolerances (1e-7, a larger set) it is infeasible,
+    so the node is empty."""
+    from rigidlcp.verify.ranges.event import event_observables
+    from rigidlcp.verify.ranges.pattern_search import _solve
+    s = models.System(models.rectangular(4, 2), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.1)
+    ep = models.event_problem(s, models.initial_state(s))
+    M, q = np.asarray(ep.lcp.M, float), np.asarray(ep.lcp.q, float)
+    fixz, fixw = np.zeros(q.size, bool), np.zeros(q.size, bool)
+    fixz[[23, 30, 33, 34, 35, 43, 44, 45]] = True
+    fixw[[0, 1, 2, 3, 9, 10, 11, 12, 22, 32]] = True
+    assert _solve(event_observables(ep)["mu_g"], M, q, fixz, fixw).status == 2
+
+
 def test_docs_example_every_pattern_range_is_proved():
     """docs/verification.md's example (rect 2x1 from rest, gamma 0.1): LCP(M, 0) has a nonzero
     solution, so the box is not proved; every end of every range is now proved without it
