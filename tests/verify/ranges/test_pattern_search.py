@@ -150,6 +150,38 @@ def test_a_node_lp_highs_leaves_unknown_is_asked_at_its_default_tolerances():
     assert _solve(event_observables(ep)["mu_g"], M, q, fixz, fixw).status == 2
 
 
+def test_a_search_stopped_by_its_time_limit_gives_no_end(monkeypatch):
+    """The docs' example's min and max of mu_g, the search's clock faked (each reading one
+    second later) so that it stops after a few nodes: "time limit", no value; the best value
+    met is attained (a checked solution) and no better than the end; a bound, where given,
+    no worse than the end (the ends: the full search, whose values test_brute_force checks
+    against every pattern)."""
+    from rigidlcp.verify.ranges import pattern_search
+    from rigidlcp.verify.ranges.event import event_observables
+    s = models.System(models.rectangular(2, 1), mu_pp=0.1, mu_plane=0.2, mu_wall=0.0,
+                      gamma=0.1)
+    ep = models.event_problem(s, models.initial_state(s))
+    M, q = np.asarray(ep.lcp.M, float), np.asarray(ep.lcp.q, float)
+    L = event_observables(ep)["mu_g"]
+    z = lcp.solve(ep.lcp).z
+    bounds = 0
+    for sense, limit in ((1, 6.5), (1, 20.5), (-1, 6.5)):
+        full, stats = extreme(M, q, L, sense, incumbent=z)
+        assert full.status == "optimal" and stats.nodes > limit
+        ticks = iter(range(10**6))
+        monkeypatch.setattr(pattern_search.time, "process_time",
+                            lambda ticks=ticks: float(next(ticks)))
+        e, stats = extreme(M, q, L, sense, incumbent=z, time_limit=limit)
+        monkeypatch.undo()
+        assert e.status == "time limit" and e.value is None and stats.nodes < limit
+        assert _is_solution(M, q, e.witness) and float(L @ e.witness) == e.best
+        assert sense * e.best >= sense * full.value - 1e-12
+        if e.bound is not None:  # min(open nodes' parent LP bounds, best): a proved bound
+            bounds += 1
+            assert sense * e.bound <= sense * full.value + 1e-12
+    assert bounds >= 1  # (sense 1 at 20 nodes: every open node's parent LP bounded)
+
+
 def test_docs_example_every_pattern_range_is_proved():
     """docs/verification.md's example (rect 2x1 from rest, gamma 0.1): LCP(M, 0) has a nonzero
     solution, so the box is not proved; every end of every range is now proved without it
