@@ -67,8 +67,9 @@ _LP = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-1
 
 @dataclass
 class SearchStats:
-    """nodes: LPs of nodes solved; pruned: nodes pruned (infeasible / by the bound / at a
-    solution); covered: the patterns the pruned nodes hold (2^n when the search finished)."""
+    """nodes: LPs of nodes solved; infeasible, bound, solutions: nodes pruned empty, by the
+    bound, at a solution; covered: the patterns the pruned nodes hold (2^n when the search
+    finished; set to 2^n when a checked ray ends it, whatever the other patterns hold)."""
 
     nodes: int = 0
     infeasible: int = 0
