@@ -9,8 +9,13 @@ P_y = {z >= 0 : z_i = 0 (y_i = 0), w_i = 0 (y_i = 1), w >= 0}. For an observable
 * over every pattern: a MILP (scipy.optimize.milp, HiGHS) in 0 <= z <= U with binaries y,
   z_i <= U y_i, w_i <= w_max,i (1 - y_i), w_max,i = max(0, q_i + U sum_j max(M_ij, 0)): exact
   consequences of the box. The box is *proved* to hold every solution when
-  verify.certificates.bounds.no_solution_beyond shows that no solution has |z|_1 >= U; else
-  the range is "within the box" (said in its scope).
+  verify.certificates.bounds.no_solution_beyond shows that no solution has |z|_1 >= U. When it
+  does not (LCP(M, 0) has a nonzero solution: the set may be unbounded, and the MILP's box is
+  an assumption), each end is proved without a box by verify.ranges.pattern_search (branch
+  and bound over the patterns, an LP per node; the MILP's witness its first bound): "optimal"
+  over every solution, "unbounded" with a ray of a nonempty piece checked at two t, or
+  "time limit" / "unproved" with the reason (the best value met is then not a bound); the
+  scope says which.
 
 Each end: the MILP's pattern is fixed and the extreme recomputed by an LP on P_y without the
 box (the witness, never the MILP's own point), re-checked by the independent residual of
@@ -50,6 +55,7 @@ from .observables import (
     mu_g_vector,
     user_observables,
 )
+from .pattern_search import check_ray, extreme
 from .result import INFEASIBLE, OPTIMAL, TIME_LIMIT, UNBOUNDED, End, Range
 
 #: A witness is accepted when its independent residual is at most this.
@@ -62,8 +68,11 @@ _LP = {"primal_feasibility_tolerance": 1e-10, "dual_feasibility_tolerance": 1e-1
 @dataclass
 class EventRanges:
     """face[name]: the range over the given solution's face (None without a solution);
-    every[name]: over every solution (scope says whether the box is proved); selected: the
-    given solution's values; U, bound_proved: the box of the MILP and its proof."""
+    every[name]: over every solution (scope says whether the box is proved, or the ends by the
+    pattern search without it); selected: the given solution's values; U, bound_proved: the box
+    of the MILP and its proof; searched: whether the ends were (also) sought by
+    verify.ranges.pattern_search, the box not being proved; proved: every end of every[...]
+    proved (optimal, unbounded or infeasible, by the proved box or by the search)."""
 
     every: dict[str, Range]
     face: dict[str, Range | None]
@@ -73,6 +82,13 @@ class EventRanges:
     bound_message: str
     seconds: float
     notes: list[str] = field(default_factory=list)
+    searched: bool = False
+
+    @property
+    def proved(self) -> bool:
+        return (self.bound_proved or self.searched) and all(
+            e.status in (OPTIMAL, UNBOUNDED, INFEASIBLE)
+            for r in self.every.values() for e in (r.lo, r.hi))
 
     def __repr__(self) -> str:
         def cell(e: End | None) -> str:
@@ -83,6 +99,9 @@ class EventRanges:
         head = (f"EventRanges: box |z| <= {self.U:.3g} "
                 f"{'(proved: no solution beyond)' if self.bound_proved else '(NOT proved)'}, "
                 f"{self.seconds:.2f} s")
+        if self.searched:
+            head += ("; every end proved without the box (pattern search)" if self.proved
+                     else "; NOT every end proved (pattern search: see each end)")
         lines = [head, f"{'observable':<14} {'face min':>14} {'face max':>14} {'all min':>14} "
                        f"{'all max':>14} {'selected':>12}  other states at"]
         for name, r in self.every.items():
@@ -134,8 +153,9 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
     """Ranges of the observables (see `event_observables`) over every solution of the
     event's LCP, and over the face of `solution` (an lcp.Solution or z) when given.
 
-    time_limit: seconds per MILP; bound: the box U (default 1e3 z_s); prove_bound: try to
-    prove that no solution lies outside the box (verify.certificates.bounds)."""
+    time_limit: seconds per MILP, and CPU seconds per end of the pattern search (run when
+    the box is not proved); bound: the box U (default 1e3 z_s); prove_bound: try to prove that
+    no solution lies outside the box (verify.certificates.bounds)."""
     t0 = time.perf_counter()
     if not isinstance(ep, EventProblem):
         raise InvalidInput(f"event_ranges takes a models.EventProblem (models.event_problem("
@@ -168,13 +188,49 @@ def event_ranges(ep: EventProblem, solution=None, observables=None, *, over: str
     for name, L in obs.items():
         every[name] = Range(name, _milp_end(M, q, L, +1, U, time_limit, pat_star),
                             _milp_end(M, q, L, -1, U, time_limit, pat_star), scope)
+        if not proved:
+            every[name] = _searched(M, q, L, every[name], U, message, time_limit, pat_star)
         face[name] = None
         if z_star is not None:
             selected[name] = every[name].selected = float(L @ z_star)
             face[name] = Range(name, _face_end(M, q, face_lps, L, +1),
                                _face_end(M, q, face_lps, L, -1), "the face of the solution",
                                selected[name])
-    return EventRanges(every, face, selected, U, proved, message, time.perf_counter() - t0)
+    return EventRanges(every, face, selected, U, proved, message, time.perf_counter() - t0,
+                       searched=not proved)
+
+
+def _searched(M, q, L, box: Range, U, message, time_limit, pat_star) -> Range:
+    """The MILP's in-box ends replaced by the pattern search's (verify.ranges.pattern_search),
+    proved without the box: an in-box "unbounded" whose ray passes check_ray (two t) is kept,
+    an in-box witness is the search's first bound."""
+    ends = []
+    for sense, e in ((+1, box.lo), (-1, box.hi)):
+        if (e.status == UNBOUNDED and e.ray is not None
+                and check_ray(M, q, np.asarray(e.witness), e.ray)[2] <= WITNESS_TOL):
+            ends.append(e)
+            continue
+        z0 = e.witness if e.status in (OPTIMAL, TIME_LIMIT) else None
+        end, _ = extreme(M, q, L, sense, incumbent=z0, time_limit=time_limit)
+        ends.append(_states_note(M, q, end, pat_star))
+    open_ = [side for side, e in zip(("min", "max"), ends)
+             if e.status not in (OPTIMAL, UNBOUNDED, INFEASIBLE)]
+    why = message.removeprefix("no bound proved: ")
+    scope = (f"every solution (proved without a box by the pattern search; the box z <= "
+             f"{U:.3g} has no bound proved: {why})" if not open_ else
+             f"every solution, NOT proved at the {' and '.join(open_)} (pattern search: "
+             f"{', '.join(e.status for e in ends)}; the box z <= {U:.3g} has no bound "
+             f"proved: {why})")
+    return Range(box.name, ends[0], ends[1], scope)
+
+
+def _states_note(M, q, end: End, pat_star) -> End:
+    """end.note told whether its witness has the given solution's contact states."""
+    if end.witness is not None and pat_star is not None:
+        same = np.array_equal(_pattern(M, q, np.asarray(end.witness)) == 1, pat_star == 1)
+        end.note = (end.note + "; " if end.note else "") + (
+            "same contact states as the solution" if same else "other contact states")
+    return end
 
 
 def _pattern(M, q, z) -> np.ndarray:
@@ -288,8 +344,4 @@ def _milp_end(M, q, L, sense, U, time_limit, pat_star) -> End:
     end.seconds = time.perf_counter() - t0
     if out.status == 1 and end.status == OPTIMAL:
         end.status, end.best, end.value = TIME_LIMIT, end.value, None
-    if end.witness is not None and pat_star is not None:
-        same = np.array_equal(_pattern(M, q, np.asarray(end.witness)) == 1, pat_star == 1)
-        end.note = (end.note + "; " if end.note else "") + (
-            "same contact states as the solution" if same else "other contact states")
-    return end
+    return _states_note(M, q, end, pat_star)

@@ -3,9 +3,11 @@
 An End's status is "optimal" (the value is the exact extreme over the set searched, attained by
 its witness), "unbounded" (a ray along which the observable grows without end, checked),
 "time limit" (HiGHS stopped before proving optimality: the value, if any, is only the best
-point met, *not* a bound) or "infeasible" (the set is empty). `scope` says over what the
-extreme was taken ("all valid steady states", "the face of the given solution", "every
-solution of the event", "... with R <= U" when a force bound is not proved).
+point met, *not* a bound), "unproved" (a check failed before the end was proved: the note
+says which; the best value met, if any, is not a bound) or "infeasible" (the set is empty).
+`scope` says over what the extreme was taken ("all valid steady states", "the face of the
+given solution", "every solution of the event", "... with R <= U" when a force bound is not
+proved).
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ if TYPE_CHECKING:
     from rigidlcp.models.system import System
 
 OPTIMAL, UNBOUNDED, TIME_LIMIT, INFEASIBLE = "optimal", "unbounded", "time limit", "infeasible"
+#: An end a check could not prove (the note says why); its best value met is not a bound.
+UNPROVED = "unproved"
 
 
 @dataclass
@@ -52,6 +56,8 @@ class End:
             best = "" if self.best is None else f", best met {self.best:.10g} (not a bound)"
             proved = "" if self.bound is None else f", proved bound {self.bound:.10g}"
             return f"time limit{best}{proved}"
+        if self.status == UNPROVED and self.best is not None:
+            return f"unproved, best met {self.best:.10g} (not a bound)"
         return self.status
 
 

@@ -83,6 +83,7 @@ def test_event_ranges_equal_enumeration(gamma, seed):
     assert ep.lcp.n <= 11
     sol = lcp.solve(ep.lcp)
     res = event_ranges(ep, sol, time_limit=20)
+    assert res.proved  # by the proved box, or by the pattern search without it
     M, q = np.asarray(ep.lcp.M, float), np.asarray(ep.lcp.q, float)
     obs = event_observables(ep)
     names = ("mu_g", "alpha[0]", "alpha[1]")
