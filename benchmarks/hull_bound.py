@@ -305,6 +305,15 @@ class HullCases(_Cases):
         _load(self.h, self.hs, self.cost, self.A, self.lo0, self.hi0, self.lb, self.ub)
         self.cur_lo, self.cur_hi = self.lo0.copy(), self.hi0.copy()
         self.pw_row = np.asarray(self.A[self.r_pw].todense()).ravel()
+        # the power row's entries stored for every column it may use (x and z: explicit
+        # zeros kept), so that a case changes them in place
+        A = self.A.tolil()
+        A[self.r_pw, :nb] = 1.0
+        A = A.tocsr()
+        lo_, hi_ = A.indptr[self.r_pw], A.indptr[self.r_pw + 1]
+        self.pw_cols = A.indices[lo_:hi_]
+        A.data[lo_:hi_] = self.pw_row[self.pw_cols]
+        self.A, self.pw_slice = A, slice(lo_, hi_)
 
     def solve_with(self, disks: np.ndarray, lo: np.ndarray, hi: np.ndarray
                    ) -> tuple[float, np.ndarray | None]:
@@ -315,9 +324,10 @@ class HullCases(_Cases):
         if changed.size:
             for j in changed:
                 h.changeCoeff(self.r_pw, int(j), float(row[j]))
-            A = self.A.tolil()
-            A[self.r_pw] = row
-            self.A, self.pw_row = A.tocsr(), row
+            if not np.all(np.isin(changed, self.pw_cols)):
+                raise AssertionError("the power row left its stored pattern")
+            self.A.data[self.pw_slice] = row[self.pw_cols]
+            self.pw_row = row
         for i in np.flatnonzero((lo != self.cur_lo) | (hi != self.cur_hi)):
             h.changeRowBounds(int(i), float(lo[i]), float(hi[i]))
         self.cur_lo, self.cur_hi = lo, hi
