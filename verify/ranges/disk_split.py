@@ -309,20 +309,22 @@ class _Cases:
 
 
 def disk_split_bound(form: Formulation, cost: np.ndarray, target: float, time_limit: float,
-                     tol: float = 1e-9, max_cases: int | None = None, clock_name: str = "wall"
-                     ) -> DiskSplitBound | None:
+                     tol: float = 1e-9, max_cases: int | None = None, clock_name: str = "wall",
+                     cases_class=None) -> DiskSplitBound | None:
     """A proved lower bound of cost . x (x = [R; S]) over every valid steady state (module
     docstring), splitting until every case is bounded at >= target - tol, the time limit or
     max_cases; None where it does not apply (no proved force box for cost, no rotation cap,
     T_u not of the form it needs). clock_name: the time limit in "wall" or "cpu" seconds
-    (verify.ranges.milp.clock); `seconds` is wall time either way."""
+    (verify.ranges.milp.clock); `seconds` is wall time either way. cases_class: the case LP
+    (default `_Cases`; a subclass may add rows valid on every valid steady state, as
+    benchmarks/hull_bound.py does)."""
     now = clock(clock_name)
     t0, c0 = time.perf_counter(), now()
     system, dyn = form.system, form.dyn
     M = rotation_cap(system, dyn)
     if M is None or M <= 0 or form.R_hi is None or not form.proved_for(cost):
         return None
-    cases = _Cases(form, cost, M)
+    cases = (cases_class or _Cases)(form, cost, M)
     goal = target - tol * max(1.0, abs(target))
     heap: list = []
     tick, n_cases, empty, closed_min, candidate = 0, 0, 0, np.inf, None
