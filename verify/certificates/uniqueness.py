@@ -341,8 +341,8 @@ def confirmed_milp(c, integrality, constraints: LinearConstraint, seconds: float
     points are polished), and stands only if that run agrees (runs = 2): at 1e-9 HiGHS called
     test_uniqueness.PRESOLVE_M infeasible (HiGHS through scipy 1.15.0 and 1.17.1, with
     presolve; 1e-8 finds the point; 1e-6 lets in spurious points; since clock21 HiGHS is
-    called through highspy, verify.certificates.clocked). seconds: the limit of both runs together, on the
-    clock `clock_name` ("cpu" or "wall")."""
+    called through highspy, verify.certificates.clocked). seconds: the limit of both runs
+    together, on the clock `clock_name` ("cpu" or "wall")."""
     now = clock(clock_name)
     t0 = now()
     runs = 0
