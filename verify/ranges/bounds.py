@@ -295,7 +295,10 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
         found = _groups(E[:, :c], free)
         if found is None:
             return None
-        rho = np.where(mu > 0, S_abs / np.where(mu > 0, mu, 1.0), 0.0)
+        with np.errstate(over="ignore"):  # mu ~ 1e-320: rho = S_abs / mu overflows
+            rho = np.where(mu > 0, S_abs / np.where(mu > 0, mu, 1.0), 0.0)
+        if not np.all(np.isfinite(rho)):
+            return None  # no finite bound: the box, said "not proved"
         for G, z in found:
             ref = G[0]
             dmin, dmax = np.zeros(G.size), np.zeros(G.size)
