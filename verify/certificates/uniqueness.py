@@ -164,7 +164,7 @@ def milp_search(
     res.seconds = time.perf_counter() - w0
     used = now() - t0
     res.message += (f" [{res.seconds:.2f} s]" if clock_name == "wall" else
-                    f" [{used:.2f} CPU s, {res.seconds:.2f} s wall]")
+                    f" [{used:.2f} s CPU, {res.seconds:.2f} s wall]")
     return res
 
 
