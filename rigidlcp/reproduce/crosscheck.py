@@ -183,10 +183,12 @@ def certify_steady(run: Run, label: str = "") -> Determinacy:
     Never raises: an error is returned in Determinacy.error."""
     from rigidlcp.verify.certificates.run import certify_event
 
+    from .valid_steady import SEARCH_CLOCK
+
     out = Determinacy(label)
     t0 = time.perf_counter()
     try:
-        row = certify_event(run, run.n_events - 1, ranges=False)
+        row = certify_event(run, run.n_events - 1, ranges=False, clock=SEARCH_CLOCK)
         cert = row["certificate"]
         out.n, out.accepted = int(row["n"]), bool(row["accepted"])
         out.verdicts = {k: {kk: v[kk] for kk in ("verdict", "stage", "reason", "witness")}

@@ -180,3 +180,30 @@ def test_an_empty_events_range_is_refused_and_writes_nothing(run_file, tmp_path,
     with pytest.raises(InvalidInput, match="selects no event"):
         certify_run(path, out, events=[])
     assert not out.exists()
+
+
+def test_clock_is_an_option_of_the_folder(run_file, tmp_path, capsys):
+    """--clock (cpu by default) is stored with the options: a folder certified on one clock is
+    not resumed on the other, one written before the option existed counts as wall; a wrong
+    clock is refused (Python: ValueError; command line: exit 2)."""
+    from rigidlcp.verify.certificates.run import OPTIONS
+
+    path, _ = run_file
+    out = tmp_path / "cert"
+    certify_run(path, out, events=[0], clock="wall")
+    assert json.loads((out / OPTIONS).read_text())["clock"] == "wall"
+    with pytest.raises(InvalidInput, match="other options"):
+        certify_run(path, out, events=[0, 1], resume=True)  # cpu, the default
+    res = certify_run(path, out, events=[0, 1], resume=True, clock="wall")
+    assert res.skipped == 1 and res.ran == 1
+    old = json.loads((out / OPTIONS).read_text())
+    del old["clock"]
+    (out / OPTIONS).write_text(json.dumps(old))
+    assert certify_run(path, out, events=[0, 1], resume=True, clock="wall").skipped == 2
+    with pytest.raises(ValueError, match="clock"):
+        certify_run(path, tmp_path / "o2", events=[0], clock="gpu")
+    with pytest.raises(SystemExit) as exc:  # argparse: usage line and the error, exit 2
+        main(["certify-run", str(path), "--out", str(tmp_path / "o3"), "--clock", "gpu"])
+    assert exc.value.code == 2
+    assert "--clock" in capsys.readouterr().err
+    assert not (tmp_path / "o2").exists() and not (tmp_path / "o3").exists()

@@ -32,6 +32,7 @@ from scipy.optimize import Bounds, LinearConstraint
 
 from rigidlcp.lcp.errors import InvalidInput
 
+from .clocked import clock
 from .uniqueness import confirmed_milp, scaled_residual
 
 _HIGHS = {"mip_feasibility_tolerance": 1e-9, "primal_feasibility_tolerance": 1e-9}
@@ -48,9 +49,12 @@ class NormBound:
     message: str
 
 
-def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float = 10.0
-                       ) -> NormBound:
-    """Decide whether LCP(M, q) has a solution with |z|_1 >= S (module docstring)."""
+def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float = 10.0,
+                       clock_name: str = "cpu") -> NormBound:
+    """Decide whether LCP(M, q) has a solution with |z|_1 >= S (module docstring), within
+    time_limit seconds on the clock `clock_name` ("cpu": this process's CPU seconds, or
+    "wall"; verify.certificates.clocked). `seconds`: wall seconds."""
+    clock(clock_name)  # a wrong clock refused before any work
     t0 = time.perf_counter()
     M = np.asarray(M, dtype=float)
     q = np.asarray(q, dtype=float)
@@ -85,7 +89,7 @@ def no_solution_beyond(M: np.ndarray, q: np.ndarray, S: float, time_limit: float
     integrality = np.r_[np.zeros(n + 1), np.ones(n)]
     out, runs = confirmed_milp(np.zeros(N), integrality,
                       LinearConstraint(A.tocsr(), np.array(lo), np.array(hi)), time_limit,
-                      bounds=Bounds(np.zeros(N), ub), options=_HIGHS)
+                      bounds=Bounds(np.zeros(N), ub), options=_HIGHS, clock_name=clock_name)
     secs = time.perf_counter() - t0
     if out.status == 2 and runs < 2:
         return NormBound(None, S, secs, "MILP infeasible at tolerance 1e-9; no time left to "

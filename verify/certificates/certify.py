@@ -37,6 +37,7 @@ from rigidlcp.lcp.acceptance.accuracy import assess_problem
 from rigidlcp.lcp.acceptance.residual import check
 from rigidlcp.lcp.errors import InvalidInput
 
+from .clocked import check_clock
 from .friction import fc_accuracy, forces_map, friction_certificate
 from .stages import OTHER, UNIQUE, certify_stages
 from .uniqueness import Search, milp_search, p_matrix_test, sign_pattern
@@ -118,6 +119,7 @@ def certify(
     problem, solution, tol: float = 1e-8, uniqueness: str = "auto", *,
     delta: float = 1e-4, bound: float | None = None, time_limit: float = 30.0,
     objective: str = "none", observables: dict[str, np.ndarray] | None = None,
+    clock: str = "cpu",
 ) -> Certificate:
     """Certify `solution` (an `lcp.Solution` or a vector z) of `problem`.
 
@@ -133,7 +135,10 @@ def certify(
     seconds per MILP; objective: "none" (the first other solution HiGHS meets) or "min-sum"
     (the other solution of least sum z, e.g. the small-force one; slower: optimality must be
     proved). observables: extra linear maps L (quantity = L z + const) whose uniqueness is
-    asked too.
+    asked too. clock: how time_limit is counted, "cpu" (this process's CPU seconds, the
+    default: a verdict does not depend on the machine's load) or "wall"
+    (verify.certificates.clocked); a MILP stopped by it leaves its question undecided (None,
+    with the limit in the notes), never a verdict. `seconds`: wall time.
     """
     if uniqueness not in UNIQUENESS_METHODS:
         raise InvalidInput(f"uniqueness must be one of {UNIQUENESS_METHODS}, got {uniqueness!r}")
@@ -145,6 +150,7 @@ def certify(
     if solution is None:  # np.asarray(None) has one entry: "the solution has 1 entries"
         raise InvalidInput("certify needs a solution: an lcp.Solution or a vector z "
                            "(lcp.solve(problem) gives one), got None")
+    check_clock(clock)
     t0 = time.perf_counter()
     obs: dict[str, np.ndarray] = {}
     fc_residual, fc = None, None
@@ -224,7 +230,7 @@ def certify(
     M, q = lcp_form.M, lcp_form.q
     n = q.size
     if uniqueness == "staged":
-        _staged(cert, lcp_form, z, obs, delta, bound, time_limit)
+        _staged(cert, lcp_form, z, obs, delta, bound, time_limit, clock)
         cert.seconds = time.perf_counter() - t0
         return cert
     method = uniqueness
@@ -246,12 +252,12 @@ def certify(
             cert.seconds = time.perf_counter() - t0
             return cert
         if n > ENUM_AUTO_MAX_N and objective == "none":  # the stages, cheapest first
-            _staged(cert, lcp_form, z, obs, delta, bound, time_limit)
+            _staged(cert, lcp_form, z, obs, delta, bound, time_limit, clock)
             cert.method = f"staged (auto, n = {n} > {ENUM_AUTO_MAX_N})"
             cert.seconds = time.perf_counter() - t0
             return cert
         method = "enumeration" if n <= ENUM_AUTO_MAX_N else "milp"
-    ctx = _Context(cert, M, q, z, w, zs, ws, obs, delta, bound, time_limit, objective)
+    ctx = _Context(cert, M, q, z, w, zs, ws, obs, delta, bound, time_limit, objective, clock)
     if method == "enumeration":
         ctx.by_enumeration(lcp_form)
     else:
@@ -261,9 +267,10 @@ def certify(
 
 
 def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: float,
-            bound: float | None, time_limit: float) -> None:
+            bound: float | None, time_limit: float, clock: str) -> None:
     """uniqueness="staged": the verdicts of verify.certificates.stages.certify_stages."""
     staged = certify_stages(problem, z, delta=delta, bound=bound, time_limit=time_limit,
+                            clock=clock,
                             observables={"z": np.eye(problem.n), "w": problem.M, **obs})
     flag = {UNIQUE: True, OTHER: False}
     v = staged.verdicts
@@ -285,11 +292,12 @@ def _staged(cert: Certificate, problem: LCP, z: np.ndarray, obs: dict, delta: fl
 class _Context:
     """The uniqueness questions for one accepted solution (shared by the two methods)."""
 
-    def __init__(self, cert, M, q, z, w, zs, ws, obs, delta, bound, time_limit, objective):
+    def __init__(self, cert, M, q, z, w, zs, ws, obs, delta, bound, time_limit, objective,
+                 clock="cpu"):
         self.cert, self.M, self.q, self.z, self.w = cert, M, q, z, w
         self.zs, self.ws, self.obs = zs, ws, obs
         self.delta, self.bound, self.time_limit = delta, bound, time_limit
-        self.objective = objective
+        self.objective, self.clock = objective, clock
 
     # -- helpers ---------------------------------------------------------------------------
     def differs(self, other: np.ndarray, L: np.ndarray | None) -> bool:
@@ -312,7 +320,8 @@ class _Context:
     def search(self, target: str, L: np.ndarray | None) -> Search:
         """One MILP; a 'found' whose difference is tiny is retried once with delta = 1e-2
         (to report a clearly different solution when there is one)."""
-        kw = dict(bound=self.bound, time_limit=self.time_limit, objective=self.objective)
+        kw = dict(bound=self.bound, time_limit=self.time_limit, objective=self.objective,
+                  clock_name=self.clock)
         s = milp_search(self.M, self.q, self.z, target, L, delta=self.delta, **kw)
         self.cert.bound = s.bound
         self.cert.delta = max(self.cert.delta, s.delta)

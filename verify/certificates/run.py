@@ -32,6 +32,7 @@ from rigidlcp.models.sweep import ResultsFile, _atomic_write_text
 
 from ..forces.polyhedra import event_z
 from ..steadiness import KINEMATICS, steadiness
+from .clocked import check_clock
 from .stages import OTHER, UNIQUE, UNKNOWN, certify_stages
 
 LINES, SUMMARY, FIGURE, OPTIONS = ("certificates.jsonl", "summary.json", "determinacy.png",
@@ -52,15 +53,18 @@ class RunCertificate:
 
 
 def certify_event(run: Run, k: int, *, time_limit: float = 10.0, tries: int = 8,
-                  ranges: bool = False) -> dict:
+                  ranges: bool = False, clock: str = "cpu") -> dict:
     """The JSON row of event k: verdicts, stages, times, the full staged certificate and every
-    witness (`witness_row`). steady_event: k is the last event of a run that ended steady."""
+    witness (`witness_row`). steady_event: k is the last event of a run that ended steady.
+    clock: how time_limit is counted ("cpu" seconds of this process, or "wall"; as
+    certify_stages); the row's seconds are wall seconds."""
     t0 = time.perf_counter()
     rec = run.records[k]
     state = run.state_at(k)
     ep = event_problem(run.system, state)
     z = event_z(ep, np.r_[rec.R, rec.S])
-    cert = certify_stages(ep, z, time_limit=time_limit, tries=tries, ranges=ranges)
+    cert = certify_stages(ep, z, time_limit=time_limit, tries=tries, ranges=ranges,
+                          clock=clock)
     row: dict = {"event": k, "t": float(rec.t), "n": int(ep.lcp.n), "k": int(ep.k),
                  "accepted": cert.accepted, "scaled_residual": cert.scaled_residual}
     for name in QUESTIONS:
@@ -134,14 +138,16 @@ class _EventTask:
 def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = None, *,
                 time_limit: float = 10.0, tries: int = 8, ranges: bool = False,
                 events: list[int] | None = None, jobs: int | None = 1, resume: bool = False,
-                force: bool = False, progress: bool = False, figure: bool = True
-                ) -> RunCertificate:
+                force: bool = False, progress: bool = False, figure: bool = True,
+                clock: str = "cpu") -> RunCertificate:
     """Certify every event of `run` (a Run or a saved run's path); see the module docstring.
 
     out: directory for the JSON lines, totals and figure (None: nothing written, no resume).
     time_limit: seconds per MILP (stage c2, per question); tries: other-solver attempts;
     ranges: the range LPs of each observable over the face (slower); events: which events
-    (default all); jobs: worker processes (models.executors.iter_map).
+    (default all); jobs: worker processes (models.executors.iter_map); clock: how time_limit
+    is counted, "cpu" (each worker's CPU seconds: the verdicts do not depend on the load) or
+    "wall" (a folder certified on another clock is not resumed: other options).
     """
     from rigidlcp.models.executors import iter_map
 
@@ -153,7 +159,9 @@ def certify_run(run: Run | str | os.PathLike, out: str | os.PathLike | None = No
                            "certify-run certifies the events of `rigidlcp simulate` (`rigidlcp "
                            "compare-integrators` checks a time-stepper's state in the event "
                            "laws)")
-    options = {"time_limit": float(time_limit), "tries": int(tries), "ranges": bool(ranges)}
+    check_clock(clock)
+    options = {"time_limit": float(time_limit), "tries": int(tries), "ranges": bool(ranges),
+               "clock": clock}
     todo_all = list(range(run.n_events)) if events is None else sorted(set(int(k) for k in
                                                                          events))
     if events is not None and not todo_all:
@@ -218,6 +226,8 @@ def _prepare(out: Path, options: dict, resume: bool, force: bool, notes: list[st
     saved = out / OPTIONS
     if resume and saved.exists():
         previous = json.loads(saved.read_text())
+        if isinstance(previous, dict):  # written before the clock was an option: wall
+            previous.setdefault("clock", "wall")
         if previous != options:
             raise InvalidInput(f"{out} was certified with other options {previous}; pass "
                              "--force to start afresh")

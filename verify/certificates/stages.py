@@ -43,6 +43,8 @@ from rigidlcp.lcp import LCP, Solution, solve
 from rigidlcp.lcp.acceptance.residual import check
 
 from .bounds import no_solution_beyond
+from .clocked import check_clock
+from .clocked import clock as clock_of
 from .faces import FaceLP, null_directions
 from .uniqueness import BOUND_FACTOR, milp_search, p_matrix_test, scales, sign_pattern
 from .verdicts import (  # noqa: F401  (re-exported: the names users import from here)
@@ -78,6 +80,7 @@ def certify_stages(
     problem, solution, *, tol: float = 1e-8, delta: float = 1e-4, time_limit: float = 10.0,
     tries: int = 8, bound: float | None = None, milp: bool = True, seed: int = 0,
     ranges: bool = True, observables: dict[str, np.ndarray] | None = None,
+    clock: str = "cpu",
 ) -> StagedCertificate:
     """Decide uniqueness of each observable of `solution` (stages 0, a, b, c above).
 
@@ -87,8 +90,12 @@ def certify_stages(
     contain every solution seen); milp: False stops after stage c1 ("unknown" if undecided);
     ranges: also the range of every moving row of each observable over the face (two LPs
     per row and face; False: only the witness LPs, the ranges are then NaN where they move);
-    observables: replace the default ones by {name: L}.
+    observables: replace the default ones by {name: L}. clock: how time_limit is counted,
+    "cpu" (this process's CPU seconds, the default: the verdicts do not depend on the
+    machine's load) or "wall" (verify.certificates.clocked); a question stopped by it is
+    "unknown" with the limit as its reason. Every `seconds` reported is wall time.
     """
+    check_clock(clock)  # a wrong clock refused before any work
     t0 = time.perf_counter()
     lcp, obs = observables_of(problem)
     if observables is not None:
@@ -109,7 +116,7 @@ def certify_stages(
     run.face()
     run.other_solvers(tries)
     if milp:
-        run.milp(time_limit, bound)
+        run.milp(time_limit, bound, clock)
     for v in out.verdicts.values():
         if v.verdict == UNKNOWN and not v.reason:
             v.reason = "undecided after the face stage and the other solvers (MILP not run)"
@@ -276,19 +283,20 @@ class _Stages:
                             f"{found} witnesses [{time.perf_counter() - t:.3f} s]")
 
     # -- stage c2 ----------------------------------------------------------------------------
-    def milp(self, time_limit: float, bound: float | None) -> None:
+    def milp(self, time_limit: float, bound: float | None, clock_name: str = "cpu") -> None:
+        now = clock_of(clock_name)
         sizes = [float(np.max(y)) for y in self.seen]
         U = bound if bound is not None else max(BOUND_FACTOR * self.zs, 10.0 * max(sizes,
                                                                                    default=0.0))
         for v in self.open():
-            t = time.perf_counter()
+            t, tc = time.perf_counter(), now()
             L = self.obs[v.name]
             s = milp_search(self.M, self.q, self.z, "values", L, delta=self.delta, bound=U,
-                            time_limit=time_limit)
-            left = time_limit - (time.perf_counter() - t)  # one budget per question
+                            time_limit=time_limit, clock_name=clock_name)
+            left = time_limit - (now() - tc)  # one budget per question
             if s.status == "found" and s.deviation < 1e-3 and self.delta < 1e-2 and left > 0.1:
                 s2 = milp_search(self.M, self.q, self.z, "values", L, delta=1e-2, bound=U,
-                                 time_limit=left)  # a clearly different one, if any
+                                 time_limit=left, clock_name=clock_name)  # a clearly other one
                 s = s2 if s2.status == "found" else s
             unproved = int(s.info.get("unproved_cuts", 0))  # cuts proved empty by LP are sound
             self.out.log.append(f"milp {v.name}: {s.status}, {s.message}")
@@ -298,8 +306,9 @@ class _Stages:
                 self.decide(v, OTHER, "milp (c2)", f"MILP: {s.message}", t, w, scope=scope)
             elif s.status == "none" and unproved == 0:
                 prior = f"; {v.reason}" if v.reason else ""
-                left = max(time_limit - (time.perf_counter() - t), 0.5)
-                nb = no_solution_beyond(self.M, self.q, U, time_limit=left)
+                left = max(time_limit - (now() - tc), 0.5)
+                nb = no_solution_beyond(self.M, self.q, U, time_limit=left,
+                                        clock_name=clock_name)
                 self.out.log.append(f"norm bound: {nb.message}")
                 scope = ("global: " + nb.message if nb.proved else
                          f"{scope}; not global: {nb.message}")

@@ -12,7 +12,8 @@ Three tools, from cheapest to most general:
   Checked by all 2^n - 1 principal minors for small n, and for any n by the sufficient condition
   that the symmetric part (M + M^T)/2 be positive definite (necessary too when M is symmetric).
 * ``lcp.enumerate_solutions`` (used by verify.certify): every complementary basis, small n.
-* ``milp_search``: a mixed-integer program (scipy.optimize.milp, i.e. HiGHS) for a solution other
+* ``milp_search``: a mixed-integer program (HiGHS, verify/certificates/clocked.py: its time
+  limit in CPU or wall seconds) for a solution other
   than a given z*, with binary variables y for the complementarity and big-M bounds; each basis
   it proposes is polished into an exact solution by LP (verify/certificates/polish.py; HiGHS's
   options and quiet context: verify/certificates/highs.py).
@@ -30,11 +31,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.optimize import Bounds, LinearConstraint, milp
+from scipy.optimize import Bounds, LinearConstraint
 
 from rigidlcp.lcp.acceptance.residual import scaled_residual, scales
 from rigidlcp.lcp.errors import InvalidInput
 
+from .clocked import UNITS, clock, solve_milp
 from .highs import HIGHS_MILP, quiet_highs
 from .pmatrix import P_MINORS_MAX_N, RCOND, PMatrixTest, p_matrix_test
 from .polish import polish_basis
@@ -88,9 +90,9 @@ class Search:
 def milp_search(
     M: np.ndarray, q: np.ndarray, z_star: np.ndarray, target: str = "pattern",
     L: np.ndarray | None = None, *, delta: float = 1e-4, bound: float | None = None,
-    time_limit: float = 10.0, objective: str = "none", retries: int = 5,
+    time_limit: float = 10.0, objective: str = "none", retries: int = 5, clock_name: str = "cpu",
 ) -> Search:
-    """Search for an LCP solution other than z_star, as a MILP (HiGHS through scipy.optimize.milp).
+    """Search for an LCP solution other than z_star, as a MILP (HiGHS, verify.certificates.clocked).
 
     Formulation, in the scaled unknowns zeta = z / U (U the box bound, so 0 <= zeta <= 1), with
     w = U M zeta + q, binaries y (y_i = 1: z_i may be positive and w_i = 0; y_i = 0: z_i = 0):
@@ -123,14 +125,18 @@ def milp_search(
     (HiGHS must then prove optimality; a feasible point at the time limit is still used);
     "none" (default) stops at the first feasible point. A basis that fails verification is cut
     off (a no-good cut on y) and the MILP asked again, at most `retries` times; the total time
-    is bounded by `time_limit` seconds. Every way of differing is tried on that basis (the
-    MILP's binaries may pick one that rounding made look satisfied); the cut is *proved* only
-    if all their LPs are infeasible, and an infeasible MILP after an unproved cut answers
-    "unknown", never "none" (a false "unique" is the worst answer a verifier can give).
+    is bounded by `time_limit` seconds on the clock `clock_name` ("cpu": this process's CPU
+    seconds, the default, so that the verdict does not depend on the machine's load; "wall";
+    a search stopped by it is "unknown", never "none"). Every way of differing is tried on
+    that basis (the MILP's binaries may pick one that rounding made look satisfied); the cut
+    is *proved* only if all their LPs are infeasible, and an infeasible MILP after an
+    unproved cut answers "unknown", never "none" (a false "unique" is the worst answer a
+    verifier can give).
     "none" rests on HiGHS's "infeasible", given twice, at two tolerances (`confirmed_milp`):
-    the MILP solver's verdict, not a certificate this module checks.
+    the MILP solver's verdict, not a certificate this module checks. `seconds`: wall seconds.
     """
-    t0 = time.perf_counter()
+    now = clock(clock_name)  # a wrong clock refused before any work
+    t0, w0 = now(), time.perf_counter()
     M = np.asarray(M, dtype=float)
     q = np.asarray(q, dtype=float)
     z_star = np.asarray(z_star, dtype=float)
@@ -151,12 +157,14 @@ def milp_search(
     if target == "pattern":
         model.differ_in_pattern()
     elif not model.differ_in_values(np.atleast_2d(np.asarray(L, dtype=float))):
-        res.status, res.seconds = "none", time.perf_counter() - t0
+        res.status, res.seconds = "none", time.perf_counter() - w0
         res.message = f"no row of L can move by {delta:g} s_L inside the box z <= {U:.3g}"
         return res
-    _solve_and_verify(model, res, objective, time_limit, retries, t0)
-    res.seconds = time.perf_counter() - t0
-    res.message += f" [{res.seconds:.2f} s]"
+    _solve_and_verify(model, res, objective, time_limit, retries, t0, clock_name)
+    res.seconds = time.perf_counter() - w0
+    used = now() - t0
+    res.message += (f" [{res.seconds:.2f} s]" if clock_name == "wall" else
+                    f" [{used:.2f} s CPU, {res.seconds:.2f} s wall]")
     return res
 
 
@@ -261,7 +269,7 @@ class _MilpModel:
 
 
 def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit: float,
-                      retries: int, t0: float) -> None:
+                      retries: int, t0: float, clock_name: str = "cpu") -> None:
     """Ask HiGHS; polish its basis into an exact solution (`polish_basis`, in polish.py) or
     cut the basis off and ask again (at most `retries` times); fill `res` (see milp_search's
     docstring)."""
@@ -271,14 +279,15 @@ def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit
         c[:n] = 1.0
     integrality = np.r_[np.zeros(n), np.ones(N - n)]
     rejected = unproved = 0
+    now = clock(clock_name)
     for _attempt in range(retries + 1):
-        left = time_limit - (time.perf_counter() - t0)
+        left = time_limit - (now() - t0)
         if left <= 0:
-            res.message = f"time limit {time_limit:g} s reached"
+            res.message = f"time limit {time_limit:g} {UNITS[clock_name]} reached"
             break
         A = sp.csr_matrix(np.array(model.rows))
         cons = LinearConstraint(A, np.array(model.lo), np.array(model.hi))
-        out, runs = confirmed_milp(c, integrality, cons, left)
+        out, runs = confirmed_milp(c, integrality, cons, left, clock_name=clock_name)
         res.info = {"milp_status": int(out.status), "milp_message": str(out.message),
                     "binaries": N - n, "rejected_bases": rejected, "milp_runs": runs}
         if out.x is None:
@@ -324,24 +333,30 @@ def _solve_and_verify(model: _MilpModel, res: Search, objective: str, time_limit
     res.info["unproved_cuts"] = unproved
 
 
-def confirmed_milp(c, integrality, constraints, seconds: float, bounds=None, options=None):
-    """(HiGHS's answer, runs). "Infeasible" is asked again without presolve at 10 times the
-    mip_feasibility_tolerance (a relaxation; its points are polished), and stands only if that
-    run agrees (runs = 2): at 1e-9 HiGHS called test_uniqueness.PRESOLVE_M infeasible (scipy
-    1.15.0, 1.17.1 with presolve; 1e-8 finds the point; 1e-6 lets in spurious points)."""
-    t0 = time.perf_counter()
+def confirmed_milp(c, integrality, constraints: LinearConstraint, seconds: float,
+                   bounds: Bounds | None = None, options: dict | None = None,
+                   clock_name: str = "cpu"):
+    """(HiGHS's answer, a verify.certificates.clocked.MilpAnswer, runs). "Infeasible" is
+    asked again without presolve at 10 times the mip_feasibility_tolerance (a relaxation; its
+    points are polished), and stands only if that run agrees (runs = 2): at 1e-9 HiGHS called
+    test_uniqueness.PRESOLVE_M infeasible (HiGHS through scipy 1.15.0 and 1.17.1, with
+    presolve; 1e-8 finds the point; 1e-6 lets in spurious points; since clock21 HiGHS is
+    called through highspy, verify.certificates.clocked). seconds: the limit of both runs
+    together, on the clock `clock_name` ("cpu" or "wall")."""
+    now = clock(clock_name)
+    t0 = now()
     runs = 0
+    bounds = Bounds(0.0, 1.0) if bounds is None else bounds
     for tight in (True, False):
-        left = seconds - (time.perf_counter() - t0)
+        left = seconds - (now() - t0)
         if runs and left <= 0:
             break
         opts = dict(HIGHS_MILP if options is None else options)
         if not tight:
             opts.update(presolve=False, mip_feasibility_tolerance=1e-8)
-        with quiet_highs():
-            out = milp(c, integrality=integrality, constraints=constraints,
-                       bounds=Bounds(0.0, 1.0) if bounds is None else bounds,
-                       options={"time_limit": float(left), **opts})
+        out = solve_milp(c, integrality, constraints.A, constraints.lb, constraints.ub,
+                         bounds.lb, bounds.ub, time_limit=max(left, 0.0), options=opts,
+                         clock_name=clock_name)
         runs += 1
         if out.status != 2:
             break

@@ -47,6 +47,10 @@ from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 #: Relative and absolute margins added to every LP bound (the LPs' tolerance is 1e-10).
 MARGIN_REL, MARGIN_ABS = 1e-6, 1e-7
+#: HiGHS settings tried, in turn, on a bound LP that ends in numerical trouble (after a run
+#: from scratch): without presolve, and with other simplex scalings (tests/verify/ranges/
+#: test_tiny_friction.py: each rescues some of the LPs of rect/tri arrays at mu_pp ~ 1e-8).
+RETRIES = ({"presolve": "off"}, {"simplex_scale_strategy": 4}, {"simplex_scale_strategy": 0})
 
 
 @dataclass
@@ -111,10 +115,22 @@ class _P:
         with quiet_highs():
             h.run()
         st = h.getModelStatus()
-        if st == hs.HighsModelStatus.kUnknown:  # warm start in trouble: once more from scratch
+        # HiGHS in numerical trouble (kUnknown, kSolveError: seen at mu_pp ~ 1e-8 - 1e-7, where
+        # R reaches ~ 1/mu and the rows' terms span 1e8): once more from scratch, then with
+        # the other settings of RETRIES (same tolerances, so a bound is as good as a first one)
+        for retry in ({}, *RETRIES):
+            if st not in (hs.HighsModelStatus.kUnknown, hs.HighsModelStatus.kSolveError):
+                break
             h.clearSolver()
-            with quiet_highs():
-                h.run()
+            saved = {key: _option(h, key) for key in retry}
+            for key, value in retry.items():
+                h.setOptionValue(key, value)
+            try:
+                with quiet_highs():
+                    h.run()
+            finally:
+                for key, value in saved.items():
+                    h.setOptionValue(key, value)
             st = h.getModelStatus()
         if st == hs.HighsModelStatus.kOptimal:
             return float(h.getInfo().objective_function_value)
@@ -127,6 +143,12 @@ class _P:
         if lo is None or hi is None:
             return None
         return lo, -hi
+
+
+def _option(h, key: str):
+    """HiGHS option `key`'s value (highspy returns (status, value) or the value alone)."""
+    v = h.getOptionValue(key)
+    return v[1] if isinstance(v, tuple) else v
 
 
 def _pad(v: float) -> float:
@@ -273,7 +295,10 @@ def proved_bounds(system: System, dyn: Dynamics, E: np.ndarray, e: np.ndarray
         found = _groups(E[:, :c], free)
         if found is None:
             return None
-        rho = np.where(mu > 0, S_abs / np.where(mu > 0, mu, 1.0), 0.0)
+        with np.errstate(over="ignore"):  # mu ~ 1e-320: rho = S_abs / mu overflows
+            rho = np.where(mu > 0, S_abs / np.where(mu > 0, mu, 1.0), 0.0)
+        if not np.all(np.isfinite(rho)):
+            return None  # no finite bound: the box, said "not proved"
         for G, z in found:
             ref = G[0]
             dmin, dmax = np.zeros(G.size), np.zeros(G.size)

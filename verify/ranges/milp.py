@@ -25,6 +25,12 @@ import scipy.sparse as sp
 
 from rigidlcp.lcp.errors import InvalidInput
 from rigidlcp.lcp.quiet import new_highs
+from rigidlcp.verify.certificates.clocked import (  # noqa: F401  (clock: re-exported)
+    BACKSTOP_FACTOR,
+    BACKSTOP_S,
+    clock,
+    start_cpu_interrupt,
+)
 from rigidlcp.verify.certificates.uniqueness import quiet_highs
 
 from .kinematics import realizable
@@ -37,21 +43,6 @@ MAX_SEEDS = 10
 #: "lazy-a_t": a_t counts as 0 within this times max(|gamma|, g) (a larger set of contacts
 #: asked only makes the check stricter; its cuts stay valid).
 AT_ZERO = 1e-7
-#: clock "cpu": HiGHS's own (wall-clock) limit is kept as a backstop at this many times the
-#: CPU limit plus BACKSTOP_S seconds (a search that never reaches a MIP callback, e.g. a
-#: very long root LP, still stops).
-BACKSTOP_FACTOR, BACKSTOP_S = 20.0, 60.0
-
-
-def clock(name: str):
-    """The clock of a time limit: "wall" (time.perf_counter) or "cpu" (time.process_time,
-    this process's CPU seconds: a limit then means the same work whatever the machine's
-    load)."""
-    if name == "wall":
-        return time.perf_counter
-    if name == "cpu":
-        return time.process_time
-    raise InvalidInput(f"clock must be 'wall' or 'cpu', got {name!r}")
 
 
 def seconds(value, name: str = "time_limit") -> float:
@@ -185,15 +176,7 @@ class MilpModel:
 
         self.h, self.lp = model(True), model(False)
         if clock_name == "cpu":
-            deadline = self._deadline
-
-            def interrupt(kind, message, data_out, data_in, user_data) -> None:
-                # set either way: HiGHS keeps the flag from one run to the next
-                data_in.user_interrupt = time.process_time() >= deadline[0]
-
-            self.h.setCallback(interrupt, None)
-            self.h.startCallback(highspy.cb.HighsCallbackType.kCallbackMipInterrupt)
-            self.h.startCallback(highspy.cb.HighsCallbackType.kCallbackSimplexInterrupt)
+            start_cpu_interrupt(self.h, highspy, self._deadline)
         self.starts: list[np.ndarray] = []
         self.seeds: list[np.ndarray] = []  # contact-state sets tried first at every end
         self.V_ref: float | None = None  # proportional witnesses' V (if of gamma's sign)

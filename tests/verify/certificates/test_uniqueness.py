@@ -230,21 +230,23 @@ def test_milp_does_not_trust_a_single_infeasible(target):
     assert np.max(np.abs(res.other[5:] - z[5:])) > 0.1
 
 
-def test_milp_none_needs_two_infeasible_answers(monkeypatch):
+@pytest.mark.parametrize("clock_name", ["cpu", "wall"])
+def test_milp_none_needs_two_infeasible_answers(monkeypatch, clock_name):
     """"none" needs HiGHS's "infeasible" at 1e-9 and again at 1e-8; with no time
-    left for the second run, the answer is "unknown"."""
+    left for the second run (on the clock the limit counts), the answer is "unknown"."""
+    import rigidlcp.verify.certificates.clocked as clocked
     import rigidlcp.verify.certificates.uniqueness as uq
 
     M, q = np.eye(2), np.array([-1.0, 1.0])  # P-matrix: one solution, z = (1, 0)
-    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern")
+    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern", clock_name=clock_name)
     assert res.status == "none" and res.info["milp_runs"] == 2, res.message
-    real = uq.milp
+    real = uq.solve_milp
 
     def slow(*a, **k):  # the first run uses up the whole budget
         out = real(*a, **k)
-        monkeypatch.setattr(uq.time, "perf_counter", lambda: 1e12)
+        monkeypatch.setitem(clocked.CLOCKS, clock_name, lambda: 1e12)
         return out
 
-    monkeypatch.setattr(uq, "milp", slow)
-    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern")
+    monkeypatch.setattr(uq, "solve_milp", slow)
+    res = uq.milp_search(M, q, np.array([1.0, 0.0]), "pattern", clock_name=clock_name)
     assert res.status == "unknown" and res.info["milp_runs"] == 1, res.message
