@@ -191,11 +191,12 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     pivots = np.empty(k, dtype=np.int64)
     # acceptance in C only where judge_lcp would use it (the C `assess` built)
     acc = np.empty((k, 4)) if _accuracy_c is not None else None
+    mmax = np.empty(k)  # max|M| of each solved problem, from the solve: not measured again
     _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots,
-                        equilibrate=on, acc=acc)
+                        equilibrate=on, acc=acc, mmax=mmax)
     with np.errstate(all="ignore"):  # as `check`: an overflow is measured, never accepted
         W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
-    measured = _kernel.measure_batch(Ms, qs, Z, W)
+    measured = _kernel.measure_batch(Ms, qs, Z, W, mmax)
     if measured is None:  # not compiled as numpy sums: measure one by one
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
     if acc is None:  # every answer to judge_lcp
