@@ -261,9 +261,22 @@ def test_the_batch_measure_with_the_solves_max_is_the_measure(n, kind):
     """solve_batch's mmax is max|M_p| exactly where it solved problem p (-1 elsewhere: rays,
     limits, an M that is not balanced), and measure_batch given it measures every problem to
     the same bits as measuring max|M_p| itself (residual, scaled residual, z_s, w_s, w)."""
+    _check_batch_measure(n, kind, range(4))
+
+
+@compiled
+@settings(max_examples=40)
+@given(st.integers(1, 40), st.sampled_from(["psd", "general", "scaled", "degenerate"]),
+       st.integers(0, 2**32 - 1))
+def test_the_batch_measure_with_the_solves_max_is_the_measure_on_random_problems(n, kind, seed):
+    """The same, on random sizes and seeds."""
+    _check_batch_measure(n, kind, range(seed, seed + 3))
+
+
+def _check_batch_measure(n: int, kind: str, seeds) -> None:
     from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL
 
-    pairs = [_problem(n, kind, seed) for seed in range(4)]
+    pairs = [_problem(n, kind, seed) for seed in seeds]
     Ms, qs = np.stack([M for M, _ in pairs]), np.stack([q for _, q in pairs])
     k = len(pairs)
     Z, basic = np.empty((k, n)), np.empty((k, n), dtype=np.int8)
