@@ -315,7 +315,31 @@ def numpy_arrays() -> bool:
                 _lemke_c.array_setup(None, np.dtype(np.float64), np.dtype(np.intp),
                                      np.ndarray)
             _arrays_found = ok
+            _lemke_c.array_fields_use(ok and _fields_read_as_numpy())
     return _arrays_found
+
+
+def _fields_read_as_numpy() -> bool:
+    """Does lcp/_numpy_abi.h read an array's data pointer, dimensions, strides, dtype and its
+    C-contiguous and writeable flags as numpy itself gives them? Checked on probes -- C and
+    Fortran order, a strided view, a view at an offset, read-only, 0-d to 2-d, float64 and
+    other dtypes -- before the C calls read plain float64 arrays' data from their fields
+    instead of asking for a buffer (`plain_f64`)."""
+    if not hasattr(_lemke_c, "array_fields"):
+        return False
+    base = np.arange(60.0).reshape(6, 10)
+    ro = np.ones((3, 3))
+    ro.flags.writeable = False
+    probes = [np.empty((30, 30)), np.empty(7), np.zeros(()), base, base[1:4, 2:5], base[:, ::2],
+              base.T, base[2], ro, np.asfortranarray(np.ones((4, 4))), np.ones(5, np.float32),
+              np.ones((2, 2), np.intp), np.empty((0, 3))]
+    for a in probes:
+        address, nd, shape, strides, dtype, c_contiguous, writeable = _lemke_c.array_fields(a)
+        if (address != a.__array_interface__["data"][0] or nd != a.ndim or shape != a.shape
+                or strides != a.strides or dtype is not a.dtype
+                or c_contiguous != a.flags["C_CONTIGUOUS"] or writeable != a.flags["WRITEABLE"]):
+            return False
+    return True
 
 
 numpy_arrays()
