@@ -166,8 +166,8 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
     /* plain float64 arrays: their data read from their fields (_numpy_abi.h), else buffers */
     const ArrayFields *af = (const ArrayFields *)oq;
     idx n = s_fields_ok && Py_TYPE(oq) == s_arr_type && af->nd == 1 ? af->dimensions[0] : 0;
-    const double *qf = n >= 1 ? plain_f64(oq, s_f64, 1, n) : NULL,
-                 *Mf = qf ? plain_f64(oM, s_f64, 2, n) : NULL;
+    const double *qf = n >= 1 ? plain_f64(oq, s_f64, 1, n, 1) : NULL,
+                 *Mf = qf ? plain_f64(oM, s_f64, 2, n, 1) : NULL;
     if (!Mf) {
         n = problem_data(oM, oq, &vM, &vq);
         if (n < 0) goto done;

@@ -161,18 +161,19 @@ static PyObject *py_array_fields_use(PyObject *self, PyObject *flag)
 }
 
 /* The data of obj when it is exactly a numpy.ndarray whose dtype object is `f64` (numpy's
- * float64 itself: native doubles), C-contiguous and writeable, of nd (1 or 2) dimensions all
- * equal to n: read from its fields, without a buffer request (numpy builds and caches a buffer
+ * float64 itself: native doubles), C-contiguous (and writeable, when `writeable`), of nd (1 or
+ * 2) dimensions all equal to n: read from its fields, without a buffer request (numpy builds and caches a buffer
  * description at an array's first request: 0.1 us for each new M and q of the natural call);
  * else NULL (the caller asks for a buffer, with its checks and errors). The array is the
  * caller's, held for as long as the pointer is used. */
-static const double *plain_f64(PyObject *obj, PyObject *f64, int nd, Py_ssize_t n)
+static const double *plain_f64(PyObject *obj, PyObject *f64, int nd, Py_ssize_t n,
+                               int writeable)
 {
     if (!s_fields_ok || Py_TYPE(obj) != s_arr_type) return NULL;
     const ArrayFields *a = (const ArrayFields *)obj;
-    const unsigned int flags = (unsigned int)a->flags;
-    if (a->descr != f64 || a->nd != nd || (flags & ARR_WARN_ON_WRITE) ||
-        (flags & (ARR_C_CONTIGUOUS | ARR_WRITEABLE)) != (ARR_C_CONTIGUOUS | ARR_WRITEABLE))
+    const unsigned int flags = (unsigned int)a->flags,
+                       need = ARR_C_CONTIGUOUS | (writeable ? ARR_WRITEABLE : 0);
+    if (a->descr != f64 || a->nd != nd || (flags & ARR_WARN_ON_WRITE) || (flags & need) != need)
         return NULL;
     for (int k = 0; k < nd; k++)
         if (a->dimensions[k] != n) return NULL;
