@@ -86,14 +86,15 @@ def parts(n: int, repeats: int) -> dict[str, float]:
     t["_lemke_batch"] = best(lambda: batch._lemke_batch(SM, SQ, True, {}, None), repeats, k)
     Z, basic = np.empty((k, n)), np.empty((k, n), dtype=np.int8)
     codes, pivots = np.empty(k, dtype=np.int64), np.empty(k, dtype=np.int64)
-    acc, d = np.empty((k, 4)), np.ones(n)
+    acc, d, mmax = np.empty((k, 4)), np.ones(n), np.empty(k)
     t["solve_batch"] = best(lambda: kernel.solve_batch(SM, SQ, d, DEFAULT_TOL, 1000 + 100 * n,
                                                        Z, basic, codes, pivots,
-                                                       equilibrate=True, acc=acc), repeats, k)
+                                                       equilibrate=True, acc=acc, mmax=mmax),
+                            repeats, k)
     t["M Z"] = best(lambda: np.matmul(SM, Z[:, :, None])[:, :, 0], repeats, k)
     W = np.matmul(SM, Z[:, :, None])[:, :, 0]
-    t["measure"] = best(lambda: kernel.measure_batch(SM, SQ, Z, W.copy()), repeats, k)
-    measured = kernel.measure_batch(SM, SQ, Z, W)  # W becomes M Z + q
+    t["measure"] = best(lambda: kernel.measure_batch(SM, SQ, Z, W.copy(), mmax), repeats, k)
+    measured = kernel.measure_batch(SM, SQ, Z, W, mmax)  # W becomes M Z + q
     t["batch_solutions"] = best(lambda: kernel._lemke_c.batch_solutions(
         Z, W, basic, codes, pivots, acc, measured, TOL, FERR_TOL, True), repeats, k)
     t["objects"] = t["solve_many"] - sum(t[w] for w in ("stack_lcps", "solve_batch", "M Z",

@@ -177,16 +177,18 @@ done:
  * the original units), basic_z (k n int8: z_j basic), codes and pivots (int64, k). Only code 0
  * (solved) leaves a usable z: the caller solves the others again one by one. acc (optional,
  * k x 4 float64): each solved answer is also assessed as `solve_accept` does (`accept_one`),
- * acc[p] = (acode, berr, ferr, refined) and Z[p] the answer (polished when refined). */
+ * acc[p] = (acode, berr, ferr, refined) and Z[p] the answer (polished when refined). mmax
+ * (optional, k float64): max|M_p| where solved (code 0: M_p finite), else -1 -- for
+ * lcp_measure_batch, which then need not measure it again. */
 static PyObject *py_solve_batch(PyObject *self, PyObject *args)
 {
-    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op, *oacc = Py_None;
+    PyObject *oM, *oq, *od, *oZ, *oB, *oc, *op, *oacc = Py_None, *omx = Py_None;
     double tol;
     long long max_iter;
     int mode = 0;
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOdLOOOO|iO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
-                          &op, &mode, &oacc))
+    if (!PyArg_ParseTuple(args, "OOOdLOOOO|iOO", &oM, &oq, &od, &tol, &max_iter, &oZ, &oB, &oc,
+                          &op, &mode, &oacc, &omx))
         return NULL;
     if (mode != 0 && mode != 1) {
         PyErr_SetString(PyExc_ValueError, "mode: 0 or 1");
@@ -210,7 +212,12 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         goto b7;
     }
     if (oacc != Py_None && get_buffer(oacc, &va, "acc", 'd', 4 * k, 0) < 0) goto b7;
-    double *acc = (double *)va.buf, *zs = NULL;
+    Py_buffer vx = {0};
+    if (omx != Py_None && get_buffer(omx, &vx, "mmax", 'd', k, 0) < 0) {
+        release(&va);
+        goto b7;
+    }
+    double *acc = (double *)va.buf, *zs = NULL, *mx = (double *)vx.buf;
     int64_t *ab = NULL;
     Work w;
     int failed = work_init(&w, n, tol, NULL) < 0;
@@ -247,6 +254,7 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
                 if (code) memcpy(Z + p * n, zs, (size_t)n * sizeof(double));
                 acc[4 * p + 1] = res[0], acc[4 * p + 2] = res[1], acc[4 * p + 3] = res[2];
             }
+            if (mx) mx[p] = code == 0 ? bound[0] : -1.0; /* max|M|, M finite (fill_*) */
             codes[p] = code;
             piv[p] = pivots;
         }
@@ -254,6 +262,7 @@ static PyObject *py_solve_batch(PyObject *self, PyObject *args)
         free(zs);
         work_free(&w);
     }
+    release(&vx);
     release(&va);
     PyBuffer_Release(&vB);
     PyBuffer_Release(&vZ);
@@ -351,7 +360,8 @@ done:
 
 static PyMethodDef methods[] = {
     {"solve_batch", py_solve_batch, METH_VARARGS,
-     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None): k "
+     "solve_batch(Ms, qs, d, tol, max_iter, Z, basic_z, codes, pivots, mode=0, acc=None, "
+     "mmax=None): k "
      "LCPs by Lemke (and the acceptance of each answer into acc)."},
     {"solve_accept", py_solve_accept, METH_VARARGS,
      "solve_accept(M, q, tol, max_iter, z, basis) -> (code, pivots, nbasis, acode, berr, ferr, "
@@ -378,6 +388,10 @@ static PyMethodDef methods[] = {
      "PyArray_NewFromDescr (see lcp/_numpy_abi.h)."},
     {"array_probe", py_array_probe, METH_VARARGS,
      "array_probe(shape, integer) -> an array made by that route, entries 0, 1, 2, ..."},
+    {"array_fields", py_array_fields, METH_O,
+     "array_fields(arr) -> (address, nd, shape, strides, dtype, C-contiguous, writeable)."},
+    {"array_fields_use", py_array_fields_use, METH_O,
+     "array_fields_use(flag) -> bool: read plain float64 arrays' data from their fields."},
     {"gemv_setup", py_gemv_setup, METH_VARARGS,
      "gemv_setup(address, ilp64): numpy's cblas_dgemv for M z (0: none; see lcp/_blas.h)."},
     {"gemv", py_gemv, METH_VARARGS,
@@ -391,7 +405,7 @@ static PyMethodDef methods[] = {
     {"lcp_measure", py_lcp_measure, METH_VARARGS,
      "lcp_measure(M, q, z, Mz) -> (residual, scaled, z_s, w_s) or None; Mz becomes M z + q."},
     {"lcp_measure_batch", py_lcp_measure_batch, METH_VARARGS,
-     "lcp_measure_batch(Ms, qs, Z, MZ, out) -> bool: lcp_measure of k problems."},
+     "lcp_measure_batch(Ms, qs, Z, MZ, out, mmax=None) -> bool: lcp_measure of k problems."},
     {"abs_row_sums", py_abs_row_sums, METH_VARARGS,
      "abs_row_sums(M, out, n): out = the row sums of |M| (m x n), in numpy's order."},
     {"check", py_check, METH_VARARGS, "check(M, q) -> (all finite, min q)."},

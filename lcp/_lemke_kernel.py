@@ -97,7 +97,8 @@ def plain_finite(M, q) -> tuple[bool, float]:
 
 def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_iter: int,
                 Z: np.ndarray, basic: np.ndarray, codes: np.ndarray, pivots: np.ndarray,
-                equilibrate: bool = False, acc: np.ndarray | None = None) -> None:
+                equilibrate: bool = False, acc: np.ndarray | None = None,
+                mmax: np.ndarray | None = None) -> None:
     """k LCPs (Ms: k x n x n, qs: k x n, finite, C-contiguous) by Lemke in one compiled loop:
     z into Z, basic z's into basic (int8), status codes and pivots (int64). Only code SOLVED
     leaves a z; the others are to be solved again one by one for their evidence.
@@ -106,9 +107,10 @@ def solve_batch(Ms: np.ndarray, qs: np.ndarray, d: np.ndarray, tol: float, max_i
     acc (k x 4 float64): each solved answer also assessed on (M, q) as `lcp.acceptance.accuracy.
     assess_lcp` does in C, acc[p] = (acode, berr, ferr, refined) -- acode 0: done, Z[p] the
     answer (polished when refined); 1: to be judged in numpy; -1: numbers too large for the
-    fast check (solve it alone)."""
+    fast check (solve it alone). mmax (k float64): max|M_p| of each solved problem (its M then
+    finite), -1 for the others: `measure_batch` takes it instead of measuring it again."""
     _lemke_c.solve_batch(Ms, qs, d, float(tol), int(max_iter), Z, basic, codes, pivots,
-                         int(bool(equilibrate)), acc)
+                         int(bool(equilibrate)), acc, mmax)
 
 
 def solve_eq(M: np.ndarray, q: np.ndarray, r: np.ndarray | None, c: np.ndarray | None,
@@ -136,15 +138,16 @@ def measure(M: np.ndarray, q: np.ndarray, z: np.ndarray, Mz: np.ndarray
     return _lemke_c.lcp_measure(M, q, z, Mz)
 
 
-def measure_batch(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, MZ: np.ndarray
-                  ) -> np.ndarray | None:
+def measure_batch(Ms: np.ndarray, qs: np.ndarray, Z: np.ndarray, MZ: np.ndarray,
+                  mmax: np.ndarray | None = None) -> np.ndarray | None:
     """`measure` of k problems at once (Ms: k x n x n, qs, Z, MZ: k x n): a k x 4 array of
     (residual, scaled residual, z_s, w_s), NaN in the rows of problems not measured (MZ[p]
-    untouched there; the others become w = M z + q); None where `measure` gives None for all."""
+    untouched there; the others become w = M z + q); None where `measure` gives None for all.
+    mmax: `solve_batch`'s (max|M_p| where >= 0: not measured again; the same numbers)."""
     if not _use or qs.shape[-1] > sums_verified_upto():
         return None
     out = np.empty((qs.shape[0], 4))
-    return out if _lemke_c.lcp_measure_batch(Ms, qs, Z, MZ, out) else None
+    return out if _lemke_c.lcp_measure_batch(Ms, qs, Z, MZ, out, mmax) else None
 
 
 #: Row lengths the probe tries, in increasing order.
@@ -312,7 +315,31 @@ def numpy_arrays() -> bool:
                 _lemke_c.array_setup(None, np.dtype(np.float64), np.dtype(np.intp),
                                      np.ndarray)
             _arrays_found = ok
+            _lemke_c.array_fields_use(ok and _fields_read_as_numpy())
     return _arrays_found
+
+
+def _fields_read_as_numpy() -> bool:
+    """Does lcp/_numpy_abi.h read an array's data pointer, dimensions, strides, dtype and its
+    C-contiguous and writeable flags as numpy itself gives them? Checked on probes -- C and
+    Fortran order, a strided view, a view at an offset, read-only, 0-d to 2-d, float64 and
+    other dtypes -- before the C calls read plain float64 arrays' data from their fields
+    instead of asking for a buffer (`plain_f64`)."""
+    if not hasattr(_lemke_c, "array_fields"):
+        return False
+    base = np.arange(60.0).reshape(6, 10)
+    ro = np.ones((3, 3))
+    ro.flags.writeable = False
+    probes = [np.empty((30, 30)), np.empty(7), np.zeros(()), base, base[1:4, 2:5], base[:, ::2],
+              base.T, base[2], ro, np.asfortranarray(np.ones((4, 4))), np.ones(5, np.float32),
+              np.ones((2, 2), np.intp), np.empty((0, 3))]
+    for a in probes:
+        address, nd, shape, strides, dtype, c_contiguous, writeable = _lemke_c.array_fields(a)
+        if (address != a.__array_interface__["data"][0] or nd != a.ndim or shape != a.shape
+                or strides != a.strides or dtype is not a.dtype
+                or c_contiguous != a.flags["C_CONTIGUOUS"] or writeable != a.flags["WRITEABLE"]):
+            return False
+    return True
 
 
 numpy_arrays()

@@ -228,15 +228,18 @@ static PyObject *py_lcp_measure(PyObject *self, PyObject *args)
     return Py_BuildValue("dddd", out[0], out[1], out[2], out[3]);
 }
 
-/* lcp_measure_batch(Ms, qs, Z, MZ, out) -> bool: `lcp_measure` of k problems (Ms k n n, qs, Z,
- * MZ k n, out k 4 float64, C-contiguous): row p of out receives (residual, scaled, z_s, w_s)
- * and MZ[p] becomes w = M z + q, or out[p] is NaN (MZ[p] untouched) when a number is not
- * finite. False when the arrays are not as described. */
+/* lcp_measure_batch(Ms, qs, Z, MZ, out, mmax=None) -> bool: `lcp_measure` of k problems (Ms k n
+ * n, qs, Z, MZ k n, out k 4 float64, C-contiguous): row p of out receives (residual, scaled,
+ * z_s, w_s) and MZ[p] becomes w = M z + q, or out[p] is NaN (MZ[p] untouched) when a number is
+ * not finite. False when the arrays are not as described. mmax (k float64, solve_batch's):
+ * where mmax[p] >= 0, M_p is finite and max|M_p| = mmax[p] (measure_known: the row sums
+ * only; the maximum of finite numbers is the same in any order); else measured here. */
 static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
 {
-    PyObject *objs[5];
+    PyObject *objs[6] = {NULL, NULL, NULL, NULL, NULL, Py_None};
     (void)self;
-    if (!PyArg_ParseTuple(args, "OOOOO", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4]))
+    if (!PyArg_ParseTuple(args, "OOOOO|O", &objs[0], &objs[1], &objs[2], &objs[3], &objs[4],
+                          &objs[5]))
         return NULL;
     idx k = PyObject_Length(objs[1]), n = 0;
     Py_buffer vz;
@@ -245,17 +248,18 @@ static PyObject *py_lcp_measure_batch(PyObject *self, PyObject *args)
         PyBuffer_Release(&vz);
     }
     PyErr_Clear();
-    Py_buffer v[5];
-    idx sizes[5] = {k * n * n, k * n, k * n, k * n, 4 * k};
-    int writable[5] = {0, 0, 0, 1, 1};
-    if (n < 1 || get_doubles(objs, v, sizes, writable, 5) < 5) Py_RETURN_FALSE;
+    Py_buffer v[6];
+    idx sizes[6] = {k * n * n, k * n, k * n, k * n, 4 * k, k};
+    int writable[6] = {0, 0, 0, 1, 1, 0}, count = objs[5] == Py_None ? 5 : 6;
+    if (n < 1 || get_doubles(objs, v, sizes, writable, count) < count) Py_RETURN_FALSE;
     const double *Ms = (const double *)v[0].buf, *qs = (const double *)v[1].buf,
-                 *Z = (const double *)v[2].buf;
+                 *Z = (const double *)v[2].buf, *mx = count == 6 ? (const double *)v[5].buf : NULL;
     double *W = (double *)v[3].buf, *out = (double *)v[4].buf;
     for (idx p = 0; p < k; p++)
-        if (measure_one(n, Ms + p * n * n, qs + p * n, Z + p * n, W + p * n, out + 4 * p) < 0)
+        if (measure_known(n, Ms + p * n * n, qs + p * n, Z + p * n, W + p * n, out + 4 * p,
+                          mx ? mx[p] : -1.0) < 0)
             for (int j = 0; j < 4; j++) out[4 * p + j] = 0.0 / 0.0;
-    for (int i = 0; i < 5; i++) PyBuffer_Release(&v[i]);
+    for (int i = 0; i < count; i++) PyBuffer_Release(&v[i]);
     Py_RETURN_TRUE;
 }
 

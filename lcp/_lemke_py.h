@@ -237,6 +237,15 @@ static int get_float64(PyObject *obj, Py_buffer *view, const char *name, idx siz
     return 0;
 }
 
+/* Are the n x n entries of M and the n of q all finite? */
+static int finite_data(const double *M, const double *q, idx n)
+{
+    double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
+    int all = abs_max_finite(M, n * n, &top);
+    for (idx i = 0; i < n; i++) all &= fabs(q[i]) <= DBL_MAX;
+    return all;
+}
+
 /* Are oq a C-contiguous native float64 vector of n >= 1 entries and oM a C-contiguous native
  * float64 n x n matrix (all entries finite, when `finite`)? Returns n, with both buffers held
  * (the caller releases vM and vq), or 0 with none held, never an error. */
@@ -256,13 +265,7 @@ static idx plain_arrays(PyObject *oM, PyObject *oq, Py_buffer *vM, Py_buffer *vq
     int ok = n >= 1 && (fq ? vq->itemsize == 8 : native_double(vq)) &&
              (fM ? vM->itemsize == 8 : native_double(vM)) && vM->ndim == 2 &&
              vM->shape[0] == n && vM->shape[1] == n;
-    if (ok && finite) {
-        const double *M = (const double *)vM->buf, *q = (const double *)vq->buf;
-        double top = 0.0; /* as `check`: |x| <= DBL_MAX false for inf and NaN; 4 lanes wide */
-        int all = abs_max_finite(M, n * n, &top);
-        for (idx i = 0; i < n; i++) all &= fabs(q[i]) <= DBL_MAX;
-        ok = all;
-    }
+    if (ok && finite) ok = finite_data((const double *)vM->buf, (const double *)vq->buf, n);
     if (ok) return n;
     PyBuffer_Release(vM);
     PyBuffer_Release(vq);
@@ -360,18 +363,28 @@ static PyObject *copy_of(int nd, const Py_ssize_t *dims, const void *src, idx by
 /* The quick route on obj: 1 (the four slots set), 0 (declined: nothing set) or -1 (error). */
 static int lcp_quick(PyObject *obj, PyObject *oM, PyObject *oq, PyObject *name, PyObject *meta)
 {
-    Py_buffer vM, vq;
-    idx n;
+    Py_buffer vM = {0}, vq = {0};
+    idx n = 0;
     if (s_lcp_off[0] <= 0 || !PyObject_TypeCheck(obj, (PyTypeObject *)s_lcp_cls) ||
-        Py_TYPE(oM) != (PyTypeObject *)s_lcp_ndarray ||
-        Py_TYPE(oq) != (PyTypeObject *)s_lcp_ndarray || !(n = plain_buffers(oM, oq, &vM, &vq)))
+        Py_TYPE(oM) != (PyTypeObject *)s_lcp_ndarray || Py_TYPE(oq) != (PyTypeObject *)s_lcp_ndarray)
         return 0;
+    /* plain float64 arrays: their data read from their fields (_numpy_abi.h), else buffers */
+    const ArrayFields *af = (const ArrayFields *)oq;
+    if (s_fields_ok && af->nd == 1) n = af->dimensions[0];
+    const double *qd = n >= 1 ? plain_f64(oq, s_f64, 1, n, 0) : NULL,
+                 *Md = qd ? plain_f64(oM, s_f64, 2, n, 0) : NULL;
+    if (Md) {
+        if (!finite_data(Md, qd, n)) return 0;
+    } else {
+        if (!(n = plain_buffers(oM, oq, &vM, &vq))) return 0;
+        Md = (const double *)vM.buf, qd = (const double *)vq.buf;
+    }
     PyObject *v[4] = {NULL, NULL, name, meta};
     const Py_ssize_t dims[2] = {n, n};
-    v[0] = copy_of(2, dims, vM.buf, n * n * 8);
-    v[1] = v[0] ? copy_of(1, dims, vq.buf, n * 8) : NULL;
-    PyBuffer_Release(&vM);
-    PyBuffer_Release(&vq);
+    v[0] = copy_of(2, dims, Md, n * n * 8);
+    v[1] = v[0] ? copy_of(1, dims, qd, n * 8) : NULL;
+    if (vM.obj) PyBuffer_Release(&vM);
+    if (vq.obj) PyBuffer_Release(&vq);
     if (v[1] && v[3] == Py_None && !(v[3] = PyDict_New())) Py_CLEAR(v[1]);
     else if (v[1] && v[3] != Py_None) Py_INCREF(v[3]);
     if (!v[1]) {

@@ -163,11 +163,19 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
     PyObject *result = NULL, *z = NULL, *w = NULL, *basis = NULL;
     void *zp, *wp, *bp;
     int64_t bbuf[64], *b = NULL;
-    idx n = problem_data(oM, oq, &vM, &vq);
-    if (n < 0) goto done;
-    if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
-        PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
-        goto done;
+    /* plain float64 arrays: their data read from their fields (_numpy_abi.h), else buffers */
+    const ArrayFields *af = (const ArrayFields *)oq;
+    idx n = s_fields_ok && Py_TYPE(oq) == s_arr_type && af->nd == 1 ? af->dimensions[0] : 0;
+    const double *qf = n >= 1 ? plain_f64(oq, s_f64, 1, n, 1) : NULL,
+                 *Mf = qf ? plain_f64(oM, s_f64, 2, n, 1) : NULL;
+    if (!Mf) {
+        n = problem_data(oM, oq, &vM, &vq);
+        if (n < 0) goto done;
+        if (vq.ndim != 1 || vM.ndim != 2 || vM.shape[0] != n || vM.shape[1] != n) {
+            PyErr_SetString(PyExc_ValueError, "M must be n x n and q of length n");
+            goto done;
+        }
+        Mf = (const double *)vM.buf, qf = (const double *)vq.buf;
     }
     if (max_iter < 0) max_iter = 1000 + 100 * (long long)n;
     if (!(z = new_array_of(1, &n, 0, s_empty, s_intp, &zp)) ||
@@ -178,7 +186,7 @@ static PyObject *lcp_answer(PyObject *oM, PyObject *oq, double tol, long long ma
         PyErr_NoMemory();
         goto done;
     }
-    const double *M = (const double *)vM.buf, *q = (const double *)vq.buf;
+    const double *M = Mf, *q = qf;
     double *zd = (double *)zp, *wd = (double *)wp;
     long long pivots = 0;
     double res[3], got[4] = {NAN, NAN, 0.0, 0.0};

@@ -100,6 +100,86 @@ static PyObject *new_array_of(int nd, const Py_ssize_t *dims, int integer, PyObj
     return arr;
 }
 
+/* The fields numpy's PyArray_DATA / NDIM / DIMS / STRIDES / DESCR / FLAGS macros read, in the
+ * order of PyArrayObject_fields (numpy 1.x and 2.x alike: the ABI array_setup checked). Read
+ * only when s_fields_ok: lcp/_lemke_kernel.py's `numpy_arrays` compares what array_fields
+ * reads with numpy's own attributes on probes (C and Fortran order, views, read-only, 0-d to
+ * 2-d, float64 and others) and sets it with array_fields_use(True). */
+typedef struct {
+    PyObject_HEAD
+    char *data;
+    int nd;
+    Py_ssize_t *dimensions;
+    Py_ssize_t *strides;
+    PyObject *base;
+    PyObject *descr;
+    int flags;
+} ArrayFields;
+#define ARR_C_CONTIGUOUS 0x0001
+#define ARR_WRITEABLE 0x0400
+#define ARR_WARN_ON_WRITE (1u << 31) /* numpy's private flag: a write warns (buffer route) */
+static int s_fields_ok;
+
+/* array_fields(arr) -> (data address, nd, shape, strides, descr, C-contiguous, writeable): the
+ * fields as read here (arr an ndarray exactly), for the check. */
+static PyObject *py_array_fields(PyObject *self, PyObject *arr)
+{
+    (void)self;
+    if (!s_arr_type || Py_TYPE(arr) != s_arr_type) {
+        PyErr_SetString(PyExc_TypeError, "array_fields: a numpy.ndarray (after array_setup)");
+        return NULL;
+    }
+    const ArrayFields *a = (const ArrayFields *)arr;
+    if (a->nd < 0 || a->nd > 32) {
+        PyErr_SetString(PyExc_ValueError, "array_fields: nd out of range");
+        return NULL;
+    }
+    PyObject *shape = PyTuple_New(a->nd), *strides = PyTuple_New(a->nd);
+    for (int k = 0; shape && strides && k < a->nd; k++) {
+        PyTuple_SET_ITEM(shape, k, PyLong_FromSsize_t(a->dimensions[k]));
+        PyTuple_SET_ITEM(strides, k, PyLong_FromSsize_t(a->strides[k]));
+    }
+    PyObject *out = shape && strides && !PyErr_Occurred()
+                        ? Py_BuildValue("(KiOOOOO)", (unsigned long long)(uintptr_t)a->data, a->nd,
+                                        shape, strides, a->descr,
+                                        (a->flags & ARR_C_CONTIGUOUS) ? Py_True : Py_False,
+                                        (a->flags & ARR_WRITEABLE) ? Py_True : Py_False)
+                        : NULL;
+    Py_XDECREF(shape);
+    Py_XDECREF(strides);
+    return out;
+}
+
+/* array_fields_use(flag) -> flag: the route of plain_f64 on or off. */
+static PyObject *py_array_fields_use(PyObject *self, PyObject *flag)
+{
+    (void)self;
+    int on = PyObject_IsTrue(flag);
+    if (on < 0) return NULL;
+    s_fields_ok = on && s_arr_type != NULL;
+    return PyBool_FromLong(s_fields_ok);
+}
+
+/* The data of obj when it is exactly a numpy.ndarray whose dtype object is `f64` (numpy's
+ * float64 itself: native doubles), C-contiguous (and writeable, when `writeable`), of nd (1 or
+ * 2) dimensions all equal to n: read from its fields, without a buffer request (numpy builds and caches a buffer
+ * description at an array's first request: 0.1 us for each new M and q of the natural call);
+ * else NULL (the caller asks for a buffer, with its checks and errors). The array is the
+ * caller's, held for as long as the pointer is used. */
+static const double *plain_f64(PyObject *obj, PyObject *f64, int nd, Py_ssize_t n,
+                               int writeable)
+{
+    if (!s_fields_ok || Py_TYPE(obj) != s_arr_type) return NULL;
+    const ArrayFields *a = (const ArrayFields *)obj;
+    const unsigned int flags = (unsigned int)a->flags,
+                       need = ARR_C_CONTIGUOUS | (writeable ? ARR_WRITEABLE : 0);
+    if (a->descr != f64 || a->nd != nd || (flags & ARR_WARN_ON_WRITE) || (flags & need) != need)
+        return NULL;
+    for (int k = 0; k < nd; k++)
+        if (a->dimensions[k] != n) return NULL;
+    return (const double *)a->data;
+}
+
 static PyObject *py_array_probe(PyObject *self, PyObject *args)
 {
     PyObject *shape;

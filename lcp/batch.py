@@ -17,11 +17,13 @@ the same z, pivots and status (tests/lcp/test_batch.py).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from types import SimpleNamespace
 
 import numpy as np
 
 import rigidlcp.lcp._lemke_kernel as _kernel
 
+from .acceptance import accuracy as _accuracy
 from .acceptance.accuracy import judge_lcp
 from .api import check_options, get_method, solve
 from .problems.problem import LCP, MLCP, InvalidProblem
@@ -31,6 +33,25 @@ _Q_NONNEGATIVE = "q >= 0: z = 0 solves the LCP"  # lemke()'s message, as it give
 #: Methods whose batch path runs the whole loop over the problems in compiled code (the others
 #: are a loop of their Python function with one lookup and one option check).
 COMPILED_BATCH = ("lemke",)
+_MODULES: SimpleNamespace | None = None
+
+
+def _modules() -> SimpleNamespace:
+    """The modules solve_many's steps use that this module does not import when it is loaded
+    (they import lcp.api, which imports this module, or are not needed by every caller):
+    imported on the first call, then kept. A function-level import statement costs ~0.7 us at
+    every call even when the module is loaded (the name's resolution); solve_many made eight,
+    a quarter of `solve_many([p])`'s time (issue 23). Their names are read from the modules at
+    each use, so a module attribute changed later (a test's monkeypatch) is seen."""
+    global _MODULES
+    if _MODULES is None:
+        from .acceptance import residual, scaling
+        from .problems import friction
+        from .solvers import fast_lemke, lemke  # fast_lemke's: the C calls' objects
+
+        _MODULES = SimpleNamespace(residual=residual, scaling=scaling, friction=friction,
+                                   fast_lemke=fast_lemke, lemke=lemke)
+    return _MODULES
 
 
 def solve_many(
@@ -55,7 +76,7 @@ def solve_many(
             problems[0], (LCP, MLCP)):
         Ms, qs = _stacked(*problems)
         return _solve_stack(Ms, qs, method, options, lambda i: LCP(Ms[i], qs[i]), repair)
-    from .problems.friction import FrictionContact2D
+    FrictionContact2D = _modules().friction.FrictionContact2D
 
     problems = list(problems)
     stacks = _stack_lcps(problems)
@@ -96,9 +117,7 @@ def _stack_lcps(problems: list) -> list | None:
     an lcp.LCP whose M is C-contiguous native float64 (n x n) and q a float64 vector: for each
     size, in the order of its first problem, (n, indices, Ms, qs) with the stacks
     np.concatenate would make; else None (and when the C calls are not built)."""
-    from .solvers.fast_lemke import _solve_lcp  # its import gives the C calls their objects
-
-    if _solve_lcp is None:
+    if _modules().fast_lemke._solve_lcp is None:
         return None
     return _kernel._lemke_c.stack_lcps(problems, LCP)
 
@@ -128,8 +147,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
     method runs on the Ruiz-equilibrated data when it is registered so, and each answer is
     checked on the problem passed (lcp.residual); an answer that is not an accepted "solved"
     is redone by `solve` itself (repairs, certificates of infeasibility)."""
-    from .acceptance.scaling import ruiz
-
+    ruiz = _modules().scaling.ruiz
     k, n = qs.shape
     info = get_method(method)
     on = info.equilibrate
@@ -162,9 +180,7 @@ def _solve_stack(Ms: np.ndarray, qs: np.ndarray, method: str, options: dict,
 
 
 def _builtin_lemke():
-    from .solvers.lemke import lemke
-
-    return lemke
+    return _modules().lemke.lemke
 
 
 def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, problem_of,
@@ -176,26 +192,25 @@ def _lemke_batch(Ms: np.ndarray, qs: np.ndarray, on: bool, options: dict, proble
     `check`): each answer judged once. A problem not solved or not accepted there -- a ray, a
     limit, a cycle, an M that is not balanced, an answer that fails the test -- is solved by
     `solve` itself, which answers it as a single call does."""
-    from .acceptance.accuracy import FERR_TOL, _accuracy_c
-    from .acceptance.residual import TOL
-    from .solvers.fast_lemke import _solve_lcp  # its import gives the C calls their objects
-    from .solvers.lemke import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
-
+    mods = _modules()
+    FERR_TOL, _accuracy_c = _accuracy.FERR_TOL, _accuracy._accuracy_c
+    TOL, _solve_lcp, lemke = mods.residual.TOL, mods.fast_lemke._solve_lcp, mods.lemke
     k, n = qs.shape
-    d = _covering_vector(options.get("d"), n)
-    max_iter = _check_max_iter(options.get("max_iter"), n)
-    tol = _check_tol(options.get("tol", DEFAULT_TOL))
+    d = lemke._covering_vector(options.get("d"), n)
+    max_iter = lemke._check_max_iter(options.get("max_iter"), n)
+    tol = lemke._check_tol(options.get("tol", lemke.DEFAULT_TOL))
     Z = np.empty((k, n))
     basic = np.empty((k, n), dtype=np.int8)
     codes = np.empty(k, dtype=np.int64)
     pivots = np.empty(k, dtype=np.int64)
     # acceptance in C only where judge_lcp would use it (the C `assess` built)
     acc = np.empty((k, 4)) if _accuracy_c is not None else None
+    mmax = np.empty(k)  # max|M| of each solved problem, from the solve: not measured again
     _kernel.solve_batch(Ms, qs, np.ascontiguousarray(d), tol, max_iter, Z, basic, codes, pivots,
-                        equilibrate=on, acc=acc)
+                        equilibrate=on, acc=acc, mmax=mmax)
     with np.errstate(all="ignore"):  # as `check`: an overflow is measured, never accepted
         W = np.matmul(Ms, Z[:, :, None])[:, :, 0]  # each M.dot(z): the same gemv
-    measured = _kernel.measure_batch(Ms, qs, Z, W)
+    measured = _kernel.measure_batch(Ms, qs, Z, W, mmax)
     if measured is None:  # not compiled as numpy sums: measure one by one
         return [solve(problem_of(i), "lemke", repair=repair, **options) for i in range(k)]
     if acc is None:  # every answer to judge_lcp
@@ -217,9 +232,7 @@ def _finish(i: int, Ms, qs, Z, W, basic, codes, pivots, acc, measured, on: bool,
     judge_lcp's verdict on the numbers of the C loop (lcp.residual's TOL, lcp.accuracy's
     FERR_TOL; a NaN fails every test), numpy's judge_lcp where the C acceptance did not handle
     the answer, else `solve` itself, which answers it as a single call does."""
-    from .acceptance.accuracy import FERR_TOL
-    from .acceptance.residual import TOL
-
+    FERR_TOL, TOL = _accuracy.FERR_TOL, _modules().residual.TOL
     acode, berr, ferr, refined = acc[i].tolist()
     raw, scaled = measured[i, :2].tolist()
     piv = int(pivots[i])

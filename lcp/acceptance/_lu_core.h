@@ -36,11 +36,72 @@ static void row_update(double *ai, const double *ak, double l, idx len)
 #define row_update row_update_plain
 #endif
 
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
+#define LU_HAVE_AVX2 1
+/* `lu` below where the CPU has AVX2: the same operations on every entry (each multiplier
+ * l = A[i, k] / piv one correctly rounded division, each update a product then a difference,
+ * no fused multiply-add), four at a time -- the multipliers of a step, then each row's update
+ * -- so the same numbers and the same verdict. */
+__attribute__((target("avx2"))) static int lu_avx2(idx m, double *A, idx *perm)
+{
+    double umax = 0.0, umin = INFINITY;
+    for (idx k = 0; k < m; k++) {
+        idx p = k;
+        for (idx i = k + 1; i < m; i++)
+            if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
+        perm[k] = p;
+        if (A[p * m + k] == 0.0) return -1;
+        if (p != k)
+            for (idx j = 0; j < m; j++) {
+                double t = A[k * m + j];
+                A[k * m + j] = A[p * m + j];
+                A[p * m + j] = t;
+            }
+        double piv = A[k * m + k];
+        const __m256d vp = _mm256_set1_pd(piv);
+        idx i = k + 1;
+        for (; i + 4 <= m; i += 4) {  /* the multipliers of step k, four divisions at once */
+            double *a0 = A + i * m + k, *a1 = a0 + m, *a2 = a1 + m, *a3 = a2 + m;
+            double l[4];
+            _mm256_storeu_pd(l, _mm256_div_pd(_mm256_set_pd(*a3, *a2, *a1, *a0), vp));
+            *a0 = l[0], *a1 = l[1], *a2 = l[2], *a3 = l[3];
+        }
+        for (; i < m; i++) A[i * m + k] /= piv;
+        const double *ak = A + k * m + k + 1;
+        const idx len = m - k - 1;
+        for (i = k + 1; i < m; i++) {
+            const double l = A[i * m + k];
+            if (l == 0.0) continue;
+            double *ai = A + i * m + k + 1;
+            const __m256d vl = _mm256_set1_pd(l);
+            idx j = 0;
+            for (; j + 4 <= len; j += 4)
+                _mm256_storeu_pd(ai + j, _mm256_sub_pd(_mm256_loadu_pd(ai + j),
+                                                       _mm256_mul_pd(vl, _mm256_loadu_pd(ak + j))));
+            for (; j < len; j++) ai[j] -= l * ak[j];
+        }
+        umax = dmax(umax, fabs(piv));
+        umin = dmin(umin, fabs(piv));
+    }
+    return (m > 0 && !(umin > (double)m * DBL_EPSILON * umax)) ? -1 : 0;
+}
+static int lu_avx2_ok = -1; /* -1: not decided yet */
+#else
+#define LU_HAVE_AVX2 0
+#endif
+
 /* LU with partial pivoting of A (m x m, row-major, in place: L below the diagonal, U on and
  * above; perm[k] the row swapped with k at step k). -1 if U is singular to working precision:
  * a pivot below m eps times the largest (the numpy code then decides, by its SVD path). */
 static int lu(idx m, double *A, idx *perm)
 {
+#if LU_HAVE_AVX2
+    if (lu_avx2_ok < 0) {
+        __builtin_cpu_init();
+        lu_avx2_ok = __builtin_cpu_supports("avx2") ? 1 : 0;
+    }
+    if (lu_avx2_ok) return lu_avx2(m, A, perm);
+#endif
     double umax = 0.0, umin = INFINITY;
     for (idx k = 0; k < m; k++) {
         idx p = k;

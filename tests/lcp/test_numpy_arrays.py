@@ -8,6 +8,11 @@ ninth pass) are the arrays numpy.empty made before, and no answer changes with t
   off (numpy.empty called from C, as before) the Solutions are the same, field for field, bit
   for bit, and so are the arrays' properties.
 * array_setup refuses what is not numpy's table for this ndarray type (then numpy.empty runs).
+* The C call reads a plain float64 M and q's data from their array fields (no buffer request,
+  session 10): `_fields_read_as_numpy` finds the fields read as numpy gives them, and with that
+  route off (buffers, as before) every outcome is the same -- Solutions field for field, bit
+  for bit, on every kind and size; the arrays the route declines (views, Fortran order,
+  read-only, another dtype object or type, other shapes) give the same answer, tuple or error.
 """
 
 from __future__ import annotations
@@ -126,3 +131,73 @@ def test_array_setup_refuses_what_is_not_numpys_table(restore):
     sol, _ = natural(np.eye(2), -np.ones(2))  # numpy.empty from C: the same Solution
     route(True)
     assert same_outcome(sol, natural(np.eye(2), -np.ones(2))[0])
+
+
+def fields_route(on: bool) -> None:
+    assert kernel._lemke_c.array_fields_use(on) == on
+
+
+def direct(M, q):
+    """The C call on the arrays as given: its Solution, its tuple (as plain values and bytes),
+    or the type of its error."""
+    from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL
+
+    try:
+        out = kernel._lemke_c.solve_lcp(M, q, DEFAULT_TOL, -1, kernel.sums_verified_upto())
+    except (ValueError, TypeError, BufferError) as exc:
+        return type(exc)
+    if isinstance(out, tuple):
+        return tuple(x.tobytes() if isinstance(x, np.ndarray) else x for x in out)
+    return out
+
+
+@compiled
+def test_the_array_fields_are_read_as_numpy_gives_them():
+    assert kernel._fields_read_as_numpy()
+    a = np.arange(24.0).reshape(4, 6)[1:, ::3]
+    address, nd, shape, strides, dtype, c_contiguous, writeable = kernel._lemke_c.array_fields(a)
+    assert (address, nd, shape, strides) == (a.__array_interface__["data"][0], 2, (3, 2),
+                                             (48, 24))
+    assert dtype is a.dtype and not c_contiguous and writeable
+
+
+@compiled
+@pytest.mark.parametrize("kind", ["psd", "general", "scaled", "degenerate", "ties"])
+@pytest.mark.parametrize("n", (1, 2, *SIZES))
+def test_the_same_answers_with_the_field_route_off(n, kind):
+    M, q = _problem(n, kind, 1)
+    try:
+        on = natural(M, q)
+        fields_route(False)
+        off = natural(M, q)
+    finally:
+        fields_route(True)
+    assert same_outcome(on[0], off[0]) and on[1] == off[1]
+
+
+_ro = np.eye(3) + 0.5
+_ro.flags.writeable = False
+
+
+@compiled
+@pytest.mark.parametrize("M, q", [
+    (np.eye(3) + 0.5, -np.ones(3)),                               # plain: the route
+    (np.asfortranarray(np.eye(3) + 0.5), -np.ones(3)),            # Fortran order
+    ((np.eye(6) + 0.5)[::2, ::2], -np.ones(3)),                   # a strided view
+    ((np.eye(4) + 0.5)[1:, 1:].copy(), -np.ones(4)[1:]),          # q a view at an offset
+    (_ro, -np.ones(3)),                                           # read-only
+    (np.eye(3) + 0.5, -np.ones((3, 1))),                          # q a column
+    (np.eye(3) + 0.5, np.array(-1.0)),                            # q 0-d
+    (np.eye(3) + 0.5, -np.ones(4)),                               # sizes differ
+    (np.eye(3, dtype=np.float32), -np.ones(3)),                   # another float type
+    (np.eye(3) + np.zeros(3, np.dtype(np.float64, metadata={"a": 1})), -np.ones(3)),
+])
+def test_the_arrays_the_field_route_declines_are_answered_as_before(M, q):
+    try:
+        on = direct(M, q)
+        fields_route(False)
+        off = direct(M, q)
+    finally:
+        fields_route(True)
+    assert type(on) is type(off)
+    assert same_outcome(on, off) if hasattr(on, "z") else on == off

@@ -11,6 +11,8 @@
   validation gives (values, dtype, layout, own copies), and every other input -- NaN, Inf,
   wrong shapes, Fortran order, views, integers, lists, complex -- is validated or refused
   exactly as before.
+* `solve_batch`'s max|M| of each solved problem, handed to `measure_batch` (solve_many), gives
+  the measure that measures max|M| itself, to the bit.
 """
 
 from __future__ import annotations
@@ -250,3 +252,45 @@ def test_c_assess_singularity_test_across_conditioning(k):
         assert code == 1
     elif skeel * m * np.finfo(float).eps < 0.01:
         assert code == 0
+
+
+@compiled
+@pytest.mark.parametrize("kind", ["psd", "general", "scaled", "degenerate", "ties"])
+@pytest.mark.parametrize("n", (3, 8, 10, 17, 31, 33))
+def test_the_batch_measure_with_the_solves_max_is_the_measure(n, kind):
+    """solve_batch's mmax is max|M_p| exactly where it solved problem p (-1 elsewhere: rays,
+    limits, an M that is not balanced), and measure_batch given it measures every problem to
+    the same bits as measuring max|M_p| itself (residual, scaled residual, z_s, w_s, w)."""
+    _check_batch_measure(n, kind, range(4))
+
+
+@compiled
+@settings(max_examples=40)
+@given(st.integers(1, 40), st.sampled_from(["psd", "general", "scaled", "degenerate"]),
+       st.integers(0, 2**32 - 1))
+def test_the_batch_measure_with_the_solves_max_is_the_measure_on_random_problems(n, kind, seed):
+    """The same, on random sizes and seeds."""
+    _check_batch_measure(n, kind, range(seed, seed + 3))
+
+
+def _check_batch_measure(n: int, kind: str, seeds) -> None:
+    from rigidlcp.lcp.solvers.lemke import DEFAULT_TOL
+
+    pairs = [_problem(n, kind, seed) for seed in seeds]
+    Ms, qs = np.stack([M for M, _ in pairs]), np.stack([q for _, q in pairs])
+    k = len(pairs)
+    Z, basic = np.empty((k, n)), np.empty((k, n), dtype=np.int8)
+    codes, pivots = np.empty(k, dtype=np.int64), np.empty(k, dtype=np.int64)
+    acc, mmax = np.empty((k, 4)), np.full(k, np.nan)
+    kernel.solve_batch(Ms, qs, np.ones(n), DEFAULT_TOL, 1000 + 100 * n, Z, basic, codes, pivots,
+                       equilibrate=True, acc=acc, mmax=mmax)
+    for p in range(k):
+        expected = np.abs(Ms[p]).max() if codes[p] == kernel.SOLVED else -1.0
+        assert mmax[p] == expected, (p, codes[p])
+    W = np.matmul(Ms, Z[:, :, None])[:, :, 0]
+    W_own, W_given = W.copy(), W.copy()
+    own = kernel.measure_batch(Ms, qs, Z, W_own)
+    given_max = kernel.measure_batch(Ms, qs, Z, W_given, mmax)
+    assert own is not None and given_max is not None
+    assert own.tobytes() == given_max.tobytes()
+    assert W_own.tobytes() == W_given.tobytes()
