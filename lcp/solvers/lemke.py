@@ -104,6 +104,11 @@ def lemke(
             exact.message = f"{sol.message}; rerun in exact rational arithmetic: " + (
                 exact.message or exact.status)
             return exact
+        if exact.status == "ray" and sol.status == "ray":  # rounding is not the cause
+            sol.info["exact_rerun"] = "ray"
+            sol.message += ("; the rerun in exact rational arithmetic ends on a secondary ray "
+                            f"too (after {exact.iterations} pivots): the ray is Lemke's on "
+                            "these data, not rounding")
     retry = tol  # larger n: restart with ties decided more coarsely
     while sol.info.get("cycling") and retry < 1e-6:
         retry *= 100.0
@@ -376,4 +381,6 @@ class _Lemke:
             return False, ("M + M^T is PSD (copositive-plus), so in exact arithmetic this ray "
                            "proves infeasibility, but its certificate fails numerically "
                            f"(max M^T y = {slack:.3g}, q^T y = {qTy:.3g}): numerical trouble")
-        return False, "M is not known to be copositive-plus: the ray proves nothing"
+        return False, ("ray (Lemke's termination; no proof of infeasibility): M is not known "
+                       "to be copositive-plus, and on such M Lemke's method can end on a "
+                       "secondary ray of an LCP that has solutions")
