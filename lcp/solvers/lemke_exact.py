@@ -8,6 +8,9 @@ repeats a basis (CPS Thm 4.9.4). `lemke_exact` runs the same algorithm on the da
 (every double is a rational number) with python-flint's exact rationals: each pivot is exact,
 each tie is decided exactly. It is the fall-back of lcp.lemke when the float run cycles or
 ends on a ray that proves nothing (small n only: the entries' sizes grow with the pivots).
+For a cycling run of larger n, `ExactTies` keeps the pivots in floats and decides exactly
+only the ratio ties that rounding may have decided (`ambiguous_tie`), from the data and the
+current basis; `with_exact_ties` is that rerun.
 
 Tableau: [I, -M, -d | q] with basis {w}, i.e. w - M z - d z0 = q; the basic variables are
 x_B = rhs - col t along an entering column. Variables: w_i = i, z_i = n + i, z0 = 2n.
