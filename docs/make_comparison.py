@@ -160,6 +160,10 @@ def good_for(results, method: str, summaries_by_set: dict) -> str:
     if unproved:
         parts.append(f"{unproved} claim{'s' if unproved > 1 else ''} of no solution without "
                      "a proof (no exact Farkas certificate: a failure, not an answer)")
+    rays = sum(r.outcome == "ray" for r in mine)
+    if rays:
+        parts.append(f"{rays} secondary ray{'s' if rays > 1 else ''} (Lemke's termination; no "
+                     "proof of infeasibility and no claim of it: a failure, not an answer)")
     if refused:
         parts.append(f"does not take {', '.join(refused)}")
     return "; ".join(parts) or "-"

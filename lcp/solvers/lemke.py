@@ -31,7 +31,15 @@ from ..acceptance.farkas import numerically_psd
 from ..problems.problem import InvalidProblem, as_matrix, as_vector
 from ..problems.solution import Solution
 from ..registry import register
-from .lemke_exact import EXACT_MAX_N, EXACT_RAY_MAX_N, lemke_exact
+from .lemke_exact import (
+    EXACT_MAX_N,
+    EXACT_RAY_MAX_N,
+    EXACT_TIES_MAX_N,
+    ExactTies,
+    ambiguous_tie,
+    lemke_exact,
+    with_exact_ties,
+)
 from .lemke_options import DEFAULT_TOL, _check_max_iter, _check_tol, _covering_vector
 
 __all__ = ["lemke", "DEFAULT_TOL", "_check_max_iter", "_check_tol", "_covering_vector"]
@@ -104,6 +112,14 @@ def lemke(
             exact.message = f"{sol.message}; rerun in exact rational arithmetic: " + (
                 exact.message or exact.status)
             return exact
+        if exact.status == "ray" and sol.status == "ray":  # rounding is not the cause
+            sol.info["exact_rerun"] = "ray"
+            sol.message += ("; the rerun in exact rational arithmetic ends on a secondary ray "
+                            f"too (after {exact.iterations} pivots): the ray is Lemke's on "
+                            "these data, not rounding")
+    if sol.info.get("cycling") and n <= EXACT_TIES_MAX_N:  # floats, ambiguous ties exact
+        sol = with_exact_ties(sol, lambda ties: _Lemke(M, q, d, tol, ties).run(max_iter),
+                              M, q, d)
     retry = tol  # larger n: restart with ties decided more coarsely
     while sol.info.get("cycling") and retry < 1e-6:
         retry *= 100.0
@@ -124,9 +140,11 @@ class _Lemke:
     w~ = w / nu, and every tolerance is absolute in these units.
     """
 
-    def __init__(self, M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float):
+    def __init__(self, M: np.ndarray, q: np.ndarray, d: np.ndarray, tol: float,
+                 exact: ExactTies | None = None):
         n = q.size
         self.n, self.M, self.q, self.d, self.tol = n, M, q, d, tol
+        self.exact, self.entering = exact, 2 * n  # exact ties: the numpy loop decides them
         T = np.empty((n, n + 2), order="F")
         if _kernel.enabled():
             self.mu, self.nu, self.delta = _kernel.setup(T, M, q, d)
@@ -198,6 +216,10 @@ class _Lemke:
         z0_row = self.row_of[2 * self.n]
         if z0_row >= 0 and np.any(rows == z0_row):
             return z0_row
+        if self.exact is not None and ambiguous_tie(self, rows, alpha, theta[tied]):
+            r = self.exact.choose(self.basic, self.entering, rows)
+            if r is not None:
+                return r
         return self.lexico_min(rows, alpha)
 
     def lexico_min(self, rows: np.ndarray, alpha: np.ndarray) -> int:
@@ -242,7 +264,7 @@ class _Lemke:
 
     # -- the run --------------------------------------------------------------------------
     def run(self, max_iter: int) -> Solution:
-        if _kernel.enabled():
+        if _kernel.enabled() and self.exact is None:
             return _kernel.run(self, max_iter)  # the same loop in C
         n, tol, T, slot_of = self.n, self.tol, self.T, self.slot_of
         beta = T[:, n + 1]
@@ -275,7 +297,7 @@ class _Lemke:
             if pivots >= max_iter:
                 return self.stopped(pivots)
             entering = leaving + n if leaving < n else leaving - n
-            ent = entering
+            ent = self.entering = entering
             s = slot_of[entering]
             a = T[:, s]
             amax = -float(amin_of(a))  # the largest pivot candidate alpha_i = -a_i
@@ -376,4 +398,6 @@ class _Lemke:
             return False, ("M + M^T is PSD (copositive-plus), so in exact arithmetic this ray "
                            "proves infeasibility, but its certificate fails numerically "
                            f"(max M^T y = {slack:.3g}, q^T y = {qTy:.3g}): numerical trouble")
-        return False, "M is not known to be copositive-plus: the ray proves nothing"
+        return False, ("ray (Lemke's termination; no proof of infeasibility): M is not known "
+                       "to be copositive-plus, and on such M Lemke's method can end on a "
+                       "secondary ray of an LCP that has solutions")

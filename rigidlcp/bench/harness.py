@@ -8,7 +8,7 @@ per solve, and every answer is checked here, never taken from the solver:
   does a point the check accepts on an LCP with an exact Farkas certificate (no feasible
   point exists: Drake's Moby returns z ~ 1e14 with w negative by O(1) on the infeasible set,
   which the scaled measures accept);
-* a claim that no solution exists ("infeasible", or Lemke's "ray") is accepted only with the
+* a claim that no solution exists ("infeasible") is accepted only with the
   project's own proof, the one `lcp.solve` needs for its "infeasible": a Farkas certificate
   y >= 0, M'y <= 0, q'y < 0 (so no z >= 0 has M z + q >= 0) found by HiGHS and checked in
   exact rational arithmetic on the data as stored (lcp.acceptance.farkas); a certificate that
@@ -16,6 +16,11 @@ per solve, and every answer is checked here, never taken from the solver:
   one, and a solution beyond it) and the claim counts as "unproved_infeasible". (An LCP can
   be feasible and still have no solution when M is not copositive-plus; such a claim cannot
   be certified this way either and counts as a failure.)
+* a secondary ray ("ray", Lemke's termination, rigidlcp's or a peer's) is no claim that no
+  solution exists: on a problem with an exact Farkas certificate it counts as "infeasible"
+  (the LCP has none), otherwise its outcome is "ray", a failure that claims nothing (Lemke's
+  method can end on a ray of an LCP that has solutions when M is not copositive-plus:
+  Cottle-Pang-Stone Sec. 4.4; Siconos's bimatrix game lcp_CPS_3 does, after one pivot).
 * a solve longer than the time limit, a refusal (NotApplicable), an exception, or any other
   status (max_iter, not_converged, failed) is a failure.
 
@@ -66,7 +71,9 @@ __all__ = ["Result", "problem_kind", "judge", "run_bench", "farkas_certificate",
            "write_csv", "append_csv", "read_csv", "available_methods", "check_methods",
            "LocalRunner", "PEERS", "SiconosRunner", "SICONOS_METHODS", "GRACE"]
 
-#: Claims that no solution exists.
+#: Statuses the harness checks for a proof that no solution exists: the claim "infeasible" and
+#: Lemke's termination "ray" (no claim: without a proof its outcome is "ray", not
+#: "unproved_infeasible").
 NO_SOLUTION = ("infeasible", "ray")
 
 
@@ -74,8 +81,9 @@ NO_SOLUTION = ("infeasible", "ray")
 class Result:
     """One (problem, method) solve. outcome: "solved" (certified solution), "infeasible"
     (certified: an LP proved it), or the failure: "uncertified", "timeout", "not_applicable",
-    "error", "unproved_infeasible", or the method's own status (max_iter, not_converged,
-    failed, ray on a feasible problem, ...)."""
+    "error", "unproved_infeasible" (a claim "infeasible" without a proof), or the method's own
+    status (max_iter, not_converged, failed, ray: Lemke's termination without a proof of
+    infeasibility, which claims nothing, ...)."""
 
     set: str
     problem: str
@@ -212,7 +220,8 @@ def judge(problem, method: str, set_name: str, raw: dict, time_limit: float,
                 "the LCP has no feasible point (an exact Farkas certificate): not a solution")
     elif status in NO_SOLUTION:
         proved = isinstance(problem, LCP) and exact_farkas(problem) is not None
-        outcome = "infeasible" if proved else "unproved_infeasible"
+        outcome = "infeasible" if proved else (
+            "ray" if status == "ray" else "unproved_infeasible")
     else:
         outcome = status
     return Result(**base, outcome=outcome, success=outcome in ("solved", "infeasible"),

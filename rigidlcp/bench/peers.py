@@ -35,7 +35,8 @@ import numpy as np
 class Peer:
     """A peer solver: the package it needs (its distribution name, for the version) and the
     call, M, q -> (z or None, status, iterations, message); status "solved" is the peer's
-    claim of a solution, "ray" its claim that none exists, anything else a failure."""
+    claim of a solution, "ray" its Lemke's termination on a secondary ray (no claim: infeasible
+    only when the harness proves it), anything else a failure."""
 
     package: str
     module: str
@@ -47,7 +48,7 @@ def _quantecon(M: np.ndarray, q: np.ndarray) -> tuple:
     from quantecon.optimize import lcp_lemke
 
     res = lcp_lemke(M, q, max_iter=1000 + 100 * q.size)
-    # status 0: solved, 1: iteration limit, 2: a secondary ray (its claim of no solution)
+    # status 0: solved, 1: iteration limit, 2: a secondary ray (Lemke's termination, no claim)
     status = {0: "solved", 1: "max_iter", 2: "ray"}.get(int(res.status), "failed")
     return res.z, status, int(res.num_iter), f"quantecon status {res.status}"
 

@@ -1,9 +1,9 @@
 """report.md of a ``rigidlcp bench`` run, in the manner of qpbenchmark's reports: the environment,
 the summary tables (rigidlcp.bench.report) over all sets and per set, one performance profile
 per kind of problem (rigidlcp.bench.profiles), the problems solved by nobody, the problems on
-which methods disagree, the false claims (a "solved" that fails the check, a "no solution"
-without a proof), every failure by problem with a one-line command that reruns it, and the
-results per problem.
+which methods disagree, the false claims (a "solved" that fails the check, an "infeasible"
+without a proof; a secondary ray claims nothing), every failure by problem with a one-line
+command that reruns it, and the results per problem.
 """
 
 from __future__ import annotations
@@ -37,14 +37,16 @@ def solved_by_nobody(results: Sequence[Result]) -> list[tuple[tuple[str, str], l
 
 def disagreements(results: Sequence[Result]) -> list[tuple[tuple[str, str], str]]:
     """Problems on which the methods' claims contradict each other: a certified solution
-    beside a claim that no solution exists (proved or not), or beside a certified
-    infeasibility (which would be a bug of the checks). One line of text each."""
+    beside a claim that no solution exists (status "infeasible", proved or not), or beside a
+    certified infeasibility (which would be a bug of the checks). One line of text each. A
+    secondary ray without a proof (outcome "ray", Lemke's termination) is no claim, so no
+    disagreement: it is listed with the failures."""
     out = []
     for key, rows in _problems(results).items():
         solved = [r.method for r in rows if r.outcome == "solved"]
         proved = [r.method for r in rows if r.outcome == "infeasible"]
         claims = [f"{r.method} ({r.status})" for r in rows
-                  if r.status in NO_SOLUTION and r.outcome != "infeasible"]
+                  if r.status in NO_SOLUTION and r.outcome not in ("infeasible", "ray")]
         if solved and (proved or claims):
             text = f"certified solutions by {', '.join(solved)}"
             if claims:
@@ -57,7 +59,8 @@ def disagreements(results: Sequence[Result]) -> list[tuple[tuple[str, str], str]
 
 def false_claims(results: Sequence[Result]) -> list[Result]:
     """Claims the check rejected: "solved" with an answer that is not a solution
-    (uncertified), "no solution" without a proof (unproved_infeasible)."""
+    (uncertified), "infeasible" without a proof (unproved_infeasible). A secondary ray claims
+    nothing (outcome "ray"): not listed here."""
     return [r for r in results if r.outcome in ("uncertified", "unproved_infeasible")]
 
 
@@ -112,7 +115,9 @@ def write_report(results: Sequence[Result], out: str | os.PathLike, *, time_limi
         "Every answer is checked by the harness, never taken from the solver (rigidlcp's "
         "methods, Siconos's and the other peers' alike): a claimed solution must pass "
         f"`verify.certify` (scaled complementarity residual <= {tol:g}); a claim that no "
-        "solution exists must be confirmed by an LP Farkas certificate; a solve over the time "
+        "solution exists must be confirmed by an LP Farkas certificate (so must a secondary "
+        "ray, Lemke's termination, to count as 'infeasible': otherwise its outcome is 'ray', a "
+        "failure that claims nothing); a solve over the time "
         f"limit ({time_limit:g} s), an error or any other status is a failure. A refusal "
         "(the method does not take the problem: outside its class or size limit) is counted "
         "apart, never timed and left out of every mean. Every method is timed the same way: "
@@ -181,9 +186,10 @@ def _sections(results: Sequence[Result], rerun: Callable[[Result], str] | None) 
     lines += [f"- `{p}` ({s}): {text}" for (s, p), text in disagreements(results)] or [
         "None: no certified solution beside a claim that no solution exists."]
     lines += ["", "## False claims", "",
-              "Answers whose claim the check rejected (a 'solved' that is not a solution, a "
-              "'no solution' without a proof): counted as failures of the method that gave "
-              "them.", ""]
+              "Answers whose claim the check rejected (a 'solved' that is not a solution, an "
+              "'infeasible' without a proof): counted as failures of the method that gave "
+              "them. A secondary ray without a proof (outcome 'ray') is Lemke's termination, "
+              "not a claim: it is a failure, listed by problem below.", ""]
     lines += [f"- {r.method} on `{r.problem}`: {r.outcome} (claimed {r.status}; "
               f"residual {r.residual:.1e}, scaled {r.scaled_residual:.1e})"
               for r in false_claims(results)] or ["None."]

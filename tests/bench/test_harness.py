@@ -157,24 +157,31 @@ def test_farkas_certificate_only_for_infeasible_problems():
         assert farkas_certificate(p.M, p.q) is None
 
 
-def test_a_ray_claim_needs_an_exact_certificate():
-    """A peer's "no solution" (Lemke's ray) is judged by the proof `lcp.solve` needs: on
-    tests/data/float_certificate_p_matrix_n16.npz, a P-matrix LCP (so it has a solution, at
-    |z| ~ 1e16) singular to working precision, the float LP certificate passes its 1e-9 margin
-    but no certificate holds in exact arithmetic: the claim is unproved. On the integer-built
-    infeasible set the exact certificate exists and the claim is certified."""
+def test_a_ray_needs_an_exact_certificate_to_count_as_infeasible():
+    """A peer's secondary ray (Lemke's termination) counts as "infeasible" only with the proof
+    `lcp.solve` needs: on tests/data/float_certificate_p_matrix_n16.npz, a P-matrix LCP (so it
+    has a solution, at |z| ~ 1e16) singular to working precision, the float LP certificate
+    passes its 1e-9 margin but no certificate holds in exact arithmetic: the outcome is "ray",
+    a failure that claims nothing (not "unproved_infeasible", a claim of no solution), and an
+    "infeasible" there is "unproved_infeasible". On the integer-built infeasible set the exact
+    certificate exists and both are certified."""
     data = np.load(DATA / "float_certificate_p_matrix_n16.npz")
     p_matrix = lcp.LCP(data["M"], data["q"], name="p16")
     assert farkas_certificate(p_matrix.M, p_matrix.q) is not None  # the float check is fooled
     assert exact_farkas(p_matrix) is None
     ray = {"kind": "answer", "z": np.full(16, np.nan), "status": "ray", "time": 1e-3,
            "iterations": 5, "message": "secondary ray"}
-    assert judge(p_matrix, "peer", "s", ray, 10.0, 1e-8).outcome == "unproved_infeasible"
+    r = judge(p_matrix, "peer", "s", ray, 10.0, 1e-8)
+    assert r.outcome == "ray" and not r.success
+    claim = {**ray, "status": "infeasible"}
+    r = judge(p_matrix, "peer", "s", claim, 10.0, 1e-8)
+    assert r.outcome == "unproved_infeasible" and not r.success
     for p in get_set("infeasible", **SMALL):
         y = exact_farkas(p)
         assert y is not None and np.all(y >= 0) and p.q @ y < 0
-        ray["z"] = np.full(p.n, np.nan)
+        ray["z"] = claim["z"] = np.full(p.n, np.nan)
         assert judge(p, "peer", "s", ray, 10.0, 1e-8).outcome == "infeasible"
+        assert judge(p, "peer", "s", claim, 10.0, 1e-8).outcome == "infeasible"
 
 
 def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
@@ -206,9 +213,9 @@ def test_a_solution_claimed_on_an_lcp_without_feasible_points_is_false():
 
 @given(n=st.integers(2, 12), seed=st.integers(0, 2**32 - 1), pd=st.booleans())
 def test_judged_rays_are_certified_exactly_when_there_is_no_feasible_point(n, seed, pd):
-    """A "ray" (no solution) claim: on the integer-built infeasible LCPs it is certified (an
-    exact Farkas certificate exists); on a positive definite LCP (always solvable: a P-matrix)
-    it never is, whatever q."""
+    """A "ray" (Lemke's termination): on the integer-built infeasible LCPs it is certified
+    infeasible (an exact Farkas certificate exists); on a positive definite LCP (always
+    solvable: a P-matrix) it never is, whatever q, and stays a "ray" (no claim)."""
     from rigidlcp.bench.problem_sets import infeasible_lcp
 
     rng = np.random.default_rng(seed)
@@ -219,7 +226,7 @@ def test_judged_rays_are_certified_exactly_when_there_is_no_feasible_point(n, se
         problem = infeasible_lcp(n, rng)
     ray = {"kind": "answer", "z": np.full(n, np.nan), "status": "ray", "time": 1e-3}
     outcome = judge(problem, "peer", "s", ray, 10.0, 1e-8).outcome
-    assert outcome == ("unproved_infeasible" if pd else "infeasible")
+    assert outcome == ("ray" if pd else "infeasible")
 
 
 def test_siconos_absent_is_reported_not_fatal():

@@ -79,9 +79,11 @@ def test_the_report_of_a_lying_and_a_refusing_method_and_two_fake_peers(doubles,
     # the fake peer's "solved" is judged by the project's check: a false success
     assert all(by[(p, "fake-liar")].outcome == "uncertified" for p in p_names)
     assert by[(p_names[0], "fake-liar")].status == "solved"
-    # a peer's claim of no solution: proved on the infeasible problem, a failure elsewhere
+    # a peer's secondary ray: proved infeasible on the infeasible problem; elsewhere a failure
+    # that claims nothing (outcome "ray", not "unproved_infeasible")
     assert by[(inf_name, "fake-ray")].outcome == "infeasible"
-    assert all(by[(p, "fake-ray")].outcome == "unproved_infeasible" for p in p_names)
+    assert all(by[(p, "fake-ray")].outcome == "ray" and not by[(p, "fake-ray")].success
+               for p in p_names)
 
     s = {x.method: x for x in summarize(results, time_limit=30)}
     assert s["test-refusing"].refused == 3 and math.isnan(s["test-refusing"].sgm_time)
@@ -101,10 +103,10 @@ def test_the_report_of_a_lying_and_a_refusing_method_and_two_fake_peers(doubles,
     nobody = report.split("## Solved by nobody")[1].split("##")[0]
     assert "None" in nobody  # lemke solves each
     disagree = report.split("## Methods disagree")[1].split("##")[0]
-    for p in p_names:  # lemke's certified solution beside fake-ray's claim of none
-        assert f"`{p}`" in disagree and "fake-ray (ray)" in disagree
+    assert "fake-ray" not in disagree  # a ray beside lemke's solution: no claim, no dispute
     false = report.split("## False claims")[1].split("##")[0]
     assert f"fake-liar on `{p_names[0]}`: uncertified (claimed solved" in false
+    assert "fake-ray" not in false
     failures = report.split("## Failures by problem")[1].split("## Results")[0]
     assert f"rerun: `rigidlcp bench --problems {p_names[0]} --methods test-lying`" in failures
     assert "test-refusing" not in failures  # a refusal is not a failure
@@ -130,12 +132,14 @@ def _r(problem, method, outcome, scaled=1e-14, forward=math.nan, status=None):
 
 
 def test_sections_from_hand_made_results():
-    results = [_r("a", "m", "solved"), _r("a", "k", "unproved_infeasible", status="ray"),
+    results = [_r("a", "m", "solved"), _r("a", "k", "unproved_infeasible", status="infeasible"),
                _r("b", "m", "timeout", math.nan), _r("b", "k", "max_iter", math.nan),
-               _r("c", "m", "solved"), _r("c", "k", "solved")]
+               _r("c", "m", "solved"), _r("c", "k", "solved"),
+               _r("d", "m", "solved"), _r("d", "k", "ray")]
     assert [key for key, _ in solved_by_nobody(results)] == [("s", "b")]
-    (key, text), = disagreements(results)
-    assert key == ("s", "a") and "m" in text and "k (ray)" in text
+    (key, text), = disagreements(results)  # d: a ray beside a solution claims nothing
+    assert key == ("s", "a") and "m" in text and "k (infeasible)" in text
+    assert "claimed no solution" in text
 
 
 def test_success_at_stated_accuracies_backward_and_forward():

@@ -476,9 +476,15 @@ def test_numerical_cycling_is_detected_and_restarted(monkeypatch):
     assert sol.success and calls["n"] == 1 and sol.info["exact"]
     assert "exact rational arithmetic" in sol.message
     np.testing.assert_allclose(sol.z, [1 / 3, 1 / 3], rtol=1e-15)
-    # larger problems restart with coarser ties
+    # EXACT_MAX_N < n <= EXACT_TIES_MAX_N: the float run again, its ambiguous ties exact
     calls["n"] = 0
     monkeypatch.setattr(lemke_module, "EXACT_MAX_N", 1)
+    sol = lcp.solve(lcp.LCP(M, q), "lemke")
+    assert sol.success and calls["n"] == 2 and "exact_ties" in sol.info
+    assert "ambiguous ratio ties decided in exact" in sol.message
+    # larger problems restart with coarser ties
+    calls["n"] = 0
+    monkeypatch.setattr(lemke_module, "EXACT_TIES_MAX_N", 1)
     sol = lcp.solve(lcp.LCP(M, q), "lemke")
     assert sol.success and calls["n"] == 2
     assert sol.info["tol_used"] == pytest.approx(1e-8) and "restarted" in sol.message
