@@ -1,9 +1,14 @@
 """Packings read and written: plain CSV / .npz (x, y, r [, m, I]) and LAMMPS text dumps.
 
 * CSV: a header line naming at least the columns x, y, r (any order; m and I optional, other
-  columns ignored), then one disk per line. Lines starting with '#' are comments; a comment
-  `# box: left=L right=R` (written by `write_packing`) gives the walls (a value "none": no
-  such wall).
+  columns ignored), then one disk per line. Optional columns box_left, box_right give the
+  walls, the same on every line (a value "none": no such wall); `write_packing` writes
+  x,y,r,m,I,box_left,box_right with the header as the FIRST line, so that csv.DictReader,
+  pandas.read_csv and numpy.genfromtxt(names=True) read it as it is (they take a first
+  comment line for the header; a sidecar file could be lost when the CSV is copied; a column
+  is read, or ignored, by every CSV tool, and survives sorting and filtering rows). Lines
+  starting with '#' are comments; files written before used a first line
+  `# box: left=L right=R` for the walls, still read.
 * .npz: arrays x, y, r [, m, I] and optional scalars left, right (NaN: no such wall).
 * LAMMPS dump (text, `dump ... custom`) of one snapshot: its `ITEM: ATOMS` columns x, y and
   radius (or diameter, halved; mass optional); atoms in the file's order. Recognized by its
@@ -40,6 +45,8 @@ from .packing import GAP_TOL, packing
 
 REQUIRED = ("x", "y", "r")
 OPTIONAL = ("m", "I")
+#: The CSV columns of the walls (module docstring), for the box's "left" and "right".
+BOX_COLUMNS = {"box_left": "left", "box_right": "right"}
 
 
 @dataclass
@@ -63,7 +70,7 @@ class Disks:
             if given is None and name in self.unusable:
                 raise InvalidFile(f"{self.unusable[name]}: give the {name} wall ({name}=X or "
                                   f"'none'; `rigidlcp forceset --{name}`), or write the disks "
-                                  "as a CSV with a '# box: left=.. right=..' comment")
+                                  "as a CSV with columns box_left, box_right")
             v = given if given is not None else stated
             if v is None:
                 return tight
@@ -156,9 +163,21 @@ def _read_csv(path: Path, lines: list[str]) -> Disks:
         for c in cols:
             cols[c].append(_number(path, k, c, fields[header.index(c)],
                                    positive=c in ("r", "m", "I")))
+        for c, side in BOX_COLUMNS.items():
+            if c in header:
+                _box_column(path, k, c, side, fields[header.index(c)], box)
     if header is None:
         raise InvalidFile(f"{path}: no header line naming the columns x, y, r")
     return _finish(path, cols, **box)
+
+
+def _box_column(path: Path, k: int, column: str, side: str, text: str, box: dict) -> None:
+    """A wall from a box_left / box_right field (module docstring): "none" or a number, the
+    same on every line (and as an old `# box:` comment, when the file has both)."""
+    value = "none" if text == "none" else _number(path, k, column, text)
+    if box.setdefault(side, value) != value:
+        raise InvalidFile(f"{path} line {k}, field {column!r}: {text!r}, but the {side} wall "
+                          f"is {box[side]!r} above (one box per file)")
 
 
 def _header_hint(line: str, header: list[str], missing: list[str],
@@ -315,8 +334,9 @@ def _lammps_box(path: Path, head: list[str], disks: Disks) -> None:
 
 def write_packing(path: str | os.PathLike, lattice: Lattice, m: np.ndarray | None = None,
                   inertia: np.ndarray | None = None, force: bool = False) -> Path:
-    """Write a lattice's disks as CSV (or .npz by suffix) with its walls; m, I default to the
-    lattice's own, else r^2 and m r^2 / 2. Refuses an existing file unless force."""
+    """Write a lattice's disks as CSV (or .npz by suffix) with its walls (the CSV's columns
+    box_left, box_right, header first: module docstring); m, I default to the lattice's own,
+    else r^2 and m r^2 / 2. Refuses an existing file unless force."""
     path = Path(path)
     check_new([path], force=force)
     r = lattice.radii
@@ -331,9 +351,9 @@ def write_packing(path: str | os.PathLike, lattice: Lattice, m: np.ndarray | Non
                 np.savez(fh, x=lattice.x[:, 0], y=lattice.x[:, 1], r=r, m=m, I=inertia,
                          **{k: np.nan if v is None else v for k, v in walls.items()})
     else:
-        box = " ".join(f"{k}={'none' if v is None else repr(float(v))}" for k, v in walls.items())
-        rows = [f"# box: {box}", "x,y,r,m,I"]
-        rows += [f"{a!r},{b!r},{c!r},{d!r},{e!r}" for a, b, c, d, e in
+        box = ",".join("none" if v is None else repr(float(v)) for v in walls.values())
+        rows = ["x,y,r,m,I," + ",".join(BOX_COLUMNS)]  # the header first (module docstring)
+        rows += [f"{a!r},{b!r},{c!r},{d!r},{e!r},{box}" for a, b, c, d, e in
                  zip(*(v.tolist() for v in (lattice.x[:, 0], lattice.x[:, 1], r, m, inertia)))]
 
         def write(tmp: str) -> None:

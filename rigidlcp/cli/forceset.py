@@ -221,9 +221,8 @@ def _forceset(args, lat, disks, left, right, system, out, known, journal) -> int
         print(f"existence undecided: {fs.undecided}")
         return _written(out, fs, args)
     if not fs.exists:
-        print("no equilibrium: Farkas certificate checked " + (
-            "in exact rational arithmetic" if fs.exact else
-            f"(no admissible forces with sum R < {fs.radius:.3g})"))
+        # analyse says "no" only with an exactly checked certificate (verify.statics.farkas)
+        print("no equilibrium: Farkas certificate checked in exact rational arithmetic")
         if fs.moving is not None and fs.moving.size < lat.p:
             shown = ", ".join(str(int(k)) for k in fs.moving[:20])
             more = f" and {fs.moving.size - 20} more" if fs.moving.size > 20 else ""
@@ -308,7 +307,8 @@ def _remove_empty(top, out) -> None:
 
 def _box_line(lat, disks, left, right) -> str:
     """Where the obstacles are and where each wall comes from (the option, the file's
-    '# box:' comment, or the tight box around the disks); the plane is y = 0."""
+    box_left / box_right columns or old '# box:' comment, or the tight box around the
+    disks); the plane is y = 0."""
     def side(name: str, at, given, stated) -> str:
         if at is None:
             return f"no {name} wall"

@@ -1,8 +1,8 @@
 """`rigidlcp pack`: a packing deposited under gravity (models.deposition), written as CSV/.npz.
 
 The interface is fixed (issue 22): `rigidlcp pack --n N --seed S [--radii MIN:MAX] --out FILE`;
-the CSV's header names x, y, r, m, I (m = r^2, I = m r^2 / 2) after a `# box: left= right=`
-comment (models.packing_io).
+the CSV's first line is its header x,y,r,m,I,box_left,box_right (m = r^2, I = m r^2 / 2; the
+walls repeated on every line: models.packing_io).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ def register(sub) -> None:
         description="Sequential deposition under gravity: each disk dropped at a random "
         "abscissa rolls down the pile to a resting position on two supports (disk, wall or "
         "plane), so its contacts are exact. Writes x, y, r, m, I (m = r^2, I = m r^2 / 2) as "
-        "CSV (or .npz by suffix), the walls in a '# box:' comment.")
+        "CSV (or .npz by suffix), the walls in columns box_left, box_right (header first).")
     p.add_argument("--n", type=int, default=None,
                    help="number of disks to deposit (required unless --array)")
     p.add_argument("--seed", type=seed, default=0,

@@ -141,6 +141,11 @@ def test_lammps_periodic_x_with_the_callers_walls(tmp_path):
     ("x,y,r\n1,nan,1\n", r"line 2, field 'y': 'nan' is not finite"),
     ("x,y,r,m\n1,1,1,zero\n", r"line 2, field 'm': 'zero' is not a number"),
     ("# box: left=0 top=3\nx,y,r\n", r"line 1: box comment field 'top'"),
+    ("x,y,r,box_left\n1,1,1,0\n3,1,1,0.5\n",
+     r"line 3, field 'box_left': '0.5', but the left wall is 0.0 above"),
+    ("# box: left=0 right=4\nx,y,r,box_right\n1,1,1,5\n",
+     r"line 3, field 'box_right': '5', but the right wall is 4.0 above"),
+    ("x,y,r,box_right\n1,1,1,wall\n", r"line 2, field 'box_right': 'wall' is not a number"),
     ("x,y,r\n", r"no disks"),
     ("", r"no header line"),
 ])

@@ -8,26 +8,33 @@ positive work, b . y < 0. (For lambda in P, b . y = lambda . H y = sum R g_n + S
 (the second block at frictional contacts only).
 
 y comes from one LP (min b . y, C y <= 0, |y| <= 1) and is checked, never taken on the LP's
-word, in one of two ways:
+word, in two ways:
 
-* floating point: with v the violations of the cone rows, every lambda in P has
-  sum R >= radius = (-b . y) / max(v); the certificate is accepted when radius exceeds
-  RADIUS_WEIGHTS times the packing's weight. HiGHS leaves C y <= 0 to its feasibility
-  tolerance (~1e-11 here), which caps that radius near 1e10 weights; so y is first projected
-  onto the cone rows it makes (nearly) active (`_polish`: least squares, twice), which
-  leaves rounding-size violations.
-* exact: the rows y nearly makes active are made exactly active by a rational y (python-flint's
-  row reduction, free unknowns at y's values as small fractions) and C y <= 0, b . y < 0 are
-  checked in rational arithmetic on the float data as stored (each double is a rational; mu
-  too; the rows of C are formed exactly from H), as lcp.acceptance.farkas does for LCPs. Such
-  a y proves P empty for the stored data: no tolerance and no radius (radius = inf).
+* floating point (evidence only): with v the violations of the cone rows, every lambda in P
+  has sum R >= radius = (-b . y) / max(v); `check` keeps y when that radius exceeds
+  RADIUS_WEIGHTS times the packing's weight. A radius bounds the size of the equilibria; it
+  does not prove that there is none (as for LCPs in lcp.acceptance.farkas: a float
+  certificate of radius 9.3e14 was once accepted on a P-matrix LCP with solutions of size
+  2.4e16). HiGHS leaves C y <= 0 to its feasibility tolerance (~1e-11 here), which caps that
+  radius near 1e10 weights; so y is first projected onto the cone rows it makes (nearly)
+  active (`_polish`: least squares, twice), which leaves rounding-size violations.
+* exact (the proof): the rows y nearly makes active are made exactly active by a rational y
+  (python-flint's row reduction, free unknowns at y's values as small fractions) and
+  C y <= 0, b . y < 0 are checked in rational arithmetic on the float data as stored (each
+  double is a rational; mu too; the rows of C are formed exactly from H), as
+  lcp.acceptance.farkas does for LCPs. Such a y proves P empty for the stored data: no
+  tolerance and no radius (radius = inf, exact True). Dense here up to EXACT_MAX_P disks;
+  beyond, on y's support only (`farkas`'s `exact` argument: verify.statics.local.
+  support_certificate, whose cost grows with the disks y moves, not with the packing).
 
-When neither check passes, no claim is made: `analyse` reports the existence as undecided
-(with the LP's statuses and the best radius) rather than "no".
+Only an exact certificate `proves` P empty. Otherwise no claim is made: `analyse` reports the
+existence as undecided, with the best floating-point certificate's radius as evidence, rather
+than "no".
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from fractions import Fraction
 
@@ -50,7 +57,8 @@ CROSSOVER_MAX_P = 3000
 @dataclass
 class Certificate:
     """y (3p) with H y in the dual cone and b . y < 0. radius: no lambda in P has sum R below
-    it (inf when exact); gap: -b . y with |y|_inf = 1; exact: checked in rational arithmetic."""
+    it (inf when exact); gap: -b . y with |y|_inf = 1; exact: checked in rational arithmetic.
+    y is None when not even the floating-point check passed (radius: the best one found)."""
 
     y: np.ndarray | None
     radius: float
@@ -59,7 +67,8 @@ class Certificate:
 
     @property
     def proves(self) -> bool:
-        return self.y is not None
+        """P is empty: only an exactly checked y proves it (module docstring)."""
+        return self.exact and self.y is not None
 
 
 def cone_rows(prob: StaticProblem) -> sp.csr_matrix:
@@ -86,9 +95,15 @@ def check(prob: StaticProblem, y: np.ndarray) -> Certificate:
     return Certificate(y / top if ok else None, float(radius) if gap > 0 else 0.0, gap)
 
 
-def farkas(prob: StaticProblem) -> Certificate:
-    """A checked certificate that P is empty, or one with y None (no claim) carrying the best
-    radius found (module docstring)."""
+#: An exact check of a candidate y beyond EXACT_MAX_P disks: an exact Certificate or None.
+ExactCheck = Callable[[StaticProblem, np.ndarray], "Certificate | None"]
+
+
+def farkas(prob: StaticProblem, exact: ExactCheck | None = None) -> Certificate:
+    """An exactly checked certificate that P is empty (`proves`), else the best evidence
+    (module docstring): a floating-point certificate with its radius (exact False), or y None
+    with the best radius found. exact: the exact check used beyond EXACT_MAX_P disks (None:
+    none there)."""
     C = cone_rows(prob)
     # first HiGHS's IPM without crossover (its interior optimum, polished): 2.2 against 3.7 CPU
     # s on a 3000-disk pile, and at 10^4 disks the crossover did not end in 15 minutes
@@ -101,7 +116,7 @@ def farkas(prob: StaticProblem) -> Certificate:
         y = farkas_lp(prob, C, crossover)
         if y is None:
             continue
-        cert = _settle(prob, C, y)
+        cert = _settle(prob, C, y, exact)
         if cert.proves:
             return cert
         best = max(best, cert, key=lambda k: k.radius)
@@ -133,22 +148,20 @@ def farkas_lp(prob: StaticProblem, C: sp.csr_matrix, crossover: bool) -> np.ndar
     return y if float(prob.b @ y) < 0 else None
 
 
-def _settle(prob: StaticProblem, C: sp.csr_matrix, y: np.ndarray) -> Certificate:
-    """The LP's y checked as it is, then polished, then (small piles) exactly; the best
-    floating-point check when none passes."""
-    best = check(prob, y)
-    if best.proves:
-        return best
+def _settle(prob: StaticProblem, C: sp.csr_matrix, y: np.ndarray,
+            exact: ExactCheck | None = None) -> Certificate:
+    """The LP's y checked exactly (dense up to EXACT_MAX_P disks, else by `exact`), polished
+    first, then as it is; when no exact check passes, the better floating-point check of the
+    two (evidence, exact False)."""
     polished = _polish(C, y)
-    cert = check(prob, polished)
-    if cert.proves:
-        return cert
-    best = max(best, cert, key=lambda k: k.radius)
-    if prob.p <= EXACT_MAX_P:
-        for cand in (polished, y):
-            exact = exact_certificate(prob, cand)
-            if exact is not None:
-                return exact
+    best = max(check(prob, polished), check(prob, y), key=lambda k: k.radius)
+    for cand in (polished, y):
+        if prob.p <= EXACT_MAX_P:
+            cert = exact_certificate(prob, cand)
+        else:
+            cert = None if exact is None else exact(prob, cand)
+        if cert is not None and cert.proves:
+            return cert
     return best
 
 
@@ -226,25 +239,58 @@ def exact_certificate(prob: StaticProblem, y: np.ndarray, active_tol: float = 1e
 
 def first_exact(rows: list[list], bq: list, J: np.ndarray, start: list
                 ) -> tuple[list, object] | None:
-    """The first of two rational candidates, the y with the cone rows J exactly active and
-    its free unknowns at `start` (`solve_homogeneous`), then `start` itself, that is a
-    Farkas certificate exactly: b . y < 0 and row . y <= 0 for every row (C y <= 0). (y, b . y)
-    as python-flint fmpq's, or None when neither passes."""
-    from flint import fmpq, fmpq_mat
+    """The first rational candidate (`candidates`: the y with the cone rows J exactly active
+    and its free unknowns at `start`, then `start` itself, then J less one row of a numerical
+    dependency) that is a Farkas certificate exactly: b . y < 0 and row . y <= 0 for every row
+    (C y <= 0). (y, b . y) as python-flint fmpq's, or None when none passes."""
+    from flint import fmpq
 
-    cands = [start]
-    if J.size:
-        A = fmpq_mat(len(J), len(start), [v for j in J for v in rows[int(j)]])
-        cands.insert(0, solve_homogeneous(A, start))
-    for cand in cands:
-        if cand is None:
-            continue
+    for cand in candidates(rows, J, start):
         work = sum((bi * yi for bi, yi in zip(bq, cand)), fmpq(0))
         if work >= 0:
             continue
         if all(sum((r * yi for r, yi in zip(row, cand)), fmpq(0)) <= 0 for row in rows):
             return cand, work
     return None
+
+
+#: Most rows of a numerical dependency tried for dropping (`candidates`).
+DROP_TRIES = 8
+
+
+def candidates(rows: list[list], J: np.ndarray, start: list) -> Iterator[list]:
+    """Rational candidates for first_exact, each computed only when asked: the y with the
+    rows J exactly active (free unknowns at `start`), `start`, and then, when the rows J are
+    dependent in floating point but not exactly (the stored data's rounding of a degenerate
+    contact geometry: 71 rows of rank 70 in floats, 71 exactly, on a 400-disk pile, whose
+    exact null space then violates another row by 0.66), the y of J less one of the rows of a
+    numerical dependency (the largest coefficients first, at most DROP_TRIES): that row is
+    then within rounding of 0, on either side, so several are tried."""
+    from flint import fmpq_mat
+
+    def active(Jk: np.ndarray) -> list | None:
+        A = fmpq_mat(len(Jk), len(start), [v for j in Jk for v in rows[int(j)]])
+        return solve_homogeneous(A, start)
+
+    if J.size:
+        cand = active(J)
+        if cand is not None:
+            yield cand
+    yield start
+    if J.size < 2:
+        return
+    F = np.array([[float(v) for v in rows[int(j)]] for j in J])
+    U, sv, _ = np.linalg.svd(F)
+    rank = int(np.sum(sv > max(F.shape) * np.finfo(float).eps * sv[0])) if sv.size else 0
+    if rank >= J.size:
+        return
+    u = U[:, rank]  # a left null vector: sum_k u_k row_k ~ 0
+    for k in np.argsort(-np.abs(u), kind="stable")[:DROP_TRIES]:
+        if abs(u[k]) <= 1e-8 * float(np.max(np.abs(u))):
+            break
+        cand = active(np.delete(J, k))
+        if cand is not None:
+            yield cand
 
 
 def solve_homogeneous(A, start: list) -> list | None:

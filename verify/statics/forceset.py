@@ -6,9 +6,12 @@
   velocities under which every contact opens or slides within its cone while gravity does
   work): first a local one, moving a cluster of disks with the others fixed, found in small
   windows and checked in exact rational arithmetic (verify.statics.local), else the global
-  one, checked in floating point with a radius or in exact rational arithmetic
-  (verify.statics.farkas); when neither passes, exists is None (undecided, with the reason),
-  never a guess.
+  one, checked in exact rational arithmetic (verify.statics.farkas; on the disks it moves,
+  verify.statics.local.support_certificate, at any size). exists is False only with an exact
+  certificate; when none passes, exists is None (undecided, with the reason), never a guess,
+  and a floating-point certificate found on the way is kept as evidence (`certificate`,
+  `radius`: no equilibrium has sum R below it; "farkas_evidence" in the JSON): a radius
+  bounds the size of the equilibria, it does not exclude them.
 * dimension: of P itself, i.e. of its affine hull. An inequality of P that holds with equality
   on all of P (an implicit equality: R = 0, S = mu R or S = -mu R on the whole set) is found
   by linear programs maximizing slacks t_k in [0, scale] of the undecided rows (a row whose
@@ -50,7 +53,7 @@ from .centre import analytic_centre
 from .contact_ranges import check_jobs, contact_ranges
 from .farkas import Certificate, farkas
 from .hull import dimension, implicit_equalities
-from .local import START_DIAMETERS, scan
+from .local import START_DIAMETERS, scan, support_certificate
 from .model import ForceLP, StaticProblem, interior_point
 
 
@@ -79,6 +82,7 @@ class ForceSet:
     exact: bool = False  # the Farkas certificate is checked in exact rational arithmetic
     undecided: str = ""
     moving: np.ndarray | None = None  # a local certificate's disks (the others held fixed)
+    gap: float | None = None  # -b . y of `certificate` (|y|_inf = 1)
 
     @property
     def c(self) -> int:
@@ -121,6 +125,8 @@ class ForceSet:
                 out["farkas_disks"] = [int(k) for k in self.moving]
             if self.exists is None:
                 out["undecided"] = self.undecided
+                if self.certificate is not None:
+                    out["farkas_evidence"] = self.evidence()
             out["contacts"] = [{"i": int(i), "j": int(j), "R": None, "S": None}
                                for i, j in zip(lat.i, lat.j)]
             return out
@@ -153,6 +159,23 @@ class ForceSet:
                    unknown_ends=[u.to_dict(c, lat.i, lat.j) for u in self.unknown],
                    retried=self.retried)
         return out
+
+    def evidence(self) -> dict:
+        """An undecided existence's floating-point Farkas certificate (not a proof: its exact
+        check failed or was out of reach): "radius" (no equilibrium has sum R below it, force
+        units; null when y violates no cone row in floating point, which still proves
+        nothing: rounding), "radius_weights" (the same in weights), "gap" (-b . y,
+        |y|_inf = 1) and "moving_disks" (the disks y moves, largest first, at most 20) of
+        "disks_moved"."""
+        y = self.certificate.reshape(3, -1)
+        move = np.max(np.abs(y), axis=0)
+        order = np.argsort(-move, kind="stable")
+        moved = int(np.sum(move > 1e-9 * float(np.max(move, initial=0.0))))
+        weight = float(np.sum(self.system.masses)) * self.system.g
+        radius = None if not np.isfinite(self.radius) else float(self.radius)
+        return {"radius": radius, "radius_weights": None if radius is None else radius / weight,
+                "gap": self.gap, "disks_moved": moved,
+                "moving_disks": [int(k) for k in order[:min(moved, 20)]]}
 
     def _slide_unknown(self, a: int) -> bool:
         return self.sliding_unknown is not None and bool(self.sliding_unknown[a])
@@ -197,10 +220,8 @@ def analyse(system: models.System, ranges: bool = True,
             status, lam = lp.solve(np.zeros(prob.n))
         if cert is not None and cert.proves or status != "optimal" or not prob.admissible(lam):
             cert = cert if cert is not None else _certificate(prob, say)
-            if not cert.proves:  # neither a checked solution nor a checked certificate
-                return ForceSet(system, None, radius=cert.radius, lps=3,
-                                undecided=f"equilibrium LP {status}; Farkas certificate "
-                                f"not proved (radius {cert.radius:.3g} weights' units)")
+            if not cert.proves:  # neither a checked solution nor an exact certificate
+                return _undecided(system, status, cert, weight)
             if isinstance(cert, _Local):
                 return _falls(system, cert.y, cert.disks, cert.windows + 1)
             return ForceSet(system, False, certificate=cert.y, radius=cert.radius, lps=3,
@@ -278,7 +299,29 @@ def _certificate(prob: StaticProblem, say=_silent) -> Certificate:
     if local is not None:
         return _Local(local.y, local.disks, local.gap, local.windows)
     say("existence: global Farkas certificate (IPM)", "")
-    return farkas(prob)
+    return farkas(prob, exact=_on_support)
+
+
+def _on_support(prob: StaticProblem, y: np.ndarray) -> Certificate | None:
+    """The global Farkas candidate y checked exactly on the disks it moves
+    (verify.statics.local.support_certificate), as a _Local certificate."""
+    local = support_certificate(prob, y)
+    return None if local is None else _Local(local.y, local.disks, local.gap, 0)
+
+
+def _undecided(system: models.System, status: str, cert: Certificate,
+               weight: float) -> ForceSet:
+    """Existence undecided: no checked equilibrium and no exact Farkas certificate; a
+    floating-point one, when found, kept as evidence (module docstring)."""
+    if cert.y is None:
+        why = f"Farkas certificate not proved (best radius {cert.radius:.3g})"
+    else:
+        why = (f"a floating-point Farkas certificate (radius {cert.radius / weight:.3g} "
+               "weights) failed the exact check or was out of its reach: the absence of an "
+               "equilibrium is not proved")
+    return ForceSet(system, None, certificate=cert.y, radius=cert.radius, lps=3,
+                    gap=cert.gap if cert.y is not None else None,
+                    undecided=f"equilibrium LP {status}; {why}")
 
 
 def _falls(system: models.System, y: np.ndarray, disks: np.ndarray, lps: int) -> ForceSet:
