@@ -330,7 +330,7 @@ def _accepts(system: System, pattern: Pattern, wit: SteadyWitness, check) -> str
 def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: float = 60.0,
                check: Callable[[SteadyWitness], bool] | None = None,
                known: list[SteadyWitness] = (), kinematics: str = "auto",
-               clock: str = "wall") -> PatternResult:
+               clock: str = "cpu") -> PatternResult:
     """A valid steady state of `target` (a System, or its Formulation) satisfying `pattern`, or
     a proof that none does (module docstring). check(witness) -> bool: the caller's own test
     of the property on the witness (e.g. the classifier of models.modes); a witness must pass
@@ -338,9 +338,9 @@ def find_state(target: System | Formulation, pattern: Pattern, *, time_limit: fl
     seeds', earlier witnesses), tried first: one that passes is the answer, no MILP.
     kinematics: MilpModel's; "auto" is "lazy-a_t" (states checked on the contacts with a_t =
     0 only) where that is exact (gamma != 0, V = gamma t admitted), else "lazy". clock:
-    time_limit counted on the wall clock ("wall") or as this process's CPU seconds ("cpu":
-    the same work whatever the machine's load; verify.ranges.milp.MilpModel); the result's
-    `seconds` are wall seconds either way."""
+    time_limit counted as this process's CPU seconds ("cpu", the default: the same work
+    whatever the machine's load; verify.ranges.milp.MilpModel) or on the wall clock
+    ("wall"); the result's `seconds` are wall seconds either way."""
     now = milp_clock(clock)  # a wrong clock refused before any work (ValueError)
     t0, c0 = time.perf_counter(), now()
     form = target if isinstance(target, Formulation) else formulate(target)

@@ -162,7 +162,7 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
                   time_limit: float = 60.0, box: float | None = None,
                   V_mode: str | None = None, kinematics: str = "auto", split: bool | float = True,
                   progress: Callable[[int, int, str], None] | None = None,
-                  clock: str = "wall") -> SteadyRanges:
+                  clock: str = "cpu") -> SteadyRanges:
     """Range of each observable over all valid steady states of `target` (a System, or a Run
     that ended steady: its last state's values are reported beside the ranges and must lie
     in them). observables: {name: L over x = [R; S]}, or a matrix whose rows are named
@@ -175,8 +175,9 @@ def steady_ranges(target, observables: dict | None = None, *, which: str = "mu_g
     split: an end left at the time limit gets a proved bound by verify.ranges.cap_split where
     it applies (a number s: also disk_split's, s seconds per end). progress(done, total,
     name): called after each end's search (total: 2 per observable). clock: time_limit and
-    the disk split's seconds counted on the wall clock ("wall") or as this process's CPU
-    time ("cpu": the same work whatever the machine's load; verify.ranges.milp.MilpModel).
+    the disk split's seconds counted as this process's CPU time ("cpu", the default, as
+    `rigidlcp ranges` and verify.certify: the same work whatever the machine's load;
+    verify.ranges.milp.MilpModel) or on the wall clock ("wall").
     Raises NotSteady (none valid, run not steady)."""
     milp_clock(clock)  # a wrong clock refused before any work (InvalidInput)
     time_limit = seconds(time_limit)
