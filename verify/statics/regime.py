@@ -14,8 +14,12 @@ solution *every* solution of the event leaves the regime: the detachment is the 
 packing under those sliding directions, not a choice of the solver. That is proved by a Farkas
 certificate y (2p, a virtual translation of the disks): with lambda = T w, w >= 0 (cone
 coordinates: R = w, S = -s mu w when sliding; u = mu R - S, v = mu R + S for a candidate),
-K = A T must satisfy K^T y <= 0 while b . y > 0, so that no w >= 0 gives K w = b. It is checked
-in floating point with a margin (`check`).
+K = A T must satisfy K^T y <= 0 while b . y > 0, so that no w >= 0 gives K w = b. It is first
+checked in floating point with a margin, then proved in exact rational arithmetic on the data
+as stored (`check`: every double is a fraction; y as found, or its small-fraction form): only
+an exactly checked y makes the answer "no". A y that passes only in floating point bounds the
+size of any forces (its radius) but proves nothing, and leaves the answer undecided with that
+evidence (as lcp.acceptance.farkas and verify.statics.farkas do).
 
 When they have a solution (a witness, checked), the regime is possible for the translations;
 whether the event's LCP selects such a solution is then the selection's business (the tangential
@@ -25,6 +29,7 @@ complementarity of Eq. 2.7 is not part of this test): `regime` says "possible", 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 
 import numpy as np
 import scipy.sparse as sp
@@ -93,34 +98,129 @@ def regime(system: models.System, state: models.State, tol: float = 1e-9) -> Reg
                           message="the regime is possible: forces with R >= 0 and the sliding "
                           f"laws hold every translation (balance residual {resid:.2g})")
         return Regime(None, message=f"undecided: the witness fails its check ({resid:.2g})")
-    return certificate(K, b)
+    return certificate(K, b, A, T)
 
 
-def certificate(K: sp.csr_matrix, b: np.ndarray) -> Regime:
+def certificate(K: sp.csr_matrix, b: np.ndarray, A: sp.csr_matrix | None = None,
+                T: sp.csr_matrix | None = None) -> Regime:
     """y with K^T y <= 0 and b . y > 0 (no w >= 0 solves K w = b), found by an LP in the box
-    |y| <= 1, then checked (`check`)."""
+    |y| <= 1, then checked (`check`; exactly on A and T, K = A T, when given)."""
     res = linprog(-b, A_ub=K.T, b_ub=np.zeros(K.shape[1]), bounds=(-1, 1), method="highs")
     if res.status != 0 or -res.fun <= 0:
         return Regime(None, message="undecided: no equilibrium found and no certificate")
-    return check(K, b, res.x)
+    return check(K, b, res.x, A, T)
 
 
 #: A certificate must exclude every w with sum w below this many times sum |b| (the loads).
 RADIUS_LOADS = 1e9
 
 
-def check(K: sp.csr_matrix, b: np.ndarray, y: np.ndarray) -> Regime:
-    """The Farkas certificate y checked in floating point. If some w >= 0 solved K w = b, then
-    b . y = sum_j w_j K_j . y <= max(0, max_j K_j . y) sum w: with gap = b . y > 0 and
-    worst = max_j K_j . y, every solution has sum w >= gap / worst (infinite when worst <= 0).
-    Accepted when that radius exceeds RADIUS_LOADS x sum |b|: no physical forces remain."""
+def check(K: sp.csr_matrix, b: np.ndarray, y: np.ndarray, A: sp.csr_matrix | None = None,
+          T: sp.csr_matrix | None = None) -> Regime:
+    """The Farkas certificate y checked in floating point, then exactly. If some w >= 0 solved
+    K w = b, then b . y = sum_j w_j K_j . y <= max(0, max_j K_j . y) sum w: with gap = b . y > 0
+    and worst = max_j K_j . y, every solution has sum w >= gap / worst (infinite when worst <=
+    0). A y whose radius reaches RADIUS_LOADS x sum |b| is then checked in rationals
+    (`exact_farkas`, on A and T when given: K = A T as stored, not its rounded product); only
+    then "no" (exists False). Otherwise undecided, y and its radius kept as evidence."""
     gap = float(b @ y)
     worst = float(np.max(K.T @ y, initial=0.0))
     radius = np.inf if worst <= 0 else gap / worst
     loads = float(np.sum(np.abs(b))) or 1.0
-    if gap > 0 and radius >= RADIUS_LOADS * loads:
-        return Regime(False, y=y, margin=radius,
-                      message="no forces keep the disks in place (Farkas certificate checked: "
-                      f"b.y = {gap:.3g} > 0, max K^T y = {worst:.2g}): every solution of the "
-                      "event leaves the no-displacement regime")
-    return Regime(None, message="undecided: the certificate fails its check")
+    if not (gap > 0 and radius >= RADIUS_LOADS * loads):
+        return Regime(None, message="undecided: the certificate fails its check")
+    exact = exact_farkas(K if A is None else A, b, y, None if A is None else T)
+    if exact is None:
+        return Regime(None, y=y, margin=radius,
+                      message="undecided: a Farkas certificate passes in floating point (b.y = "
+                      f"{gap:.3g} > 0, forces would exceed {radius:.3g} x the loads) but not in "
+                      "exact arithmetic: that the event leaves the no-displacement regime is "
+                      "not proved")
+    return Regime(False, y=exact, margin=radius,
+                  message="no forces keep the disks in place (Farkas certificate checked in "
+                  f"exact arithmetic: b.y = {gap:.3g} > 0, K^T y <= 0): every solution of the "
+                  "event leaves the no-displacement regime")
+
+
+def _exact_ok(A: sp.csr_matrix, b: np.ndarray, T: sp.csr_matrix | None,
+              yq: dict[int, Fraction]) -> bool:
+    """b . y > 0 and (A T)^T y <= 0 in rationals (y given on its support yq)."""
+    if sum((Fraction(float(b[i])) * v for i, v in yq.items()), Fraction(0)) <= 0:
+        return False
+    At = sp.csr_matrix(A.T)  # row k of A^T: column k of A
+    u: dict[int, Fraction] = {}
+    for k in range(At.shape[0]):
+        lo, hi = At.indptr[k], At.indptr[k + 1]
+        acc = Fraction(0)
+        for i, a in zip(At.indices[lo:hi], At.data[lo:hi]):
+            if int(i) in yq:
+                acc += Fraction(float(a)) * yq[int(i)]
+        if acc:
+            u[k] = acc
+    if T is None:
+        return all(v <= 0 for v in u.values())
+    Tt = sp.csc_matrix(T)
+    for j in range(Tt.shape[1]):
+        lo, hi = Tt.indptr[j], Tt.indptr[j + 1]
+        acc = Fraction(0)
+        for k, t in zip(Tt.indices[lo:hi], Tt.data[lo:hi]):
+            if int(k) in u:
+                acc += Fraction(float(t)) * u[int(k)]
+        if acc > 0:
+            return False
+    return True
+
+
+#: Largest support of y (2 unknowns per disk it moves) for the exact row reduction of
+#: `exact_farkas` (dense, in rationals): ~3 CPU s at 100 disks (about 200 unknowns), 235 CPU s
+#: at 300 (a spun 300-disk pile, 2026-11-28); beyond it a certificate that passes only in
+#: floating point leaves the regime undecided.
+EXACT_SUPPORT = 200
+
+
+def exact_farkas(A: sp.csr_matrix, b: np.ndarray, y: np.ndarray,
+                 T: sp.csr_matrix | None = None) -> np.ndarray | None:
+    """A y that proves in exact rationals that no w >= 0 solves (A T) w = b (T None: A w = b):
+    b . y > 0 and (A T)^T y <= 0, with A, T, b the stored doubles read as fractions. Tried: y
+    as found; then, on y's support (entries above 1e-12 max|y|; y is 0 elsewhere, so the
+    columns that do not touch it contribute 0), the rational y that makes the nearly active
+    columns exactly active, and y's small-fraction form (verify.statics.farkas.first_exact, as
+    forceset's certificates). None when none passes."""
+    from .farkas import first_exact, rational, small_rational
+
+    y = np.asarray(y, dtype=float)
+    top = float(np.max(np.abs(y), initial=0.0))
+    if not top > 0 or not np.all(np.isfinite(y)):
+        return None
+    A, b = sp.csr_matrix(A), np.asarray(b, dtype=float)
+    plain = {int(i): Fraction(float(y[i])) for i in np.flatnonzero(y)}
+    if _exact_ok(A, b, T, plain):
+        return y
+    y = y / top
+    S = np.flatnonzero(np.abs(y) > 1e-12)
+    if S.size > EXACT_SUPPORT:
+        return None
+    K = sp.csc_matrix(A[S] @ T if T is not None else A[S])
+    touched = np.flatnonzero(np.diff(K.indptr))
+    At = sp.csc_matrix(A[S])  # columns of A on the support rows
+    Tc = sp.csc_matrix(T) if T is not None else None
+    rows = []
+    for j in touched:  # column j of (A T) on the support, exactly
+        col: dict[int, object] = {}
+        terms = (zip(Tc.indices[Tc.indptr[j]:Tc.indptr[j + 1]],
+                     Tc.data[Tc.indptr[j]:Tc.indptr[j + 1]]) if Tc is not None
+                 else [(j, 1.0)])
+        for k, t in terms:
+            tq = rational(t)
+            for i, a in zip(At.indices[At.indptr[k]:At.indptr[k + 1]],
+                            At.data[At.indptr[k]:At.indptr[k + 1]]):
+                col[int(i)] = col.get(int(i), 0) + tq * rational(a)
+        rows.append([col.get(i, rational(0.0)) for i in range(S.size)])
+    g = K[:, touched].T @ y[S]
+    found = first_exact(rows, [rational(-v) for v in b[S]], np.flatnonzero(g > -1e-9),
+                        [small_rational(v) for v in y[S]])
+    if found is None:
+        return None
+    out = np.zeros(len(y))
+    out[S] = [int(v.p) / int(v.q) for v in found[0]]
+    return out / float(np.max(np.abs(out)))

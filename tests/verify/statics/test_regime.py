@@ -3,6 +3,7 @@ no-displacement regime)? Checked against a case by hand and against the event en
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from rigidlcp import models
@@ -123,3 +124,31 @@ def test_time_stepper_reaches_the_same_steady_state_on_the_pile():
     assert ev.status == ts.status == "steady"
     assert np.array_equal(ev.last.s, ts.records[-1].s)
     assert abs(ev.last.mu_g - ts.summary()["mu_g"]) <= 1e-9
+
+
+def test_a_float_only_certificate_proves_nothing():
+    """K = [-1, 1e-30], b = 1: w = (0, 1e30) solves K w = b exactly, yet y = 1 passes the
+    floating-point test (b.y = 1 > 0, max K^T y = 1e-30: every solution has sum w >= 1e30,
+    beyond RADIUS_LOADS). It must not be a "no"; the exact check refuses it."""
+    from rigidlcp.verify.statics.regime import check
+
+    K, b = sp.csr_matrix(np.array([[-1.0, 1e-30]])), np.array([1.0])
+    r = check(K, b, np.array([1.0]))
+    assert r.exists is None and r.y is not None and r.margin >= 1e29
+    assert "not in exact arithmetic" in r.text()
+    # K = [-1, -2]: no w >= 0 gives K w = 1, and y = 1 proves it exactly
+    proved = check(sp.csr_matrix(np.array([[-1.0, -2.0]])), b, np.array([1.0]))
+    assert proved.exists is False and "exact" in proved.text()
+
+
+def test_the_exact_check_uses_the_product_as_stored():
+    """K = A T with A = [1, 1], T = [[0.1], [-0.1]]: the float product of K is 0 or a rounding
+    of it, but exactly (A T) = 0.1 - 0.1 = 0 (both 0.1 the same double), so y = 1 with b = 1 has
+    (A T)^T y = 0 <= 0 and b.y = 1 > 0: proved from A and T themselves."""
+    from rigidlcp.verify.statics.regime import exact_farkas
+
+    A = sp.csr_matrix(np.array([[1.0, 1.0]]))
+    T = sp.csr_matrix(np.array([[0.1], [-0.1]]))
+    assert exact_farkas(A, np.array([1.0]), np.array([1.0]), T) is not None
+    T_bad = sp.csr_matrix(np.array([[0.1], [-0.09999999999999999]]))  # A T > 0 exactly
+    assert exact_farkas(A, np.array([1.0]), np.array([1.0]), T_bad) is None
