@@ -107,7 +107,7 @@ def test_lemke_answers_agree_with_exact_enumeration(n, seed, zeros, copositive_p
         assert certify(problem, sol, uniqueness="none").accepted
         alpha = tuple(int(i) for i in np.flatnonzero(sol.z > 0))
         match = [a for a in found if set(alpha) <= set(a)
-                 and np.allclose(sol.z[list(a)], [float(v) for v in found[a]], rtol=1e-9,
+                 and np.allclose(sol.z[list(a)], [int(v.p) / int(v.q) for v in found[a]], rtol=1e-9,
                                  atol=1e-12 * max(1.0, float(np.abs(sol.z).max())))
                  and np.all(np.delete(sol.z, list(a)) == 0)]
         assert match, (sol.z, list(found))

@@ -279,7 +279,8 @@ def candidates(rows: list[list], J: np.ndarray, start: list) -> Iterator[list]:
     yield start
     if J.size < 2:
         return
-    F = np.array([[float(v) for v in rows[int(j)]] for j in J])
+    # p / q: python-flint's fmpq has no __float__ before 0.7 (the lowest-direct job)
+    F = np.array([[int(v.p) / int(v.q) for v in rows[int(j)]] for j in J])
     U, sv, _ = np.linalg.svd(F)
     rank = int(np.sum(sv > max(F.shape) * np.finfo(float).eps * sv[0])) if sv.size else 0
     if rank >= J.size:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import scipy
 
 from rigidlcp import models
 from rigidlcp.verify.ranges import steady_ranges
@@ -26,6 +27,16 @@ from rigidlcp.verify.ranges.observables import mu_g_vector, steady_observables
 from rigidlcp.verify.ranges.result import OPTIMAL, UNBOUNDED
 from rigidlcp.verify.ranges.steady import formulate, state_extreme, state_velocities
 from rigidlcp.verify.ranges.witness import WITNESS_TOL, steady_check
+
+# scipy < 1.16 (the newest on Python 3.10) bundles an older HiGHS whose LPs at these scales
+# (values over 1e8) end "infeasible" where the newer one finds the valid state: the test's
+# own derivation (`_a_valid_state`) fails there, and the library answers those ends "failed"
+# with the unproved box named (an honest undecided, never "no valid steady state"), not the
+# decided ends these tests assert. Measured on the lowest-direct job (scipy 1.15.0, numpy
+# 1.24.0) with highspy 1.10-1.16: 1-3 of the 4 fail, all pass with scipy 1.17.
+pytestmark = pytest.mark.skipif(
+    tuple(int(v) for v in scipy.__version__.split(".")[:2]) < (1, 16),
+    reason="scipy < 1.16: its HiGHS cannot solve these 1e8-scale LPs (module comment)")
 
 # (lattice, lx, ly, mu_pp, mu_plane, gamma); mu_wall = 0
 RECT_4x2 = ("rect", 4, 2, 1.5100944943278496e-07, 0.058571737122677124, 0.2726493559896462)
