@@ -142,33 +142,26 @@ def check(K: sp.csr_matrix, b: np.ndarray, y: np.ndarray, A: sp.csr_matrix | Non
                   "event leaves the no-displacement regime")
 
 
+def _columns_dot(C: sp.csc_matrix, v: dict[int, Fraction]) -> dict[int, Fraction]:
+    """C^T v in rationals, C's doubles read exactly (v and the result by their nonzeros)."""
+    out: dict[int, Fraction] = {}
+    for j in range(C.shape[1]):
+        lo, hi = C.indptr[j], C.indptr[j + 1]
+        acc = sum((Fraction(float(c)) * v[int(i)] for i, c in zip(C.indices[lo:hi], C.data[lo:hi])
+                   if int(i) in v), Fraction(0))
+        if acc:
+            out[j] = acc
+    return out
+
+
 def _exact_ok(A: sp.csr_matrix, b: np.ndarray, T: sp.csr_matrix | None,
               yq: dict[int, Fraction]) -> bool:
     """b . y > 0 and (A T)^T y <= 0 in rationals (y given on its support yq)."""
     if sum((Fraction(float(b[i])) * v for i, v in yq.items()), Fraction(0)) <= 0:
         return False
-    At = sp.csr_matrix(A.T)  # row k of A^T: column k of A
-    u: dict[int, Fraction] = {}
-    for k in range(At.shape[0]):
-        lo, hi = At.indptr[k], At.indptr[k + 1]
-        acc = Fraction(0)
-        for i, a in zip(At.indices[lo:hi], At.data[lo:hi]):
-            if int(i) in yq:
-                acc += Fraction(float(a)) * yq[int(i)]
-        if acc:
-            u[k] = acc
-    if T is None:
-        return all(v <= 0 for v in u.values())
-    Tt = sp.csc_matrix(T)
-    for j in range(Tt.shape[1]):
-        lo, hi = Tt.indptr[j], Tt.indptr[j + 1]
-        acc = Fraction(0)
-        for k, t in zip(Tt.indices[lo:hi], Tt.data[lo:hi]):
-            if int(k) in u:
-                acc += Fraction(float(t)) * u[int(k)]
-        if acc > 0:
-            return False
-    return True
+    u = _columns_dot(sp.csc_matrix(A), yq)  # A^T y
+    K_y = u if T is None else _columns_dot(sp.csc_matrix(T), u)  # T^T A^T y
+    return all(v <= 0 for v in K_y.values())
 
 
 #: Largest support of y (2 unknowns per disk it moves) for the exact row reduction of
