@@ -81,6 +81,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
     for name in COMMAND_MODULES:
         importlib.import_module(name).register(sub)
+    for command in sub.choices.values():  # a script may pass --no-progress to every command
+        if "--no-progress" not in command._option_string_actions:
+            command.add_argument("--no-progress", action="store_true",
+                                 help="accepted for scripts; this command shows no progress")
     return parser
 
 
