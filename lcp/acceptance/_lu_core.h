@@ -36,6 +36,25 @@ static void row_update(double *ai, const double *ak, double l, idx len)
 #define row_update row_update_plain
 #endif
 
+/* Step k's partial pivoting, shared by both `lu` loops: the row p >= k of largest |A[p, k]|
+ * (the first of equals), recorded in perm[k] and swapped with row k; -1 if that column is 0
+ * from row k down (U singular). */
+static inline int lu_pivot(idx m, double *A, idx *perm, idx k)
+{
+    idx p = k;
+    for (idx i = k + 1; i < m; i++)
+        if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
+    perm[k] = p;
+    if (A[p * m + k] == 0.0) return -1;
+    if (p != k)
+        for (idx j = 0; j < m; j++) {
+            double t = A[k * m + j];
+            A[k * m + j] = A[p * m + j];
+            A[p * m + j] = t;
+        }
+    return 0;
+}
+
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__)) && !defined(RIGIDLCP_NO_AVX2)
 #define LU_HAVE_AVX2 1
 /* `lu` below where the CPU has AVX2: the same operations on every entry (each multiplier
@@ -46,17 +65,7 @@ __attribute__((target("avx2"))) static int lu_avx2(idx m, double *A, idx *perm)
 {
     double umax = 0.0, umin = INFINITY;
     for (idx k = 0; k < m; k++) {
-        idx p = k;
-        for (idx i = k + 1; i < m; i++)
-            if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
-        perm[k] = p;
-        if (A[p * m + k] == 0.0) return -1;
-        if (p != k)
-            for (idx j = 0; j < m; j++) {
-                double t = A[k * m + j];
-                A[k * m + j] = A[p * m + j];
-                A[p * m + j] = t;
-            }
+        if (lu_pivot(m, A, perm, k) != 0) return -1;
         double piv = A[k * m + k];
         const __m256d vp = _mm256_set1_pd(piv);
         idx i = k + 1;
@@ -104,17 +113,7 @@ static int lu(idx m, double *A, idx *perm)
 #endif
     double umax = 0.0, umin = INFINITY;
     for (idx k = 0; k < m; k++) {
-        idx p = k;
-        for (idx i = k + 1; i < m; i++)
-            if (fabs(A[i * m + k]) > fabs(A[p * m + k])) p = i;
-        perm[k] = p;
-        if (A[p * m + k] == 0.0) return -1;
-        if (p != k)
-            for (idx j = 0; j < m; j++) {
-                double t = A[k * m + j];
-                A[k * m + j] = A[p * m + j];
-                A[p * m + j] = t;
-            }
+        if (lu_pivot(m, A, perm, k) != 0) return -1;
         double piv = A[k * m + k];
         for (idx i = k + 1; i < m; i++) {
             double l = A[i * m + k] / piv;
