@@ -30,6 +30,8 @@ from rigidlcp.lcp.solvers.lemke_exact import lemke_exact
 from rigidlcp.lcp.solvers.mlcp_full import split_lcp
 from rigidlcp.verify import certify
 
+from .test_lemke_degenerate import exact_solutions
+
 DATA = Path(__file__).resolve().parents[1] / "data" / "siconos"
 NO_PROOF = "ray (Lemke's termination; no proof of infeasibility)"
 
@@ -119,10 +121,6 @@ def test_integer_tie_cases_are_feasible_lcps_without_a_solution():
     feasible (the LP point below, checked in rationals) so "infeasible" would be false; no
     complementary pattern with a nonsingular principal block gives a solution (exact
     enumeration: every one of the 2^n patterns). lemke's "ray" is the honest answer."""
-    from itertools import combinations
-
-    from flint import fmpq_mat
-
     feasible = {0: {2: Fraction(1, 4), 5: Fraction(5, 8), 7: Fraction(5, 16),
                     8: Fraction(19, 16), 11: Fraction(11, 16)}}
     for j in (0, 1):
@@ -136,16 +134,6 @@ def test_integer_tie_cases_are_feasible_lcps_without_a_solution():
             z = [feasible[j].get(i, Fraction(0)) for i in range(n)]
             assert all(sum(int(M[i, k]) * z[k] for k in range(n)) + int(q[i]) >= 0
                        for i in range(n))
-        for k in range(1, n + 1):
-            for a in combinations(range(n), k):
-                A = fmpq_mat([[int(M[r, c]) for c in a] for r in a])
-                if A.det() == 0:
-                    continue
-                x = A.solve(fmpq_mat([[-int(q[r])] for r in a]))
-                za = [x[t, 0] for t in range(k)]
-                if min(za) < 0:
-                    continue
-                w = [int(q[r]) + sum(int(M[r, a[t]]) * za[t] for t in range(k))
-                     for r in range(n) if r not in a]
-                assert min(w, default=0) < 0, (j, a)  # not a solution
+        # no nonsingular pattern's exact solution is a solution (exact enumeration)
+        assert exact_solutions(case.M, case.q) == {}, j
         assert q.min() < 0  # the empty pattern (z = 0) is not one either

@@ -137,6 +137,16 @@ def fields_route(on: bool) -> None:
     assert kernel._lemke_c.array_fields_use(on) == on
 
 
+def with_fields_route_and_without(call, M, q):
+    """call(M, q) with the direct read of numpy's array fields on, then off (on again after)."""
+    try:
+        on = call(M, q)
+        fields_route(False)
+        return on, call(M, q)
+    finally:
+        fields_route(True)
+
+
 def direct(M, q):
     """The C call on the arrays as given: its Solution, its tuple (as plain values and bytes),
     or the type of its error."""
@@ -166,12 +176,7 @@ def test_the_array_fields_are_read_as_numpy_gives_them():
 @pytest.mark.parametrize("n", (1, 2, *SIZES))
 def test_the_same_answers_with_the_field_route_off(n, kind):
     M, q = _problem(n, kind, 1)
-    try:
-        on = natural(M, q)
-        fields_route(False)
-        off = natural(M, q)
-    finally:
-        fields_route(True)
+    on, off = with_fields_route_and_without(natural, M, q)
     assert same_outcome(on[0], off[0]) and on[1] == off[1]
 
 
@@ -193,11 +198,6 @@ _ro.flags.writeable = False
     (np.eye(3) + np.zeros(3, np.dtype(np.float64, metadata={"a": 1})), -np.ones(3)),
 ])
 def test_the_arrays_the_field_route_declines_are_answered_as_before(M, q):
-    try:
-        on = direct(M, q)
-        fields_route(False)
-        off = direct(M, q)
-    finally:
-        fields_route(True)
+    on, off = with_fields_route_and_without(direct, M, q)
     assert type(on) is type(off)
     assert same_outcome(on, off) if hasattr(on, "z") else on == off

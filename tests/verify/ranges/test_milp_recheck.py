@@ -27,19 +27,27 @@ def _system(mpp):
                          gamma=0.328125)
 
 
-def _a_valid_state():
-    near = steady_ranges(_system(1e-3), which="mu_g", time_limit=60, split=False)
+def state_near(system_at, tiny: float):
+    """A steady state of system_at(tiny) found without the MILP at that mu_pp: the contact
+    states of the minimum of mu_g at mu_pp = 1e-3 (a nearby system), their forces at `tiny`
+    by one LP (asserted optimal), their velocities. (system, form, its mu_g, steady_check's
+    independent residual), for the caller's own tolerance."""
+    near = steady_ranges(system_at(1e-3), which="mu_g", time_limit=60, split=False)
     s = np.asarray(near.mu_g.lo.witness.s)
-    system = _system(TINY)
+    system = system_at(tiny)
     form = formulate(system)
     L = mu_g_vector(system)
     status, x, _ = state_extreme(form, s, L, +1)
     assert status == OPTIMAL
     omega, V = state_velocities(form, s)
-    c = system.c
-    res, _ = steady_check(system, omega, V, x[:c], x[c:])
+    res, _ = steady_check(system, omega, V, x[:system.c], x[system.c:])
+    return system, form, float(L @ x), res
+
+
+def _a_valid_state():
+    system, form, value, res = state_near(_system, TINY)
     assert res <= 1e-8
-    return system, form, float(L @ x)
+    return system, form, value
 
 
 def test_feasible_milp_not_reported_infeasible():

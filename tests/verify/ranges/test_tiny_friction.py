@@ -23,10 +23,12 @@ import scipy
 
 from rigidlcp import models
 from rigidlcp.verify.ranges import steady_ranges
-from rigidlcp.verify.ranges.observables import mu_g_vector, steady_observables
+from rigidlcp.verify.ranges.observables import steady_observables
 from rigidlcp.verify.ranges.result import OPTIMAL, UNBOUNDED
-from rigidlcp.verify.ranges.steady import formulate, state_extreme, state_velocities
-from rigidlcp.verify.ranges.witness import WITNESS_TOL, steady_check
+from rigidlcp.verify.ranges.steady import formulate
+from rigidlcp.verify.ranges.witness import WITNESS_TOL
+
+from .test_milp_recheck import state_near
 
 # scipy < 1.16 (the newest on Python 3.10) bundles an older HiGHS whose LPs at these scales
 # (values over 1e8) end "infeasible" where the newer one finds the valid state: the test's
@@ -52,20 +54,12 @@ def _system(case, mu_pp=None):
 
 
 def _a_valid_state(case):
-    """A valid steady state of `case` and its mu_g, without the MILP at the tiny mu: the
-    contact states of the minimum of mu_g at mu_pp = 1e-3 (a nearby system), their forces at
-    the tiny mu_pp by one LP, their velocities, steady_check's independent residual."""
-    near = steady_ranges(_system(case, 1e-3), which="mu_g", time_limit=60, split=False)
-    s = np.asarray(near.mu_g.lo.witness.s)
-    system = _system(case)
-    form = formulate(system)
-    L = mu_g_vector(system)
-    status, x, _ = state_extreme(form, s, L, +1)
-    assert status == OPTIMAL
-    omega, V = state_velocities(form, s)
-    res, _ = steady_check(system, omega, V, x[:system.c], x[system.c:])
+    """A valid steady state of `case` and its mu_g, without the MILP at the tiny mu
+    (test_milp_recheck.state_near: the states of a nearby system's minimum, one LP at the
+    tiny mu_pp), checked by steady_check's independent residual."""
+    _, _, value, res = state_near(lambda mpp: _system(case, mpp), case[3])
     assert res <= WITNESS_TOL
-    return float(L @ x)
+    return value
 
 
 def _decided(end, L):
