@@ -60,6 +60,7 @@ from rigidlcp.verify.ranges.bounds import rotation_cap
 from rigidlcp.verify.ranges.disk_split import DOWN, NOTDOWN, NOTUP, OPEN, UP, _Cases, _load
 from rigidlcp.verify.ranges.milp import certified_result
 from rigidlcp.verify.ranges.observables import alpha_rows
+from rigidlcp.verify.ranges.seeds import two_colouring
 from rigidlcp.verify.ranges.steady import Formulation, _equalities, velocity_box
 
 
@@ -249,26 +250,16 @@ class Hull:
     def _colours(Tf: np.ndarray, p: int) -> np.ndarray:
         """sigma = +-1 with sigma_j = -sigma_i on every two-disk row (a 2-colouring), else
         ValueError."""
-        sigma = np.zeros(p, int)
         adj: list[list[int]] = [[] for _ in range(p)]
         for rr in Tf:
             nz = np.flatnonzero(rr)
             if nz.size == 2:
                 adj[nz[0]].append(nz[1])
                 adj[nz[1]].append(nz[0])
-        for s0 in range(p):
-            if sigma[s0]:
-                continue
-            sigma[s0], stack = 1, [s0]
-            while stack:
-                u = stack.pop()
-                for v in adj[u]:
-                    if sigma[v] == 0:
-                        sigma[v] = -sigma[u]
-                        stack.append(v)
-                    elif sigma[v] == sigma[u]:
-                        raise ValueError("the two-disk contacts do not 2-colour the disks")
-        return sigma
+        sigma = two_colouring(adj)
+        if sigma is None:
+            raise ValueError("the two-disk contacts do not 2-colour the disks")
+        return sigma.astype(int)
 
     def solve(self, col_lb: np.ndarray | None = None, col_ub: np.ndarray | None = None
               ) -> tuple[float, np.ndarray | None]:

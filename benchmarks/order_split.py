@@ -56,6 +56,7 @@ import numpy as np
 
 from rigidlcp.verify.ranges.bounds import rotation_cap
 from rigidlcp.verify.ranges.disk_split import DOWN, INSIDE, NOTDOWN, NOTUP, OPEN, UP, _Cases
+from rigidlcp.verify.ranges.seeds import two_colouring
 from rigidlcp.verify.ranges.steady import Formulation, velocity_box
 
 
@@ -114,19 +115,10 @@ def order_graph(form: Formulation, M: float) -> OrderGraph | None:
             adj[nz[1]].append(int(nz[0]))
         elif nz.size != 1:
             return None
-    sigma = np.zeros(p, dtype=int)
-    for s in range(p):  # 2-colour by breadth-first search
-        if sigma[s]:
-            continue
-        sigma[s], queue = 1, [s]
-        while queue:
-            i = queue.pop()
-            for j in adj[i]:
-                if sigma[j] == 0:
-                    sigma[j] = -sigma[i]
-                    queue.append(j)
-                elif sigma[j] == sigma[i]:
-                    return None
+    sigma = two_colouring(adj)
+    if sigma is None:
+        return None
+    sigma = sigma.astype(int)
     consts = [-M, M]
     u, v, o = [], [], []
     for a in fr:

@@ -14,29 +14,35 @@ from .steady import Formulation, least_R, state_extreme, state_velocities
 from .witness import WITNESS_TOL, steady_check
 
 
-def _two_colouring(system: System) -> np.ndarray | None:
-    """sigma = +-1 per disk with sigma_i = -sigma_j across every disk-disk contact, or None
-    (the contact graph is not bipartite)."""
-    lat, p = system.lattice, system.p
-    nbr: list[list[int]] = [[] for _ in range(p)]
-    for i, j in zip(lat.i, lat.j):
-        if 0 <= i < p and 0 <= j < p:
-            nbr[int(i)].append(int(j))
-            nbr[int(j)].append(int(i))
-    sigma = np.zeros(p)
-    for root in range(p):
+def two_colouring(adj: list[list[int]]) -> np.ndarray | None:
+    """sigma = +-1 (floats) per vertex with sigma_i = -sigma_j across every edge of the graph
+    `adj` (adjacency lists), each component's lowest vertex +1; None if it is not bipartite."""
+    sigma = np.zeros(len(adj))
+    for root in range(len(adj)):
         if sigma[root]:
             continue
         sigma[root], stack = 1.0, [root]
         while stack:
             i = stack.pop()
-            for j in nbr[i]:
+            for j in adj[i]:
                 if not sigma[j]:
                     sigma[j] = -sigma[i]
                     stack.append(j)
                 elif sigma[j] == sigma[i]:
                     return None
     return sigma
+
+
+def _two_colouring(system: System) -> np.ndarray | None:
+    """two_colouring of the disks across every disk-disk contact, or None (the contact graph
+    is not bipartite)."""
+    lat, p = system.lattice, system.p
+    nbr: list[list[int]] = [[] for _ in range(p)]
+    for i, j in zip(lat.i, lat.j):
+        if 0 <= i < p and 0 <= j < p:
+            nbr[int(i)].append(int(j))
+            nbr[int(j)].append(int(i))
+    return two_colouring(nbr)
 
 
 def seed_states(form: Formulation) -> list[np.ndarray]:
